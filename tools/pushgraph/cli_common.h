@@ -1,0 +1,40 @@
+#pragma once
+// Shared helpers of the `pushgraph` tool's subcommands. Each subcommand lives in its own
+// cmd_*.cpp and registers itself on the app; errors are thrown as CliError (or any
+// std::exception) and reported by main() as one line on stderr with exit status 1.
+#include <pushgraph/geometry/pose.h>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace pushgraph::cli {
+
+struct CliError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Subcommand registration (one per cmd_*.cpp).
+void RegisterDistance(CLI::App& app);
+void RegisterPenetration(CLI::App& app);
+void RegisterLimitSurface(CLI::App& app);
+void RegisterSimulate(CLI::App& app);
+
+/// Parses "X,Y,THETA" (finite numbers); `what` names the option in error messages.
+geometry::Pose2 ParsePose(const std::string& text, const std::string& what);
+/// Parses a comma-separated list of exactly `count` finite numbers.
+std::vector<double> ParseNumbers(const std::string& text, std::size_t count, const std::string& what);
+/// Formats a double with 17 significant digits (round-trips exactly).
+std::string FormatDouble(double value);
+/// Writes JSON with doubles printed to 17 significant digits.
+std::string DumpJson(const nlohmann::json& value, int indent = 2);
+
+/// Rewrites "--opt -0.1,0,1" into "--opt=-0.1,0,1" for options that take a value, so that
+/// negative numbers are never mistaken for options. `value_options` lists such long options.
+std::vector<std::string> JoinNegativeValues(const std::vector<std::string>& args,
+                                            const std::vector<std::string>& value_options);
+
+}  // namespace pushgraph::cli

@@ -1,0 +1,45 @@
+// pushgraph: command-line front end. Each subcommand is a thin layer over the libraries.
+#include "cli_common.h"
+
+#include <cstdio>
+#include <exception>
+#include <iostream>
+
+int main(int argc, char** argv) {
+  using namespace pushgraph::cli;
+  CLI::App app{"pushgraph: geometry-exact planar contact, limit surfaces and pushing estimation"};
+  app.require_subcommand(1, 1);
+  app.set_version_flag("--version", "pushgraph 0.1.0");
+  RegisterDistance(app);
+  RegisterPenetration(app);
+  RegisterLimitSurface(app);
+  RegisterSimulate(app);
+
+  std::vector<std::string> args(argv + 1, argv + argc);
+  // Every option that takes a value may be given a negative number after a space.
+  std::vector<std::string> value_options;
+  for (const CLI::App* sub : app.get_subcommands({})) {
+    for (const CLI::Option* opt : sub->get_options()) {
+      if (opt->get_type_size() == 0) continue;  // flags
+      for (const std::string& name : opt->get_lnames()) value_options.push_back("--" + name);
+    }
+  }
+  args = JoinNegativeValues(args, value_options);
+  std::vector<std::string> reversed(args.rbegin(), args.rend());
+  try {
+    app.parse(reversed);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::cerr << "pushgraph: " << e.what() << " (see pushgraph --help)\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "pushgraph: error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}
