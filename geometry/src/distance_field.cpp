@@ -49,15 +49,29 @@ DistanceField::DistanceField(const Shape& shape, const Options& options) : impl_
                         " samples; use a coarser resolution");
   m.bounds.max = m.bounds.min + m.h * Vec2(m.cols - 1, m.rows - 1);
   m.values.resize(static_cast<std::size_t>(m.rows) * m.cols);
-  for (int i = 0; i < m.rows; ++i)
-    for (int j = 0; j < m.cols; ++j)
-      m.values[static_cast<std::size_t>(i) * m.cols + j] = QueryPoint(shape, m.bounds.min + m.h * Vec2(j, i)).signed_distance;
+  // The closest feature of each sample: a cell whose corners disagree contains a kink of the
+  // field (the medial axis), where interpolation errs most and the check samples densely.
+  std::vector<long> feature(m.values.size());
+  for (int i = 0; i < m.rows; ++i) {
+    for (int j = 0; j < m.cols; ++j) {
+      const PointQuery q = QueryPoint(shape, m.bounds.min + m.h * Vec2(j, i));
+      const std::size_t k = static_cast<std::size_t>(i) * m.cols + j;
+      m.values[k] = q.signed_distance;
+      const EdgeId& e = q.feature.edge;
+      feature[k] = ((static_cast<long>(e.polygon) * 65536 + e.ring + 1) * 1048576 + e.index) * 2 +
+                   (q.feature.kind == BoundaryFeature::Kind::kEdge ? 1 : 0);
+    }
+  }
   m.grid = std::make_unique<ceres::Grid2D<double, 1>>(m.values.data(), 0, m.rows, 0, m.cols);
   m.interpolator = std::make_unique<ceres::BiCubicInterpolator<ceres::Grid2D<double, 1>>>(*m.grid);
 
-  const int s = options.error_samples_per_cell;
-  for (int i = 0; s > 0 && i + 1 < m.rows; ++i) {
+  const int samples = options.error_samples_per_cell;
+  for (int i = 0; samples > 0 && i + 1 < m.rows; ++i) {
     for (int j = 0; j + 1 < m.cols; ++j) {
+      const std::size_t k = static_cast<std::size_t>(i) * m.cols + j;
+      const bool kink = feature[k] != feature[k + 1] || feature[k] != feature[k + m.cols] ||
+                        feature[k] != feature[k + m.cols + 1];
+      const int s = kink ? 8 * samples + 1 : samples;
       for (int a = 0; a < s; ++a) {
         for (int c = 0; c < s; ++c) {
           const Vec2 p = m.bounds.min + m.h * Vec2(j + (c + 0.5) / s, i + (a + 0.5) / s);

@@ -113,13 +113,14 @@ void EdgeIndex::Build(const std::vector<Vec2>& vertices, const std::vector<int>&
   m.nx = m.ny = 0;
   if (n <= kLinearScanEdges) return;
 
-  // Grid over the bounds plus a margin of a quarter of the size; about 2 cells per edge.
+  // Grid over the bounds plus a margin of a quarter of the size; about 16 cells per edge, so
+  // that a cell is small against the features and its candidate list short (1 to 3 edges).
   const Vec2 size = bounds.max - bounds.min;
   const double extent = std::max(size.x(), size.y());
   const Vec2 margin = Vec2::Constant(0.25 * extent);
   m.grid = {bounds.min - margin, bounds.max + margin};
   const Vec2 gsize = m.grid.max - m.grid.min;
-  const int cells = std::clamp(static_cast<int>(2.0 * n), 64, 1 << 16);
+  const int cells = std::clamp(16 * n, 1024, 1 << 18);
   const double aspect = gsize.x() / std::max(gsize.y(), 1e-300);
   m.nx = std::clamp(static_cast<int>(std::ceil(std::sqrt(cells * aspect))), 1, 1024);
   m.ny = std::clamp(static_cast<int>(std::ceil(cells / static_cast<double>(m.nx))), 1, 1024);

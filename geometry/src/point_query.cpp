@@ -138,7 +138,8 @@ CoreResult QueryCore(const Shape::Impl& m, const Vec2& p, EdgeIndex::Span span) 
     const Vec2 left_unit = Vec2(a.y() - b.y(), b.x() - a.x()) / len;
     out.distance = std::abs(h);
     out.closest = best.cross == 0.0 ? p : Vec2(p - h * left_unit);
-    out.normal = -left_unit;
+    // A segment core has no inside: its normal points to the side the point is on.
+    out.normal = m.degenerate_core && best.cross > 0.0 ? left_unit : Vec2(-left_unit);
     out.side = best.cross == 0.0 ? 0 : (m.degenerate_core ? 1 : (best.cross > 0 ? -1 : 1));
     out.feature.t = std::clamp((p - a).dot(b - a) / best.len2, 0.0, 1.0);
     return out;

@@ -16,8 +16,20 @@ Eigen::Matrix2d RotationDerivative(double theta) {
   return dR;
 }
 
-// A(phi) = (phi / 2) sin(phi) / (1 - cos(phi)) and its derivative; series near 0 where the
-// closed form cancels. V(phi)^-1 = [[A, B], [-B, A]] with B = phi / 2.
+// sin(phi) - phi without cancellation: its Taylor series where |phi| < 1.
+double SinMinusX(double phi) {
+  if (std::abs(phi) >= 1.0) return std::sin(phi) - phi;
+  const double p2 = phi * phi;
+  double term = -phi * p2 / 6.0, sum = 0.0;
+  for (int k = 1; k < 12 && term != 0.0; ++k) {  // term_k = (-1)^k phi^(2k+1) / (2k+1)!
+    sum += term;
+    term *= -p2 / ((2.0 * k + 2.0) * (2.0 * k + 3.0));
+  }
+  return sum;
+}
+
+// A(phi) = (phi / 2) cot(phi / 2) and dA/dphi = (sin(phi) - phi) / (4 sin^2(phi / 2)), written
+// without cancellation; series at the origin. V(phi)^-1 = [[A, B], [-B, A]], B = phi / 2.
 void HalfCotTerm(double phi, double* a, double* da) {
   if (std::abs(phi) < 1e-4) {
     const double p2 = phi * phi;
@@ -25,28 +37,28 @@ void HalfCotTerm(double phi, double* a, double* da) {
     *da = -phi / 6.0 - p2 * phi / 180.0;
     return;
   }
-  const double s = std::sin(phi), c = std::cos(phi);
-  *a = 0.5 * phi * s / (1.0 - c);
-  // d/dphi [phi s / (2 (1 - c))] = (s + phi c) / (2 (1 - c)) - phi s^2 / (2 (1 - c)^2)
-  //                              = (s - phi) / (2 (1 - c))   (using s^2 = (1 - c)(1 + c))
-  *da = (s - phi) / (2.0 * (1.0 - c));
+  const double half_sin = std::sin(0.5 * phi);
+  *a = 0.5 * phi / std::tan(0.5 * phi);
+  *da = SinMinusX(phi) / (4.0 * half_sin * half_sin);
 }
 
-// (1 - cos(phi)) / phi and sin(phi) / phi with derivatives, for V(phi) in Exp.
+// sin(phi)/phi, (1 - cos(phi))/phi and their derivatives, for V(phi) in Exp, using
+// 1 - cos(phi) = 2 sin^2(phi / 2) and phi cos(phi) - sin(phi) = -phi (1 - cos(phi)) - (sin(phi) - phi).
 void ExpTerms(double phi, double* sa, double* cb, double* dsa, double* dcb) {
   if (std::abs(phi) < 1e-4) {
     const double p2 = phi * phi;
-    *sa = 1.0 - p2 / 6.0;
-    *cb = phi / 2.0 - p2 * phi / 24.0;
-    *dsa = -phi / 3.0;
-    *dcb = 0.5 - p2 / 8.0;
+    *sa = 1.0 - p2 / 6.0 + p2 * p2 / 120.0;
+    *cb = phi / 2.0 - p2 * phi / 24.0 + p2 * p2 * phi / 720.0;
+    *dsa = -phi / 3.0 + p2 * phi / 30.0 - p2 * p2 * phi / 840.0;
+    *dcb = 0.5 - p2 / 8.0 + p2 * p2 / 144.0;
     return;
   }
-  const double s = std::sin(phi), c = std::cos(phi);
+  const double s = std::sin(phi), half_sin = std::sin(0.5 * phi);
+  const double one_minus_cos = 2.0 * half_sin * half_sin;
   *sa = s / phi;
-  *cb = (1.0 - c) / phi;
-  *dsa = (c * phi - s) / (phi * phi);
-  *dcb = (s * phi - (1.0 - c)) / (phi * phi);
+  *cb = one_minus_cos / phi;
+  *dsa = (-phi * one_minus_cos - SinMinusX(phi)) / (phi * phi);
+  *dcb = (s * phi - one_minus_cos) / (phi * phi);
 }
 
 }  // namespace

@@ -44,7 +44,7 @@ Shape ParseShapeJson(const std::string& text, const std::string& source) {
   json doc;
   try {
     doc = json::parse(text);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // syntax errors, and numbers that overflow a double
     Fail(source, std::string("malformed JSON: ") + e.what());
   }
   if (!doc.is_object()) Fail(source, "top level must be an object with \"polygons\"");

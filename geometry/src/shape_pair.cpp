@@ -14,6 +14,8 @@
 #include "minkowski_obstacle.h"
 #include "shape_impl.h"
 
+#include <Eigen/LU>
+
 #include <cmath>
 #include <deque>
 #include <limits>
@@ -175,40 +177,101 @@ ShapePairResult ShapePairQuerier::Impl::QueryExact(const Pose2& object_pose, con
   const Vec2 c_contact = qc.closest_point - C.radius() * n_o;  // finger origin at first contact (cores)
   const Eigen::Matrix2d R = Pose2{0.0, 0.0, phi}.rotation();
 
-  // Which features touch at the contact configuration: the finger vertex nearest to the
-  // object's core boundary, and the object vertex nearest to the finger's core boundary.
-  double best_f = std::numeric_limits<double>::infinity(), best_o = best_f;
-  Vec2 f_l{0, 0}, o_l{0, 0};
-  for (const Vec2& f : finger.impl().vertices) {
-    const double d = std::abs(QueryPoint(object, c_contact + R * f).signed_distance + ro);
-    if (d < best_f) best_f = d, f_l = f;
+  // The touching pairs at the contact configuration c_contact generate C's closest feature.
+  // Each is a line of C's boundary, n . x = h, moving with phi (Lozano-Perez's type A: finger
+  // vertex on object edge, n fixed; type B: object vertex on finger edge, n turns with phi),
+  // or a vertex-vertex pair, a C vertex o - R f.
+  struct Pair {
+    bool vertex_vertex = false, finger_material = true;
+    Vec2 f{0, 0}, o{0, 0};  // finger vertex (finger frame) / object vertex (object frame)
+    Vec2 n{0, 0}, dn{0, 0};
+    double dh = 0.0;
+  };
+  const Eigen::Matrix2d dR = RotationDerivative(phi);
+  const Box2 ob = object.bounds(), fb = finger.bounds();
+  const double tol = 1e-9 * ((ob.max - ob.min).norm() + (fb.max - fb.min).norm());
+  std::vector<Pair> pairs;
+  const Shape::Impl& oi = object.impl();
+  const Shape::Impl& fi = finger.impl();
+  for (const Vec2& f : fi.vertices) {
+    const PointQuery q = QueryPoint(object, c_contact + R * f);
+    if (std::abs(q.signed_distance + ro) > tol) continue;
+    Pair p;
+    p.f = f;
+    if (q.feature.kind == BoundaryFeature::Kind::kVertex) {
+      p.vertex_vertex = true;
+      p.o = oi.vertices[oi.rings[0].first];  // replaced below by the exact vertex
+      for (const RingInfo& ring : oi.rings)
+        if (ring.polygon == q.feature.edge.polygon && ring.ring == q.feature.edge.ring) p.o = oi.vertices[ring.first + q.feature.edge.index];
+    } else {
+      p.n = q.normal;
+      p.dh = -p.n.dot(dR * f);
+    }
+    pairs.push_back(p);
   }
   const Pose2 contact_pose{c_contact.x(), c_contact.y(), phi};
-  for (const Vec2& o : object.impl().vertices) {
-    const double d = std::abs(QueryPoint(finger, contact_pose, o).signed_distance + rf);
-    if (d < best_o) best_o = d, o_l = o;
+  for (const Vec2& o : oi.vertices) {
+    const Vec2 local = R.transpose() * (o - c_contact);
+    const PointQuery q = QueryPoint(finger, local);
+    if (std::abs(q.signed_distance + rf) > tol || q.feature.kind == BoundaryFeature::Kind::kVertex) continue;
+    Pair p;
+    p.finger_material = false;
+    p.o = o;
+    p.n = -(R * q.normal);
+    p.dn = Perp(p.n);
+    p.dh = p.dn.dot(o);
+    pairs.push_back(p);
   }
-  const bool vertex_vertex = qc.feature.kind == BoundaryFeature::Kind::kVertex;
-  const bool finger_material = !vertex_vertex && best_f <= best_o;
-  const Vec2 g = finger_material ? f_l : Vec2(R.transpose() * (o_l - c_contact));  // finger-frame contact point
+  if (pairs.empty()) throw GeometryError("internal: no touching pair found at the contact configuration");
 
-  // d sd / d c = n; d sd / d phi = n . dR g (C's boundary moves by -dR g per unit of phi).
-  const Eigen::Matrix2d dR = RotationDerivative(phi);
-  const double sd_phi = n_o.dot(dR * g);
-  // d n / d c and d n / d phi in the object frame.
+  // d sd / d c = n; d sd / d phi and the normal's derivatives from the generating pair(s).
+  double sd_phi = 0.0;
   Eigen::Matrix2d Nc = Eigen::Matrix2d::Zero();
   Vec2 Nphi = Vec2::Zero();
-  if (vertex_vertex) {
+  const Pair* material = &pairs[0];
+  if (qc.feature.kind == BoundaryFeature::Kind::kEdge) {
+    const Pair* best = nullptr;
+    for (const Pair& p : pairs)
+      if (!p.vertex_vertex && (!best || p.n.dot(n_o) > best->n.dot(n_o))) best = &p;
+    if (!best) best = &pairs[0];
+    material = best;
+    sd_phi = best->dn.dot(c) - best->dh;
+    Nphi = best->dn;
+  } else {
+    // A C vertex: either o - R f, or the crossing of two contact lines (two simultaneous contacts).
+    Vec2 dv = Vec2::Zero();
+    const Pair* vv = nullptr;
+    for (const Pair& p : pairs)
+      if (p.vertex_vertex) vv = &p;
+    if (vv) {
+      dv = -(dR * vv->f);
+      material = vv;
+    } else {
+      const Pair* first = nullptr;
+      const Pair* second = nullptr;
+      for (const Pair& p : pairs) {
+        if (!first) first = &p;
+        else if (!second || std::abs(p.n.dot(first->n)) < std::abs(second->n.dot(first->n))) second = &p;
+      }
+      Eigen::Matrix2d Nm;
+      Nm << first->n.transpose(), (second ? second->n : first->n).transpose();
+      if (second && std::abs(Nm.determinant()) > 1e-12) {
+        const Vec2 rhs(first->dh - first->dn.dot(c_contact), second->dh - second->dn.dot(c_contact));
+        dv = Nm.inverse() * rhs;
+      }
+      material = first;
+    }
     const double d = (c - c_contact).norm();
+    sd_phi = -n_o.dot(dv);
     if (d > 0.0) {
       const double s = qc.signed_distance + C.radius() > 0.0 ? 1.0 : -1.0;
       const Eigen::Matrix2d P = Eigen::Matrix2d::Identity() - n_o * n_o.transpose();
       Nc = s * P / d;
-      Nphi = s * P * (dR * f_l) / d;
+      Nphi = -s * P * dv / d;
     }
-  } else if (!finger_material) {
-    Nphi = Perp(n_o);  // the contact edge belongs to the finger and turns with it
   }
+  const bool finger_material = material->finger_material;
+  const Vec2 f_l = material->f, o_l = material->o;
   const Eigen::Matrix2d Ro = object_pose.rotation();
   WitnessInputs w;
   w.sd = sd;

@@ -22,6 +22,7 @@ void RegisterDistance(CLI::App& app);
 void RegisterPenetration(CLI::App& app);
 void RegisterLimitSurface(CLI::App& app);
 void RegisterSimulate(CLI::App& app);
+void RegisterDemo(CLI::App& app);
 
 /// Parses "X,Y,THETA" (finite numbers); `what` names the option in error messages.
 geometry::Pose2 ParsePose(const std::string& text, const std::string& what);

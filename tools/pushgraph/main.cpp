@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   RegisterPenetration(app);
   RegisterLimitSurface(app);
   RegisterSimulate(app);
+  RegisterDemo(app);
 
   std::vector<std::string> args(argv + 1, argv + argc);
   // Every option that takes a value may be given a negative number after a space.

@@ -1,0 +1,180 @@
+// Runs the pushgraph tool as a user would and checks the contracts of its subcommands.
+#include <pushgraph/geometry/point_query.h>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace {
+
+namespace fs = std::filesystem;
+using pushgraph::geometry::Vec2;
+
+struct ToolRun {
+  int status = 0;
+  std::string out, err;
+};
+
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("pushgraph_cli_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string Write(const std::string& name, const std::string& text) {
+    const fs::path p = dir_ / name;
+    std::ofstream(p) << text;
+    return p.string();
+  }
+
+  ToolRun Exec(const std::string& args) {
+    const std::string err_path = (dir_ / "stderr.txt").string();
+    const std::string cmd = std::string(PUSHGRAPH_TOOL) + " " + args + " 2>" + err_path;
+    ToolRun run;
+    FILE* pipe = ::popen(cmd.c_str(), "r");
+    std::array<char, 4096> buf{};
+    std::size_t n = 0;
+    while ((n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0) run.out.append(buf.data(), n);
+    const int status = ::pclose(pipe);
+    run.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    std::ifstream e(err_path);
+    std::stringstream ss;
+    ss << e.rdbuf();
+    run.err = ss.str();
+    return run;
+  }
+
+  fs::path dir_;
+};
+
+const char* kSquareWithHole =
+    R"({"polygons": [{"outer": [[0,0],[1,0],[1,1],[0,1]], "holes": [[[0.4,0.4],[0.4,0.6],[0.6,0.6],[0.6,0.4]]]}]})";
+
+TEST_F(CliTest, DistancePrintsOneRowPerPointInOrderWithFullPrecision) {
+  const std::string shape = Write("s.json", kSquareWithHole);
+  const std::string pts = Write("p.csv", "x,y\n0.5,0.5\n2,2\n1,0.5\n0.3,0.3\n0.5,1e-13\n");
+  const ToolRun r = Exec("distance " + shape + " " + pts);
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::istringstream lines(r.out);
+  std::string line;
+  std::getline(lines, line);
+  EXPECT_EQ(line, "x,y,signed_distance,closest_x,closest_y,normal_x,normal_y");
+  const pushgraph::geometry::Shape s = pushgraph::geometry::ParseShapeJson(kSquareWithHole);
+  const Vec2 expected_points[] = {{0.5, 0.5}, {2, 2}, {1, 0.5}, {0.3, 0.3}, {0.5, 1e-13}};
+  for (const Vec2& p : expected_points) {
+    ASSERT_TRUE(std::getline(lines, line));
+    std::vector<double> v;
+    std::stringstream fields(line);
+    std::string f;
+    while (std::getline(fields, f, ',')) v.push_back(std::stod(f));
+    ASSERT_EQ(v.size(), 7u) << line;
+    const auto q = pushgraph::geometry::QueryPoint(s, p);
+    EXPECT_EQ(v[0], p.x());
+    EXPECT_EQ(v[1], p.y());
+    EXPECT_EQ(v[2], q.signed_distance) << "17 significant digits must round-trip";
+    EXPECT_EQ(v[3], q.closest_point.x());
+    EXPECT_EQ(v[4], q.closest_point.y());
+    EXPECT_EQ(v[5], q.normal.x());
+    EXPECT_EQ(v[6], q.normal.y());
+  }
+  EXPECT_FALSE(std::getline(lines, line));
+}
+
+TEST_F(CliTest, DistanceValuesAreTheExactOnes) {
+  const std::string shape = Write("s.json", kSquareWithHole);
+  const ToolRun r = Exec("distance " + shape + " " + Write("p.csv", "x,y\n1,0.5\n0.5,0.5\n"));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("\n1,0.5,0,1,0.5,1,0\n"), std::string::npos) << r.out;  // on the boundary: exactly 0
+  // In the hole, 0.1 from its edge y = 0.6: the exact difference of the doubles 0.6 and 0.5.
+  EXPECT_NE(r.out.find("0.5,0.5,0.099999999999999978,"), std::string::npos) << r.out;
+}
+
+TEST_F(CliTest, DistanceBadInputNamesFileAndLine) {
+  const std::string shape = Write("s.json", kSquareWithHole);
+  ToolRun r = Exec("distance " + shape + " " + Write("bad.csv", "x,y\n1,2\n3,abc\n"));
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("bad.csv:3"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "one line on stderr: " << r.err;
+
+  r = Exec("distance " + shape + " " + Write("nohdr.csv", "1,2\n"));
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("nohdr.csv:1"), std::string::npos) << r.err;
+
+  r = Exec("distance " + Write("bow.json", R"({"polygons":[{"outer":[[0,0],[1,1],[1,0],[0,1]]}]})") + " " +
+           Write("p.csv", "x,y\n0,0\n"));
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("bow.json"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("polygon 0"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("not simple"), std::string::npos) << r.err;
+
+  r = Exec("distance " + (dir_ / "missing.json").string() + " " + Write("p.csv", "x,y\n"));
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("missing.json"), std::string::npos) << r.err;
+
+  r = Exec("distance " + Write("nan.json", R"({"polygons":[{"outer":[[0,0],[1,0],[1,1]]}], "radius": 0, "extra": 1})") +
+           " " + Write("p.csv", "x,y\n"));
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("unknown field \"extra\""), std::string::npos) << r.err;
+}
+
+TEST_F(CliTest, PenetrationJsonContractAndNegativeNumberOptions) {
+  const std::string object = Write("o.json", kSquareWithHole);
+  const std::string finger = Write("f.json", R"({"polygons":[{"outer":[[0,0]]}],"radius":0.1})");
+  for (const std::string pose : {"--finger-pose=-0.05,0.5,1", "--finger-pose -0.05,0.5,1"}) {
+    const ToolRun r = Exec("penetration " + object + " " + finger + " " + pose);
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_TRUE(j["intersecting"].get<bool>());
+    EXPECT_NEAR(j["signed_distance"].get<double>(), -0.05, 1e-15);
+    EXPECT_NEAR(j["depth"].get<double>(), 0.05, 1e-15);
+    EXPECT_EQ(j["direction"][0].get<double>(), -1.0);
+    EXPECT_EQ(j["direction"][1].get<double>(), 0.0);
+    EXPECT_NEAR(j["finger_point"][0].get<double>(), 0.05, 1e-15);   // deepest finger point
+    EXPECT_NEAR(j["object_point"][0].get<double>(), 0.0, 1e-15);    // its projection
+  }
+  const ToolRun apart = Exec("penetration " + object + " " + finger + " --object-pose 0,0,0 --finger-pose -0.3,0.5,0");
+  ASSERT_EQ(apart.status, 0) << apart.err;
+  const auto j = nlohmann::json::parse(apart.out);
+  EXPECT_FALSE(j["intersecting"].get<bool>());
+  EXPECT_TRUE(j["direction"].is_null());
+  EXPECT_EQ(j["depth"].get<double>(), 0.0);
+  EXPECT_NEAR(j["signed_distance"].get<double>(), 0.2, 1e-15);
+}
+
+TEST_F(CliTest, PenetrationBadPoseIsOneClearLine) {
+  const std::string object = Write("o.json", kSquareWithHole);
+  const std::string finger = Write("f.json", R"({"polygons":[{"outer":[[0,0]]}],"radius":0.1})");
+  for (const std::string bad : {"--finger-pose 1,2", "--finger-pose=1,2,x", "--object-pose nan,0,0"}) {
+    const ToolRun r = Exec("penetration " + object + " " + finger + " " + bad);
+    EXPECT_NE(r.status, 0) << bad;
+    EXPECT_NE(r.err.find("pose"), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+  const ToolRun r = Exec("penetration " + object + " " + Write("pt.json", R"({"polygons":[{"outer":[[0,0]]}]})"));
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("rounding radius > 0"), std::string::npos) << r.err;
+}
+
+TEST_F(CliTest, DemoRunsOnShippedShapesAndWritesSvg) {
+  const std::string svg = (dir_ / "demo.svg").string();
+  const ToolRun r = Exec("demo --data " PUSHGRAPH_SOURCE_DIR "/data --svg " + svg);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("0 of 20000 random points differ from brute force"), std::string::npos) << r.out;
+  EXPECT_TRUE(fs::exists(svg));
+  EXPECT_GT(fs::file_size(svg), 500u);
+}
+
+}  // namespace
