@@ -21,7 +21,16 @@ inline void TwoDiff(double a, double b, double* s, double* e) {
 }
 inline void TwoProduct(double a, double b, double* p, double* e) {
   *p = a * b;
+#if defined(__FMA__) || defined(__aarch64__)
   *e = std::fma(a, b, -*p);
+#else
+  // Dekker's product with Veltkamp splitting: exact without a hardware fma (std::fma would be
+  // a slow library call here).
+  constexpr double kSplit = 134217729.0;  // 2^27 + 1
+  const double ta = kSplit * a, ah = ta - (ta - a), al = a - ah;
+  const double tb = kSplit * b, bh = tb - (tb - b), bl = b - bh;
+  *e = ((ah * bh - *p) + ah * bl + al * bh) + al * bl;
+#endif
 }
 
 Q ExactCross(const Vec2& a, const Vec2& b, const Vec2& p) {

@@ -23,13 +23,14 @@ namespace {
 using exact::FeatureDistance;
 
 struct Feature {
-  bool is_edge = false;
-  int vertex = -1;     // the vertex, or the edge's start vertex (global numbering)
-  double d2 = std::numeric_limits<double>::infinity();
-  double cross = 0.0;  // edge: accurate cross(b - a, p - a)
-  double len2 = 0.0;   // edge: |b - a|^2
+  bool is_edge;
+  int vertex;    // the vertex, or the edge's start vertex (global numbering); -1: none yet
+  double d2;
+  double cross;  // edge: accurate cross(b - a, p - a)
+  double len2;   // edge: |b - a|^2
   int key() const { return 2 * vertex + (is_edge ? 1 : 0); }
 };
+constexpr Feature kNoFeature{false, -1, std::numeric_limits<double>::infinity(), 0.0, 0.0};
 
 struct CoreResult {
   double distance = 0.0;  // unsigned distance to the core boundary
@@ -48,10 +49,45 @@ FeatureDistance ToExact(const Shape::Impl& m, const Feature& f) {
   return fd;
 }
 
+// First pass, plain double arithmetic: bounds on the squared distance from p to an edge (the
+// clamped projection). Near the switch between the edge's interior and an end the two formulas
+// agree to far below the bound, so the bounds hold even where the double classification could
+// be wrong.
+struct Bounded {  // plain data: a buffer of these is not initialized per query
+  int start;
+  double lo, hi;
+};
+
+inline Bounded BoundEdge(const Shape::Impl& m, int start, const Vec2& p) {
+  const Vec2& a = m.vertices[start];
+  const Vec2& b = m.vertices[m.next[start]];
+  const double ex = b.x() - a.x(), ey = b.y() - a.y(), wx = p.x() - a.x(), wy = p.y() - a.y();
+  const double t = ex * wx + ey * wy;
+  const double len2 = ex * ex + ey * ey;
+  double d2;
+  if (t <= 0.0) {
+    d2 = wx * wx + wy * wy;
+  } else if (t >= len2) {
+    const double vx = p.x() - b.x(), vy = p.y() - b.y();
+    d2 = vx * vx + vy * vy;
+  } else {
+    const double c = ex * wy - ey * wx;
+    d2 = c * c / len2;
+  }
+  // |error of the distance| <= 8 eps (|w| + |e|) covers every branch (cross-product rounding
+  // included); a cheap upper bound of |w| + |e| is the sum of the absolute components.
+  const double err = 8.0 * exact::kEps * (std::abs(wx) + std::abs(wy) + std::abs(ex) + std::abs(ey));
+  const double d = std::sqrt(d2);
+  const double lo = std::max(0.0, d - err);
+  return {start, lo * lo, (d + err) * (d + err)};
+}
+
+// Second pass, for the edges that can still win: which part of the edge is closest (exact
+// dot-product signs) and the accurate squared distance.
 Feature ClassifyEdge(const Shape::Impl& m, int start, const Vec2& p) {
   const Vec2& a = m.vertices[start];
   const Vec2& b = m.vertices[m.next[start]];
-  Feature f;
+  Feature f = kNoFeature;
   if (exact::DotSign(p, a, b) <= 0) {
     f.vertex = start;
   } else if (exact::DotSign(p, b, a) <= 0) {
@@ -118,13 +154,29 @@ int VertexSide(const Shape::Impl& m, int v, const Vec2& p) {
 
 CoreResult QueryCore(const Shape::Impl& m, const Vec2& p, EdgeIndex::Span span) {
   CoreResult out;
-  Feature best;
+  Feature best = kNoFeature;
   if (m.edges.empty()) {  // point core
     best.vertex = 0;
     best.d2 = (p - m.vertices[0]).squaredNorm();
   }
+  // Bounds for every candidate; the accurate value only for those whose lower bound does not
+  // exceed the smallest upper bound.
+  constexpr int kInline = 32;
+  Bounded inline_buffer[kInline];
+  thread_local std::vector<Bounded> heap_buffer;
+  Bounded* bounded = inline_buffer;
+  if (span.size > kInline) {
+    heap_buffer.resize(span.size);
+    bounded = heap_buffer.data();
+  }
+  double min_hi = std::numeric_limits<double>::infinity();
   for (int k = 0; k < span.size; ++k) {
-    const Feature f = ClassifyEdge(m, m.edges[span.data[k]], p);
+    bounded[k] = BoundEdge(m, m.edges[span.data[k]], p);
+    min_hi = std::min(min_hi, bounded[k].hi);
+  }
+  for (int k = 0; k < span.size; ++k) {
+    if (bounded[k].lo > min_hi) continue;
+    const Feature f = ClassifyEdge(m, bounded[k].start, p);
     if (Closer(m, p, f, best)) best = f;
   }
   out.exact_feature = ToExact(m, best);

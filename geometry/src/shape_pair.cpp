@@ -209,7 +209,6 @@ ShapePairResult ShapePairQuerier::Impl::QueryExact(const Pose2& object_pose, con
     }
     pairs.push_back(p);
   }
-  const Pose2 contact_pose{c_contact.x(), c_contact.y(), phi};
   for (const Vec2& o : oi.vertices) {
     const Vec2 local = R.transpose() * (o - c_contact);
     const PointQuery q = QueryPoint(finger, local);
