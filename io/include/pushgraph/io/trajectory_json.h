@@ -1,0 +1,39 @@
+#pragma once
+// The project's trajectory file ("pushgraph-trajectory-1", JSON):
+//
+//   {"format": "pushgraph-trajectory-1",
+//    "object": {"shape": SHAPE, "mass": kg, "mu_surface": mu, "pressure": "uniform"},
+//    "finger": {"shape": SHAPE, "mu_contact": mu_c},
+//    "streams": {"object_pose": [[t, x, y, theta], ...], "finger_pose": [[t, x, y, theta], ...],
+//                "contact_point": [[t, x, y], ...], "force": [[t, f_x, f_y], ...]},
+//    "ground_truth": {... same layout as "streams" ...}}
+//
+// SHAPE is the shape JSON object of docs/geometry.md. Any stream may be missing or empty;
+// `ground_truth` is optional. Reading validates everything and names the file and JSON path of
+// the first problem: unknown fields, wrong types, NaN/inf, wrong row lengths, negative mass or
+// friction, invalid shapes. Samples out of time order are sorted (stable); duplicate time
+// stamps within a stream are an error.
+//
+//   limit_surface::Trajectory t = io::LoadTrajectoryJson("push.json");
+//   io::SaveTrajectoryJson(t, "copy.json");
+#include <pushgraph/limit_surface/trajectory.h>
+
+#include <stdexcept>
+#include <string>
+
+namespace pushgraph::io {
+
+/// Thrown for unreadable or invalid input files; what() names the file and the location.
+class IoError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+inline constexpr const char* kTrajectoryFormat = "pushgraph-trajectory-1";
+
+limit_surface::Trajectory LoadTrajectoryJson(const std::string& path);
+limit_surface::Trajectory ParseTrajectoryJson(const std::string& text, const std::string& source_name = "<string>");
+std::string TrajectoryToJson(const limit_surface::Trajectory& trajectory, int indent = 1);
+void SaveTrajectoryJson(const limit_surface::Trajectory& trajectory, const std::string& path);
+
+}  // namespace pushgraph::io

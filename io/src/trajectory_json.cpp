@@ -1,0 +1,201 @@
+// Reading and writing "pushgraph-trajectory-1" JSON files. Every problem is reported with the
+// file name and the JSON path of the offending value.
+#include <pushgraph/io/trajectory_json.h>
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+namespace pushgraph::io {
+namespace {
+
+using json = nlohmann::json;
+using limit_surface::ForceSample;
+using limit_surface::PointSample;
+using limit_surface::PoseSample;
+using limit_surface::Streams;
+using limit_surface::Trajectory;
+
+class Reader {
+ public:
+  explicit Reader(std::string source) : source_(std::move(source)) {}
+
+  [[noreturn]] void Fail(const std::string& path, const std::string& what) const {
+    throw IoError(source_ + ": " + path + ": " + what);
+  }
+
+  void CheckKeys(const json& object, std::initializer_list<const char*> allowed, const std::string& path) const {
+    if (!object.is_object()) Fail(path, "must be an object");
+    for (auto it = object.begin(); it != object.end(); ++it) {
+      if (std::none_of(allowed.begin(), allowed.end(), [&](const char* k) { return it.key() == k; }))
+        Fail(path, "unknown field \"" + it.key() + "\"");
+    }
+  }
+
+  const json& Require(const json& object, const char* key, const std::string& path) const {
+    if (!object.contains(key)) Fail(path, std::string("missing field \"") + key + "\"");
+    return object[key];
+  }
+
+  double Number(const json& value, const std::string& path) const {
+    if (!value.is_number()) Fail(path, "must be a number, got " + value.dump());
+    const double v = value.get<double>();
+    if (!std::isfinite(v)) Fail(path, "must be finite");
+    return v;
+  }
+
+  double NonNegative(const json& value, const std::string& path) const {
+    const double v = Number(value, path);
+    if (v < 0.0) Fail(path, "must be >= 0, got " + std::to_string(v));
+    return v;
+  }
+
+  geometry::Shape ShapeOf(const json& value, const std::string& path) const {
+    try {
+      return geometry::ParseShapeJson(value.dump(), source_ + ": " + path);
+    } catch (const geometry::GeometryError& e) {
+      throw IoError(e.what());
+    }
+  }
+
+  // Rows [t, v1, ..., vn]; sorted by time (stable), duplicates rejected.
+  template <typename Sample, typename Make>
+  std::vector<Sample> Rows(const json& value, std::size_t width, const std::string& path, Make make) const {
+    if (!value.is_array()) Fail(path, "must be an array of rows");
+    std::vector<Sample> out;
+    out.reserve(value.size());
+    for (std::size_t i = 0; i < value.size(); ++i) {
+      const std::string row_path = path + "[" + std::to_string(i) + "]";
+      const json& row = value[i];
+      if (!row.is_array() || row.size() != width)
+        Fail(row_path, "must be a row of " + std::to_string(width) + " numbers, got " + row.dump());
+      std::vector<double> v(width);
+      for (std::size_t k = 0; k < width; ++k) v[k] = Number(row[k], row_path + "[" + std::to_string(k) + "]");
+      out.push_back(make(v));
+    }
+    std::stable_sort(out.begin(), out.end(), [](const Sample& a, const Sample& b) { return a.t < b.t; });
+    for (std::size_t i = 1; i < out.size(); ++i)
+      if (out[i].t == out[i - 1].t) Fail(path, "two samples with the same time stamp " + std::to_string(out[i].t));
+    return out;
+  }
+
+  Streams StreamsOf(const json& value, const std::string& path) const {
+    CheckKeys(value, {"object_pose", "finger_pose", "contact_point", "force"}, path);
+    Streams s;
+    auto pose = [](const std::vector<double>& v) { return PoseSample{v[0], {v[1], v[2], v[3]}}; };
+    if (value.contains("object_pose")) s.object_pose = Rows<PoseSample>(value["object_pose"], 4, path + ".object_pose", pose);
+    if (value.contains("finger_pose")) s.finger_pose = Rows<PoseSample>(value["finger_pose"], 4, path + ".finger_pose", pose);
+    if (value.contains("contact_point"))
+      s.contact_point = Rows<PointSample>(value["contact_point"], 3, path + ".contact_point",
+                                          [](const std::vector<double>& v) { return PointSample{v[0], {v[1], v[2]}}; });
+    if (value.contains("force"))
+      s.force = Rows<ForceSample>(value["force"], 3, path + ".force",
+                                  [](const std::vector<double>& v) { return ForceSample{v[0], {v[1], v[2]}}; });
+    return s;
+  }
+
+ private:
+  std::string source_;
+};
+
+json ShapeJson(const geometry::Shape& shape) { return json::parse(geometry::ShapeToJson(shape, -1)); }
+
+json StreamsJson(const Streams& s) {
+  json out = json::object();
+  json op = json::array(), fp = json::array(), cp = json::array(), f = json::array();
+  for (const PoseSample& p : s.object_pose) op.push_back({p.t, p.pose.x, p.pose.y, p.pose.theta});
+  for (const PoseSample& p : s.finger_pose) fp.push_back({p.t, p.pose.x, p.pose.y, p.pose.theta});
+  for (const PointSample& p : s.contact_point) cp.push_back({p.t, p.point.x(), p.point.y()});
+  for (const ForceSample& p : s.force) f.push_back({p.t, p.force.x(), p.force.y()});
+  out["object_pose"] = op;
+  out["finger_pose"] = fp;
+  out["contact_point"] = cp;
+  out["force"] = f;
+  return out;
+}
+
+}  // namespace
+
+Trajectory ParseTrajectoryJson(const std::string& text, const std::string& source) {
+  json doc;
+  try {
+    doc = json::parse(text);
+  } catch (const json::exception& e) {
+    throw IoError(source + ": malformed JSON: " + e.what());
+  }
+  const Reader r(source);
+  r.CheckKeys(doc, {"format", "object", "finger", "streams", "ground_truth"}, "top level");
+  const json& format = r.Require(doc, "format", "top level");
+  if (!format.is_string() || format.get<std::string>() != kTrajectoryFormat)
+    r.Fail("format", std::string("expected \"") + kTrajectoryFormat + "\", got " + format.dump());
+
+  Trajectory t;
+  const json& object = r.Require(doc, "object", "top level");
+  r.CheckKeys(object, {"shape", "mass", "mu_surface", "pressure"}, "object");
+  t.object.shape = r.ShapeOf(r.Require(object, "shape", "object"), "object.shape");
+  t.object.mass = r.NonNegative(r.Require(object, "mass", "object"), "object.mass");
+  if (t.object.mass == 0.0) r.Fail("object.mass", "must be > 0");
+  t.object.mu_surface = r.NonNegative(r.Require(object, "mu_surface", "object"), "object.mu_surface");
+  if (object.contains("pressure")) {
+    if (!object["pressure"].is_string() || object["pressure"].get<std::string>() != "uniform")
+      r.Fail("object.pressure", "only \"uniform\" is supported in trajectory files, got " + object["pressure"].dump());
+  }
+  const json& finger = r.Require(doc, "finger", "top level");
+  r.CheckKeys(finger, {"shape", "mu_contact"}, "finger");
+  t.finger.shape = r.ShapeOf(r.Require(finger, "shape", "finger"), "finger.shape");
+  t.finger.mu_contact = r.NonNegative(r.Require(finger, "mu_contact", "finger"), "finger.mu_contact");
+  if (doc.contains("streams")) t.measured = r.StreamsOf(doc["streams"], "streams");
+  if (doc.contains("ground_truth")) t.ground_truth = r.StreamsOf(doc["ground_truth"], "ground_truth");
+  return t;
+}
+
+Trajectory LoadTrajectoryJson(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw IoError(path + ": cannot open file");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return ParseTrajectoryJson(buffer.str(), path);
+}
+
+// One stream row per line: readable, diff-friendly and still plain JSON.
+std::string TrajectoryToJson(const Trajectory& t, int indent) {
+  json object = {{"shape", ShapeJson(t.object.shape)},
+                 {"mass", t.object.mass},
+                 {"mu_surface", t.object.mu_surface},
+                 {"pressure", t.object.pressure}};
+  json finger = {{"shape", ShapeJson(t.finger.shape)}, {"mu_contact", t.finger.mu_contact}};
+  if (indent < 0) {
+    json doc = {{"format", kTrajectoryFormat}, {"object", object}, {"finger", finger}, {"streams", StreamsJson(t.measured)}};
+    if (t.ground_truth) doc["ground_truth"] = StreamsJson(*t.ground_truth);
+    return doc.dump();
+  }
+  auto streams = [](const Streams& s) {
+    const json j = StreamsJson(s);
+    std::string out = "{";
+    bool first_stream = true;
+    for (const char* key : {"object_pose", "finger_pose", "contact_point", "force"}) {
+      out += std::string(first_stream ? "\n" : ",\n") + "  \"" + key + "\": [";
+      first_stream = false;
+      const json& rows = j[key];
+      for (std::size_t i = 0; i < rows.size(); ++i) out += std::string(i == 0 ? "\n    " : ",\n    ") + rows[i].dump();
+      out += rows.empty() ? "]" : "\n  ]";
+    }
+    return out + "\n }";
+  };
+  std::string out = "{\"format\": \"" + std::string(kTrajectoryFormat) + "\",\n \"object\": " + object.dump() +
+                    ",\n \"finger\": " + finger.dump() + ",\n \"streams\": " + streams(t.measured);
+  if (t.ground_truth) out += ",\n \"ground_truth\": " + streams(*t.ground_truth);
+  return out + "}";
+}
+
+void SaveTrajectoryJson(const Trajectory& t, const std::string& path) {
+  std::ofstream out(path);
+  if (!out) throw IoError(path + ": cannot open file for writing");
+  out << TrajectoryToJson(t) << "\n";
+  if (!out) throw IoError(path + ": write failed");
+}
+
+}  // namespace pushgraph::io

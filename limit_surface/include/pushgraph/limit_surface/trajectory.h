@@ -1,0 +1,64 @@
+#pragma once
+// A pushing trajectory: the object and finger descriptions and time-stamped measurement
+// streams (plus optional ground truth), as plain data. The simulator produces it, the
+// estimator consumes it, and pushgraph::io reads and writes it as JSON
+// ("pushgraph-trajectory-1", see docs/formats.md).
+//
+// Units: metres, radians, newtons, seconds. Poses and points in the world frame; `force` is the
+// force the finger applies to the object, world frame. Every stream may be empty; samples are
+// sorted by time (io's reader sorts and reports duplicates).
+//
+//   Trajectory traj = pushgraph::io::LoadTrajectoryJson("push.json");
+//   for (const PoseSample& s : traj.measured.object_pose) { ... s.t, s.pose ... }
+#include <pushgraph/geometry/pose.h>
+#include <pushgraph/geometry/shape.h>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace pushgraph::limit_surface {
+
+struct PoseSample {
+  double t = 0.0;
+  geometry::Pose2 pose;
+};
+
+struct PointSample {
+  double t = 0.0;
+  geometry::Vec2 point{0.0, 0.0};
+};
+
+struct ForceSample {
+  double t = 0.0;
+  geometry::Vec2 force{0.0, 0.0};  ///< applied by the finger to the object, world frame
+};
+
+/// The four streams of a push, each with its own clock.
+struct Streams {
+  std::vector<PoseSample> object_pose;
+  std::vector<PoseSample> finger_pose;
+  std::vector<PointSample> contact_point;
+  std::vector<ForceSample> force;
+};
+
+struct ObjectDescription {
+  geometry::Shape shape;
+  double mass = 0.0;        ///< kg
+  double mu_surface = 0.0;  ///< object-table friction coefficient
+  std::string pressure = "uniform";
+};
+
+struct FingerDescription {
+  geometry::Shape shape;
+  double mu_contact = 0.0;  ///< finger-object friction coefficient
+};
+
+struct Trajectory {
+  ObjectDescription object;
+  FingerDescription finger;
+  Streams measured;
+  std::optional<Streams> ground_truth;
+};
+
+}  // namespace pushgraph::limit_surface

@@ -1,0 +1,88 @@
+// The trajectory file format: round trip, sorting, and a clear error for every kind of bad input.
+#include <pushgraph/io/trajectory_json.h>
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+namespace {
+
+using pushgraph::io::IoError;
+using pushgraph::io::ParseTrajectoryJson;
+using pushgraph::io::TrajectoryToJson;
+
+const std::string kShape = R"({"polygons": [{"outer": [[-0.045,-0.045],[0.045,-0.045],[0.045,0.045],[-0.045,0.045]]}]})";
+const std::string kFinger = R"({"polygons": [{"outer": [[0,0]]}], "radius": 0.00235})";
+
+std::string Doc(const std::string& streams, const std::string& extra = "") {
+  return R"({"format": "pushgraph-trajectory-1", "object": {"shape": )" + kShape +
+         R"(, "mass": 0.8374, "mu_surface": 0.25, "pressure": "uniform"}, "finger": {"shape": )" + kFinger +
+         R"(, "mu_contact": 0.3}, "streams": )" + streams + extra + "}";
+}
+
+TEST(TrajectoryJson, RoundTripIsExact) {
+  const auto t = ParseTrajectoryJson(Doc(
+      R"({"object_pose": [[0.0, 0.1, 0.2, 0.3], [0.04, 0.10000000000000001, 0.2, -3.1]],
+          "finger_pose": [[0.0, -0.05, 0.0, 0.0]], "contact_point": [[0.004, -0.045, 0.001]],
+          "force": [[0.004, 1.5, -0.25]]})",
+      R"(, "ground_truth": {"object_pose": [[0.0, 0.1, 0.2, 0.3]]})"));
+  ASSERT_EQ(t.measured.object_pose.size(), 2u);
+  EXPECT_EQ(t.measured.object_pose[1].pose.x, 0.10000000000000001);
+  EXPECT_EQ(t.measured.object_pose[1].pose.theta, -3.1);
+  EXPECT_EQ(t.measured.force[0].force.y(), -0.25);
+  ASSERT_TRUE(t.ground_truth.has_value());
+  EXPECT_EQ(t.ground_truth->object_pose.size(), 1u);
+  EXPECT_TRUE(t.ground_truth->force.empty());
+  EXPECT_EQ(t.finger.shape.radius(), 0.00235);
+  for (int indent : {-1, 1}) {
+    const auto u = ParseTrajectoryJson(TrajectoryToJson(t, indent));
+    EXPECT_EQ(TrajectoryToJson(u, indent), TrajectoryToJson(t, indent));
+    EXPECT_EQ(u.measured.object_pose[1].pose.x, t.measured.object_pose[1].pose.x);
+    EXPECT_EQ(u.object.mass, 0.8374);
+  }
+}
+
+TEST(TrajectoryJson, MissingStreamsAreEmptyAndOutOfOrderSamplesAreSorted) {
+  const auto t = ParseTrajectoryJson(Doc(R"({"force": [[0.3, 1, 0], [0.1, 2, 0], [0.2, 3, 0]]})"));
+  EXPECT_TRUE(t.measured.object_pose.empty());
+  EXPECT_FALSE(t.ground_truth.has_value());
+  ASSERT_EQ(t.measured.force.size(), 3u);
+  EXPECT_EQ(t.measured.force[0].t, 0.1);
+  EXPECT_EQ(t.measured.force[0].force.x(), 2.0);
+  EXPECT_EQ(t.measured.force[2].t, 0.3);
+}
+
+void ExpectError(const std::string& text, const std::string& needle) {
+  try {
+    ParseTrajectoryJson(text, "push.json");
+    FAIL() << "no error for: " << needle;
+  } catch (const IoError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("push.json"), std::string::npos) << what;
+    EXPECT_NE(what.find(needle), std::string::npos) << what;
+  }
+}
+
+TEST(TrajectoryJson, BadInputNamesFileAndPath) {
+  ExpectError("{", "malformed JSON");
+  ExpectError(Doc("{}", R"(, "extra": 1)"), "unknown field \"extra\"");
+  ExpectError(Doc(R"({"object_pose": [[0, 1, 2]]})"), "streams.object_pose[0]");
+  ExpectError(Doc(R"({"object_pose": [[0, 1, 2, "x"]]})"), "streams.object_pose[0][3]");
+  ExpectError(Doc(R"({"force": [[0, 1e999, 2]]})"), "malformed JSON");
+  ExpectError(Doc(R"({"force": [[0, 1, 2], [0, 1, 2]]})"), "same time stamp");
+  ExpectError(Doc(R"({"velocity": []})"), "unknown field \"velocity\"");
+  std::string bad_format = Doc("{}");
+  bad_format.replace(bad_format.find("trajectory-1"), 12, "trajectory-9");
+  ExpectError(bad_format, "format");
+  std::string bad_mass = Doc("{}");
+  bad_mass.replace(bad_mass.find("0.8374"), 6, "-1.000");
+  ExpectError(bad_mass, "object.mass");
+  std::string bad_shape = Doc("{}");
+  bad_shape.replace(bad_shape.find("[0.045,0.045]"), 13, "[-0.045,-0.045]");
+  ExpectError(bad_shape, "object.shape");
+  std::string point_finger = Doc("{}");
+  point_finger.replace(point_finger.find(", \"radius\": 0.00235"), 19, "");
+  ExpectError(point_finger, "finger.shape");
+}
+
+}  // namespace
