@@ -4,9 +4,27 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <sstream>
 
 namespace pushgraph::cli {
+
+std::string DefaultDataDir() {
+  namespace fs = std::filesystem;
+  if (const char* env = std::getenv("PUSHGRAPH_DATA_DIR"); env && *env) return env;
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const fs::path installed = exe.parent_path().parent_path() / "share" / "pushgraph";
+    if (fs::exists(installed / "shapes", ec)) return installed.string();
+  }
+#ifdef PUSHGRAPH_DATA_DIR
+  return PUSHGRAPH_DATA_DIR;
+#else
+  return "data";
+#endif
+}
 
 std::vector<double> ParseNumbers(const std::string& text, std::size_t count, const std::string& what) {
   std::vector<double> values;

@@ -24,6 +24,10 @@ void RegisterLimitSurface(CLI::App& app);
 void RegisterSimulate(CLI::App& app);
 void RegisterDemo(CLI::App& app);
 
+/// Where the shipped data (shapes) are: $PUSHGRAPH_DATA_DIR if set, else ../share/pushgraph next
+/// to the installed executable, else the source tree's data/ folder.
+std::string DefaultDataDir();
+
 /// Parses "X,Y,THETA" (finite numbers); `what` names the option in error messages.
 geometry::Pose2 ParsePose(const std::string& text, const std::string& what);
 /// Parses a comma-separated list of exactly `count` finite numbers.

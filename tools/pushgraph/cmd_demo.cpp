@@ -15,10 +15,6 @@
 #include <iostream>
 #include <random>
 
-#ifndef PUSHGRAPH_DATA_DIR
-#define PUSHGRAPH_DATA_DIR "data"
-#endif
-
 namespace pushgraph::cli {
 namespace {
 
@@ -46,7 +42,7 @@ std::string SvgPath(const geometry::Shape& shape, double scale, const Vec2& orig
 
 void RegisterDemo(CLI::App& app) {
   auto* cmd = app.add_subcommand("demo", "Run the built-in geometry demo on the project's own shapes");
-  auto data_dir = std::make_shared<std::string>(PUSHGRAPH_DATA_DIR);
+  auto data_dir = std::make_shared<std::string>(DefaultDataDir());
   auto svg_path = std::make_shared<std::string>("pushgraph-demo.svg");
   cmd->add_option("--data", *data_dir, "Folder with the shipped shapes")->capture_default_str();
   cmd->add_option("--svg", *svg_path, "Where to write the picture")->capture_default_str();

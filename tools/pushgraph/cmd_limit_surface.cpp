@@ -1,5 +1,98 @@
-// Being written by the limit-surface work (replaced before commit).
+// pushgraph limit-surface SHAPE.json --mass KG --mu MU [--twist VX,VY,W]... [--gravity G]
+// [--ellipsoid]: f_max, tau_max, c and the applied loads that sustain the given twists
+// (uniform pressure, about the centroid, in the shape's axes); docs/limit_surface.md.
 #include "cli_common.h"
+
+#include <pushgraph/limit_surface/ellipsoid.h>
+#include <pushgraph/limit_surface/limit_surface.h>
+
+#include <iostream>
+#include <memory>
+
 namespace pushgraph::cli {
-void RegisterLimitSurface(CLI::App&) {}
+namespace {
+
+namespace ls = limit_surface;
+
+struct LimitSurfaceOptions {
+  std::string shape_path;
+  double mass = 0.0;
+  double mu = 0.0;
+  double gravity = ls::kStandardGravity;
+  std::vector<std::string> twists;
+  bool ellipsoid = false;
+  int samples = 4000;
+};
+
+nlohmann::json ToJson(const ls::EllipsoidError& e) {
+  return {{"samples", e.samples},
+          {"mean_direction_error_deg", e.mean_direction_error_deg},
+          {"max_direction_error_deg", e.max_direction_error_deg},
+          {"min_radius_ratio", e.min_radius_ratio},
+          {"max_radius_ratio", e.max_radius_ratio}};
+}
+
+void Run(const LimitSurfaceOptions& options) {
+  ls::SupportSpec spec;
+  spec.region = geometry::LoadShapeJson(options.shape_path);
+  spec.mass = options.mass;
+  spec.mu = options.mu;
+  spec.gravity = options.gravity;
+  const ls::Support support = ls::MakeSupport(spec);
+  const ls::Summary summary = ls::Summarize(support);
+
+  nlohmann::json out;
+  out["area"] = summary.area;
+  out["centroid"] = {summary.centroid.x(), summary.centroid.y()};
+  out["normal_force"] = summary.normal_force;
+  out["f_max"] = summary.f_max;
+  out["tau_max"] = summary.tau_max;
+  out["c"] = summary.c;
+  out["twists"] = nlohmann::json::array();
+  for (const std::string& text : options.twists) {
+    const std::vector<double> v = ParseNumbers(text, 3, "--twist (VX,VY,W)");
+    ls::Load load;
+    try {
+      load = ls::SustainingLoad(support, {v[0], v[1], v[2]});  // centroid = centre of pressure
+    } catch (const ls::LimitSurfaceError& e) {
+      throw CliError("--twist " + text + ": " + e.what());
+    }
+    out["twists"].push_back(
+        {{"twist", v}, {"force", {load.force.x(), load.force.y()}}, {"torque", load.torque}});
+  }
+  if (options.ellipsoid) {
+    if (options.samples < 1) throw CliError("--samples must be >= 1");
+    out["ellipsoid"] = {
+        {"paper", ToJson(ls::CompareWithExact(support, ls::PaperEllipsoid(summary), options.samples))},
+        {"fitted", ToJson(ls::CompareWithExact(support, ls::FitEllipsoid(support, options.samples, 2),
+                                               options.samples))}};
+  }
+  std::cout << DumpJson(out) << "\n";
+}
+
+}  // namespace
+
+void RegisterLimitSurface(CLI::App& app) {
+  auto options = std::make_shared<LimitSurfaceOptions>();
+  auto* cmd = app.add_subcommand("limit-surface", "Limit surface of a sliding shape under uniform pressure");
+  cmd->add_option("SHAPE", options->shape_path, "Support region: shape JSON file (polygons with holes, or a disk)")
+      ->required();
+  cmd->add_option("--mass", options->mass, "Object mass in kg (> 0)")->required();
+  cmd->add_option("--mu", options->mu, "Object-surface friction coefficient (> 0)")->required();
+  cmd->add_option("--gravity", options->gravity, "Gravity in m/s^2 (default 9.80665)");
+  cmd->add_option("--twist", options->twists,
+                  "Body twist VX,VY,W of the centroid (m/s, m/s, rad/s), shape axes; repeatable")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  cmd->add_flag("--ellipsoid", options->ellipsoid,
+                "Also report the direction error of the paper's ellipsoid and of a fitted one");
+  cmd->add_option("--samples", options->samples, "Random twists for --ellipsoid (default 4000)");
+  cmd->footer(
+      "Prints one JSON object: area, centroid, normal_force (m g), f_max (mu m g), tau_max, c = tau_max/f_max,\n"
+      "twists: [{twist: [vx, vy, w], force: [fx, fy], torque}], the load that must be applied to keep the\n"
+      "object sliding with each twist (about the centroid, shape axes; friction is its negative).\n"
+      "Rounded polygons and capsules are rejected; a disk (one point with a radius) is exact.");
+  cmd->callback([options] { Run(*options); });
+}
+
 }  // namespace pushgraph::cli
