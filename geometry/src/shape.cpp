@@ -82,8 +82,45 @@ CGAL::Bounded_side SideOfRing(const std::vector<K::Point_2>& ring, const Vec2& p
   return CGAL::bounded_side_2(ring.begin(), ring.end(), K::Point_2(p.x(), p.y()), K());
 }
 
+// Segments a-b and c-d that share an endpoint and meet nowhere else (not collinear overlapping).
+bool TouchOnlyAtSharedVertex(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d) {
+  const Vec2* shared = nullptr;
+  const Vec2 *other1 = nullptr, *other2 = nullptr;
+  if (a == c) shared = &a, other1 = &b, other2 = &d;
+  else if (a == d) shared = &a, other1 = &b, other2 = &c;
+  else if (b == c) shared = &b, other1 = &a, other2 = &d;
+  else if (b == d) shared = &b, other1 = &a, other2 = &c;
+  if (!shared) return false;
+  const bool collinear = exact::OrientationSign(*shared, *other1, *other2) == 0;
+  return !collinear || exact::DotSign(*other2, *shared, *other1) < 0;  // collinear but pointing apart
+}
+
+// Is direction x strictly inside the sector swept counter-clockwise from direction a to b?
+bool InSector(const Vec2& x, const Vec2& a, const Vec2& b) {
+  const Vec2 o(0.0, 0.0);
+  const int ab = exact::OrientationSign(o, a, b);
+  if (ab > 0) return exact::OrientationSign(o, a, x) > 0 && exact::OrientationSign(o, x, b) > 0;
+  if (ab == 0 && exact::DotSign(b, o, a) < 0) return exact::OrientationSign(o, a, x) > 0;  // half plane
+  return !(exact::OrientationSign(o, b, x) >= 0 && exact::OrientationSign(o, x, a) >= 0);
+}
+
+// Two rings meeting at a shared vertex (global vertices i and j, same position) must not cross
+// there: ring j's two edges at the vertex lie in one sector between ring i's two edges.
+void CheckNoCrossingAt(const Shape::Impl& impl, int i, int j) {
+  const Vec2& v = impl.vertices[i];
+  const Vec2 a = impl.vertices[impl.prev[i]] - v, b = impl.vertices[impl.next[i]] - v;
+  const Vec2 c = impl.vertices[impl.prev[j]] - v, d = impl.vertices[impl.next[j]] - v;
+  if (InSector(c, a, b) != InSector(d, a, b)) {
+    const EdgeId ei = impl.edge_id(i), ej = impl.edge_id(j);
+    Fail("boundary crosses " + Where(ej.polygon, ej.ring) + " at their shared vertex (its vertex " +
+             std::to_string(ej.index) + ")",
+         ei.polygon, ei.ring, ei.index);
+  }
+}
+
 // No two edges of any rings may meet, except consecutive edges of a ring at their shared vertex
-// (and those must not fold back onto each other).
+// (and those must not fold back onto each other), and edges of different rings that touch only at
+// a vertex both rings share (a polygon touching another, or its hole, at one point).
 void CheckEdgeIntersections(const Shape::Impl& impl) {
   std::vector<int> nearby;
   const int n = static_cast<int>(impl.edges.size());
@@ -116,6 +153,12 @@ void CheckEdgeIntersections(const Shape::Impl& impl) {
       }
       const K::Segment_2 t(K::Point_2(c.x(), c.y()), K::Point_2(d.x(), d.y()));
       if (!CGAL::do_intersect(s, t)) continue;
+      if (!same_ring && TouchOnlyAtSharedVertex(a, b, c, d)) {
+        const int vi = (a == c || a == d) ? i : impl.next[i];
+        const int vj = (c == a || c == b) ? j : impl.next[j];
+        CheckNoCrossingAt(impl, vi, vj);
+        continue;
+      }
       if (same_ring) {
         Fail("ring is not simple: edge " + std::to_string(ei.index) + " meets edge " + std::to_string(ej.index),
              ei.polygon, ei.ring, ei.index);
@@ -127,7 +170,15 @@ void CheckEdgeIntersections(const Shape::Impl& impl) {
   }
 }
 
-// With no boundary intersections, nesting is decided by one vertex per ring.
+// A vertex of `ring` that is not on the boundary `other` (rings may share touching vertices).
+const Vec2& VertexOffRing(const Ring& ring, const std::vector<K::Point_2>& other) {
+  for (const Vec2& v : ring)
+    if (SideOfRing(other, v) != CGAL::ON_BOUNDARY) return v;
+  return ring[0];
+}
+
+// With no boundary crossings, nesting is decided by one vertex per ring (one not shared with the
+// other ring).
 void CheckNesting(const std::vector<Polygon>& polygons) {
   const int np = static_cast<int>(polygons.size());
   std::vector<std::vector<std::vector<K::Point_2>>> rings(np);  // [polygon][0: outer, 1+: holes]
@@ -138,10 +189,10 @@ void CheckNesting(const std::vector<Polygon>& polygons) {
   for (int p = 0; p < np; ++p) {
     const int nh = static_cast<int>(polygons[p].holes.size());
     for (int h = 0; h < nh; ++h) {
-      if (SideOfRing(rings[p][0], polygons[p].holes[h][0]) != CGAL::ON_BOUNDED_SIDE)
+      if (SideOfRing(rings[p][0], VertexOffRing(polygons[p].holes[h], rings[p][0])) != CGAL::ON_BOUNDED_SIDE)
         Fail("hole is not inside its outer boundary", p, h, 0);
       for (int g = 0; g < nh; ++g) {
-        if (g != h && SideOfRing(rings[p][g + 1], polygons[p].holes[h][0]) == CGAL::ON_BOUNDED_SIDE)
+        if (g != h && SideOfRing(rings[p][g + 1], VertexOffRing(polygons[p].holes[h], rings[p][g + 1])) == CGAL::ON_BOUNDED_SIDE)
           Fail("hole lies inside hole " + std::to_string(g) + " of the same polygon", p, h, 0);
       }
     }
@@ -151,11 +202,11 @@ void CheckNesting(const std::vector<Polygon>& polygons) {
   for (int p = 0; p < np; ++p) {
     for (int q = 0; q < np; ++q) {
       if (p == q) continue;
-      const Vec2& v = polygons[p].outer[0];
+      const Vec2& v = VertexOffRing(polygons[p].outer, rings[q][0]);
       if (SideOfRing(rings[q][0], v) != CGAL::ON_BOUNDED_SIDE) continue;
       bool in_hole = false;
       for (std::size_t h = 1; h < rings[q].size() && !in_hole; ++h)
-        in_hole = SideOfRing(rings[q][h], v) == CGAL::ON_BOUNDED_SIDE;
+        in_hole = SideOfRing(rings[q][h], v) != CGAL::ON_UNBOUNDED_SIDE;
       if (!in_hole) Fail("polygon overlaps polygon " + std::to_string(q), p, -1, 0);
     }
   }

@@ -31,8 +31,7 @@ struct RingMoments {
 };
 RingMoments MomentsOf(const std::vector<Vec2>& ring);
 
-/// Frame of a twist with v != 0: ex = v/|v|, ey = z x ex, s = omega/|v| (disk_far_field.cpp,
-/// far_field.cpp).
+/// Frame of a twist with v != 0: ex = v/|v|, ey = z x ex, s = omega/|v| (far_field.cpp).
 struct FarFrame {
   Vec2 ex = Vec2::UnitX();
   Vec2 ey = Vec2::UnitY();
@@ -63,10 +62,12 @@ DiskLoad UniformDiskLoad(double radius, double d);
 Eigen::Vector3d SmoothNearFieldLoad(const Support& support, const Vec2& q, double* error);
 
 /// Integral of g(r) over a directed ring's signed triangle fan with apex `apex`, collapsed
-/// (Duffy) n x n Gauss rule: exact for polynomials of degree <= 2n - 2.
-template <class Integrand>
-Eigen::Vector3d FanIntegral(const std::vector<Vec2>& ring, const Vec2& apex, int n, Integrand&& g) {
-  const GaussRule& rule = GaussLegendre01(n);
+/// (Duffy) Gauss rule with n_rho points towards the apex and points_along(edge length) along
+/// each edge: exact for polynomials of degree <= 2 min(n_rho - 1, n_t) - 1.
+template <class PointsAlong, class Integrand>
+Eigen::Vector3d FanIntegral(const std::vector<Vec2>& ring, const Vec2& apex, int n_rho, PointsAlong&& points_along,
+                            Integrand&& g) {
+  const GaussRule& radial = GaussLegendre01(n_rho);
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   const std::size_t size = ring.size();
   for (std::size_t i = 0; i < size; ++i) {
@@ -75,17 +76,26 @@ Eigen::Vector3d FanIntegral(const std::vector<Vec2>& ring, const Vec2& apex, int
     const double jacobian = a.x() * b.y() - a.y() * b.x();  // twice the signed triangle area
     if (jacobian == 0.0) continue;
     const Vec2 ab = b - a;
+    const GaussRule& along = GaussLegendre01(points_along(ab.norm()));
     Eigen::Vector3d edge = Eigen::Vector3d::Zero();
-    for (int j = 0; j < n; ++j) {
-      const Vec2 w = a + rule.nodes[j] * ab;
-      for (int k = 0; k < n; ++k) {
-        const double rho = rule.nodes[k];
-        edge += (rule.weights[j] * rule.weights[k] * rho) * g(Vec2(apex + rho * w));
+    for (std::size_t j = 0; j < along.nodes.size(); ++j) {
+      const Vec2 w = a + along.nodes[j] * ab;
+      Eigen::Vector3d ray = Eigen::Vector3d::Zero();
+      for (std::size_t k = 0; k < radial.nodes.size(); ++k) {
+        const double rho = radial.nodes[k];
+        ray += (radial.weights[k] * rho) * g(Vec2(apex + rho * w));
       }
+      edge += along.weights[j] * ray;
     }
     sum += jacobian * edge;
   }
   return sum;
+}
+
+/// Fixed order in both directions.
+template <class Integrand>
+Eigen::Vector3d FanIntegral(const std::vector<Vec2>& ring, const Vec2& apex, int n, Integrand&& g) {
+  return FanIntegral(ring, apex, n, [n](double) { return n; }, g);
 }
 
 }  // namespace pushgraph::limit_surface::detail

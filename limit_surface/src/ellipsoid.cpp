@@ -58,6 +58,7 @@ Twist EllipsoidTwist(const Ellipsoid& ellipsoid, const Load& load) {
 }
 
 Ellipsoid FitEllipsoid(const Support& support, int samples, std::uint64_t seed) {
+  if (samples < 6) throw LimitSurfaceError("FitEllipsoid: needs at least 6 samples for 6 unknowns");
   const Summary summary = Summarize(support);
   // Fit in loads scaled to the unit sphere of the paper's ellipsoid, then scale back.
   const Eigen::Vector3d scale(1.0 / summary.f_max, 1.0 / summary.f_max, 1.0 / summary.tau_max);

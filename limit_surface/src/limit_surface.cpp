@@ -6,6 +6,7 @@
 //   force = sgn(omega) sum_rings p z x Phi(q),   torque = sgn(omega) sum_rings p (G(q) + q . Phi(q)).
 #include "detail.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -62,14 +63,19 @@ void CheckTwist(const Twist& twist) {
 
 }  // namespace
 
-Load SustainingLoad(const Support& support, const Twist& twist, double* error_estimate) {
-  CheckTwist(twist);
+Load SustainingLoad(const Support& support, const Twist& raw_twist, double* error_estimate) {
+  CheckTwist(raw_twist);
+  // Loads depend on the twist's direction only: scaling it to O(1) rules out overflow.
+  const double scale = std::max({std::abs(raw_twist.vx), std::abs(raw_twist.vy), std::abs(raw_twist.omega)});
+  const Twist twist{raw_twist.vx / scale, raw_twist.vy / scale, raw_twist.omega / scale};
   double error = 0.0;
   const double speed = std::hypot(twist.vx, twist.vy);
   Load load;
-  if (speed > kFarFieldRatio * support.size * std::abs(twist.omega)) {
+  if (twist.omega == 0.0) {  // translation: every point slides along v, no torque about the centre of pressure
+    load.force = support.mu * support.normal_force * Vec2(twist.vx, twist.vy) / speed;
+  } else if (speed > kFarFieldRatio * support.size * std::abs(twist.omega)) {
     const detail::FarFrame frame = detail::MakeFarFrame(twist);
-    const double distance = twist.omega == 0.0 ? HUGE_VAL : speed / std::abs(twist.omega);
+    const double distance = speed / std::abs(twist.omega);
     const Eigen::Vector3d local = detail::FarFieldLoad(support, frame, distance);
     load.force = support.mu * (local.x() * frame.ex + local.y() * frame.ey);
     load.torque = support.mu * local.z();

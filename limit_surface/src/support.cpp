@@ -13,18 +13,20 @@ using detail::MomentsOf;
 
 [[noreturn]] void Fail(const std::string& message) { throw LimitSurfaceError("support: " + message); }
 
-std::string Describe(const Vec2& p) {
+std::string Number(double value) {
   std::ostringstream out;
   out.precision(17);
-  out << "(" << p.x() << ", " << p.y() << ")";
+  out << value;
   return out.str();
 }
 
+std::string Describe(const Vec2& p) { return "(" + Number(p.x()) + ", " + Number(p.y()) + ")"; }
+
 void CheckScalars(const SupportSpec& spec) {
-  if (!std::isfinite(spec.mass) || spec.mass <= 0.0) Fail("mass must be finite and > 0, got " + std::to_string(spec.mass));
-  if (!std::isfinite(spec.mu) || spec.mu <= 0.0) Fail("mu must be finite and > 0, got " + std::to_string(spec.mu));
+  if (!std::isfinite(spec.mass) || spec.mass <= 0.0) Fail("mass must be finite and > 0, got " + Number(spec.mass));
+  if (!std::isfinite(spec.mu) || spec.mu <= 0.0) Fail("mu must be finite and > 0, got " + Number(spec.mu));
   if (!std::isfinite(spec.gravity) || spec.gravity <= 0.0)
-    Fail("gravity must be finite and > 0, got " + std::to_string(spec.gravity));
+    Fail("gravity must be finite and > 0, got " + Number(spec.gravity));
   if (!(spec.relative_tolerance >= 1e-15 && spec.relative_tolerance <= 1e-2))
     Fail("relative_tolerance must lie in [1e-15, 1e-2]");
   if (spec.region.empty()) Fail("the region is an empty shape");
@@ -131,7 +133,7 @@ std::function<double(const Vec2&)> UserDensity(const Pressure& pressure, int* de
   *degree = -1;
   return [f = pressure.function](const Vec2& r) {
     const double value = f(r);
-    if (!std::isfinite(value)) Fail("the pressure function returned " + std::to_string(value) + " at " + Describe(r));
+    if (!std::isfinite(value)) Fail("the pressure function returned " + Number(value) + " at " + Describe(r));
     return value;
   };
 }
@@ -149,7 +151,7 @@ void PrepareSmooth(Support& support, const std::vector<std::vector<Vec2>>& rings
       const double p = user(r);
       return {p, p * r.x(), p * r.y()};
     });
-  if (!(moments.x() > 0.0)) Fail("the pressure integrates to " + std::to_string(moments.x()) + " (must be > 0)");
+  if (!(moments.x() > 0.0)) Fail("the pressure integrates to " + Number(moments.x()) + " (must be > 0)");
   support.centre_of_pressure = moments.tail<2>() / moments.x();
   const double scale = support.normal_force / moments.x();
   const Vec2 cop = support.centre_of_pressure;
@@ -182,8 +184,8 @@ void PreparePoints(Support& support, const std::vector<SupportPoint>& points) {
 void PrepareDisk(Support& support, const geometry::Shape& region, const Pressure& pressure) {
   const std::vector<geometry::Polygon>& polygons = region.polygons();
   if (polygons.size() != 1 || polygons[0].outer.size() != 1)
-    Fail("rounded regions are supported only with a point core (a disk); this one has radius " +
-         std::to_string(region.radius()) + " around a segment or polygon: approximate it by a polygon");
+    Fail("rounded regions are supported only as a single disk (one point with a radius); this one has radius " +
+         Number(region.radius()) + " around a segment, polygon or several points: approximate it by polygons");
   support.disk_radius = region.radius();
   support.area = M_PI * support.disk_radius * support.disk_radius;
   support.centroid = polygons[0].outer[0];

@@ -40,6 +40,11 @@ std::vector<double> SpecialAngles() {
           kPi - 1e-6, 3.0, -3.1, 7.0};
 }
 
+/// Reports the first few failures of a tally in full (the count is asserted at the end).
+void ReportLimited(const JacobianTally& tally, const ::testing::AssertionResult& r) {
+  if (!r && tally.failed() <= 3) ADD_FAILURE() << r.message();
+}
+
 NumericDiffOptions SmallStep(double h) {
   NumericDiffOptions o;
   o.h = h;
@@ -256,11 +261,11 @@ TEST(PointQueryJacobians, PosedQueryAgainstNumericDifferences) {
       MatrixXd Jp(5, 2), Jt(5, 3);
       Jp << J.J_sd_point, J.J_closest_point, J.J_normal_point;
       Jt << J.J_sd_pose, J.J_closest_pose, J.J_normal_pose;
-      EXPECT_TRUE(tally_point.Record(
+      ReportLimited(tally_point, tally_point.Record(
           CheckJacobian([&](const VectorXd& v) { return Stack(QueryPoint(shape, pose, Vec2(v[0], v[1]))); },
                         V(p), Jp, opt),
           ctx));
-      EXPECT_TRUE(tally_pose.Record(
+      ReportLimited(tally_pose, tally_pose.Record(
           CheckJacobian([&](const VectorXd& v) { return Stack(QueryPoint(shape, P(v), p)); }, V(pose), Jt,
                         opt),
           ctx));
@@ -284,12 +289,13 @@ TEST(PointQueryJacobians, SignedDistanceGradient) {
       EXPECT_EQ(sd, q.signed_distance) << name;
       EXPECT_NEAR((g - q.normal).norm(), 0.0, 1e-12) << name;
       EXPECT_NEAR(g.norm(), 1.0, 1e-12) << name;
-      EXPECT_TRUE(tally.Record(CheckJacobian([&](const VectorXd& v) {
+      ReportLimited(tally, tally.Record(CheckJacobian([&](const VectorXd& v) {
                                  return VectorXd::Constant(1, SignedDistance(shape, Vec2(v[0], v[1])));
                                },
                                              V(p), MatrixXd(g.transpose()))));
     }
     EXPECT_TRUE(tally.MostlyChecked(0.7));
+    EXPECT_EQ(tally.failed(), 0) << name;
   }
 }
 
@@ -342,11 +348,11 @@ void CheckShapePairJacobians(const std::string& name, const ShapePairQuerier& qu
     opt.rel_tol = 1e-5;
     opt.abs_tol = 1e-5;
     const std::string ctx = "case " + std::to_string(i) + " sd " + std::to_string(r.signed_distance);
-    EXPECT_TRUE(tally_obj.Record(
+    ReportLimited(tally_obj, tally_obj.Record(
         CheckJacobian([&](const VectorXd& v) { return Stack(querier.Query(P(v), finger_pose)); },
                       V(object_pose), Jo, opt),
         ctx));
-    EXPECT_TRUE(tally_fin.Record(
+    ReportLimited(tally_fin, tally_fin.Record(
         CheckJacobian([&](const VectorXd& v) { return Stack(querier.Query(object_pose, P(v))); },
                       V(finger_pose), Jf, opt),
         ctx));
@@ -355,6 +361,8 @@ void CheckShapePairJacobians(const std::string& name, const ShapePairQuerier& qu
   EXPECT_GT(apart, 0) << name;
   EXPECT_TRUE(tally_obj.MostlyChecked(min_checked));
   EXPECT_TRUE(tally_fin.MostlyChecked(min_checked));
+  EXPECT_EQ(tally_obj.failed(), 0) << name;
+  EXPECT_EQ(tally_fin.failed(), 0) << name;
 }
 
 Shape JacobianObject() {

@@ -193,6 +193,9 @@ void CheckAgainstOracle(const Shape& shape, const ExactOracle& oracle, const Vec
     const auto& ring = oracle.Ring(f.edge);
     const EPoint& a = ring[static_cast<size_t>(f.edge.index)];
     EPoint exact_closest = a;
+    const Ring& dring = shape.ring(f.edge.polygon, f.edge.ring);
+    const Vec2 da = dring[static_cast<size_t>(f.edge.index)];
+    const Vec2 db = dring[(static_cast<size_t>(f.edge.index) + 1) % dring.size()];
     if (f.kind == BoundaryFeature::Kind::kEdge) {
       const EPoint& b = ring[(static_cast<size_t>(f.edge.index) + 1) % ring.size()];
       const FT num = (ep - a) * (b - a), den = (b - a).squared_length();
@@ -207,7 +210,9 @@ void CheckAgainstOracle(const Shape& shape, const ExactOracle& oracle, const Vec
     // rounded relation closest = core closest + r n is checked in test_point_query.cpp).
     if (r == 0.0) {
       const Vec2 ec(CGAL::to_double(exact_closest.x()), CGAL::to_double(exact_closest.y()));
-      const double mag = std::max({std::abs(p.x()), std::abs(p.y()), std::abs(ec.x()), std::abs(ec.y())});
+      // Magnitude of the coordinates involved: the query point and the feature's endpoints.
+      const double mag = std::max({p.cwiseAbs().maxCoeff(), da.cwiseAbs().maxCoeff(),
+                                   f.kind == BoundaryFeature::Kind::kEdge ? db.cwiseAbs().maxCoeff() : 0.0});
       const double tol = 8 * Ulp(mag);
       if (!((q.closest_point - ec).cwiseAbs().maxCoeff() <= tol))
         err << "closest point " << Str(q.closest_point) << ", exact " << Str(ec) << " (off by "

@@ -1,6 +1,7 @@
 // SE(2) pose algebra: values (Jacobians are in test_jacobians.cpp).
 #include <pushgraph/geometry/pose.h>
 
+#include <Eigen/LU>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -112,9 +113,31 @@ TEST(Pose2, LogExpRoundTrip) {
     const Eigen::Vector3d v = Log(a);
     EXPECT_NEAR(v.z(), WrapAngle(a.theta), 1e-15);
     ExpectPoseNear(Exp(v), a, 1e-12);
+    if (HasFailure()) {
+      ADD_FAILURE() << "case " << i << " theta " << a.theta;
+      return;
+    }
     // Exp then Log on tangents with |phi| < pi.
     const Eigen::Vector3d w(a.x, a.y, WrapAngle(a.theta) * 0.999);
     EXPECT_NEAR((Log(Exp(w)) - w).norm(), 0.0, 1e-11);
+  }
+}
+
+// Log and Exp to (nearly) full double precision at small and large angles, against a
+// long-double evaluation of the cancellation-free forms A = (phi/2) (1 + cos) / sin and
+// (1 - cos) / phi = 2 sin^2(phi/2) / phi.
+TEST(Pose2, LogExpSmallAngleAccuracy) {
+  const Vec2 t(0.690594913551756, 0.757232449965136);
+  for (double th : {1e-9, 5e-5, 1.0001e-4, -1.5e-4, 2e-4, 5e-4, 1e-3, -3e-3, 1e-2, 0.3, -2.0, 3.0}) {
+    const long double phi = th, s = sinl(phi), c = cosl(phi), sh = sinl(phi / 2);
+    const long double A = 0.5L * phi * (1 + c) / s, B = 0.5L * phi;
+    const Eigen::Vector3d v = Log(Pose2{t.x(), t.y(), th});
+    EXPECT_NEAR(v.x(), static_cast<double>(A * t.x() + B * t.y()), 4e-16) << "Log theta " << th;
+    EXPECT_NEAR(v.y(), static_cast<double>(-B * t.x() + A * t.y()), 4e-16) << "Log theta " << th;
+    const long double sa = s / phi, cb = 2 * sh * sh / phi;
+    const Pose2 e = Exp(Eigen::Vector3d(t.x(), t.y(), th));
+    EXPECT_NEAR(e.x, static_cast<double>(sa * t.x() - cb * t.y()), 4e-16) << "Exp theta " << th;
+    EXPECT_NEAR(e.y, static_cast<double>(cb * t.x() + sa * t.y()), 4e-16) << "Exp theta " << th;
   }
 }
 
@@ -140,9 +163,11 @@ TEST(Pose2, ExpAtZeroAngleIsTranslation) {
   EXPECT_EQ(p.x, 0.5);
   EXPECT_EQ(p.y, -0.25);
   EXPECT_EQ(p.theta, 0.0);
-  const Pose2 q = Exp(Eigen::Vector3d(0.5, -0.25, 1e-12));
-  EXPECT_NEAR(q.x, 0.5, 1e-15);
-  EXPECT_NEAR(q.y, -0.25, 1e-15);
+  // t = V(phi) rho with V = [1 - phi^2/6, -phi/2; phi/2, 1 - phi^2/6] + O(phi^3).
+  const double phi = 1e-6;
+  const Pose2 q = Exp(Eigen::Vector3d(0.5, -0.25, phi));
+  EXPECT_NEAR(q.x, 0.5 * (1 - phi * phi / 6) + 0.25 * phi / 2, 1e-16);
+  EXPECT_NEAR(q.y, 0.5 * phi / 2 - 0.25 * (1 - phi * phi / 6), 1e-16);
   EXPECT_TRUE(std::isfinite(q.x) && std::isfinite(q.y));
   const Eigen::Vector3d l = Log(Pose2{0.5, -0.25, 0.0});
   EXPECT_EQ(l, Eigen::Vector3d(0.5, -0.25, 0.0));

@@ -1,5 +1,6 @@
 // Shape construction: normalization, accessors, and every bad-input case of the issue, with the
 // error's polygon/ring/vertex and its message.
+#include <pushgraph/geometry/point_query.h>
 #include <pushgraph/geometry/shape.h>
 
 #include <gtest/gtest.h>
@@ -333,9 +334,25 @@ TEST(ShapeBadInput, OverlappingOrTouchingPolygons) {
   }
   // The first inside the second.
   EXPECT_THROW(Shape::FromPolygons({Polygon{Square(2, 2, 1), {}}, Polygon{Square(0, 0, 10), {}}}), GeometryError);
-  // Sharing an edge / a vertex (touching is not allowed).
+  // Sharing an edge is not allowed; neither is a vertex of one lying inside an edge of the other.
   EXPECT_THROW(Shape::FromPolygons({Polygon{Square(0, 0, 2), {}}, Polygon{Square(2, 0, 2), {}}}), GeometryError);
-  EXPECT_THROW(Shape::FromPolygons({Polygon{Square(0, 0, 2), {}}, Polygon{Square(2, 2, 2), {}}}), GeometryError);
+  EXPECT_THROW(Shape::FromPolygons({Polygon{Square(0, 0, 2), {}}, Polygon{{{2, 1}, {3, 0}, {3, 2}}, {}}}), GeometryError);
+  // Rings crossing each other through a vertex they share are rejected...
+  const Ring notched = {{0, 0}, {2, 0}, {1, 1}, {2, 2}, {0, 2}};
+  EXPECT_THROW(Shape::FromPolygons({Polygon{notched, {}}, Polygon{{{1, 1}, {3, 0.5}, {3, 2.5}, {0.5, 2.5}}, {}}}),
+               GeometryError);
+  // ...while touching at a shared vertex (exact footprints of real meshes have such corners) is a
+  // valid shape, and queries near the corner see both parts.
+  const Shape corners = Shape::FromPolygons({Polygon{Square(0, 0, 2), {}}, Polygon{Square(2, 2, 2), {}}});
+  EXPECT_EQ(QueryPoint(corners, Vec2(2, 2)).containment, Containment::kOnBoundary);
+  EXPECT_EQ(QueryPoint(corners, Vec2(2, 2)).signed_distance, 0.0);
+  EXPECT_EQ(QueryPoint(corners, Vec2(1.9, 1.95)).containment, Containment::kInside);
+  EXPECT_EQ(QueryPoint(corners, Vec2(2.1, 2.05)).containment, Containment::kInside);
+  EXPECT_EQ(QueryPoint(corners, Vec2(1.9, 2.05)).containment, Containment::kOutside);
+  EXPECT_EQ(QueryPoint(corners, Vec2(2.1, 1.95)).containment, Containment::kOutside);
+  const Shape notch_touch = Shape::FromPolygons({Polygon{notched, {}}, Polygon{{{1, 1}, {3, 0.5}, {3, 1.5}}, {}}});
+  EXPECT_EQ(QueryPoint(notch_touch, Vec2(1.2, 1.0)).containment, Containment::kInside);
+  EXPECT_EQ(QueryPoint(notch_touch, Vec2(1.2, 1.1)).containment, Containment::kOutside);
   // Polygon 2 of 3 overlaps polygon 0: polygons named are 0 or 2, never 1.
   try {
     Shape::FromPolygons({Polygon{Square(0, 0, 2), {}}, Polygon{Square(5, 0, 2), {}}, Polygon{Square(1, 1, 2), {}}});

@@ -15,6 +15,10 @@ int main(int argc, char** argv) {
   RegisterLimitSurface(app);
   RegisterSimulate(app);
   RegisterDemo(app);
+#ifdef PUSHGRAPH_WITH_GRAPH
+  RegisterEstimate(app);
+#endif
+  RegisterFootprint(app);
 
   std::vector<std::string> args(argv + 1, argv + argc);
   // Every option that takes a value may be given a negative number after a space.

@@ -6,8 +6,9 @@
 // Construction validates and normalizes: either orientation is accepted on input; outer
 // boundaries are stored counter-clockwise and holes clockwise (interior always on the left).
 // Rings must be simple with no zero-length edges and no zero area; holes lie strictly inside
-// their outer boundary and are disjoint from each other; polygons are pairwise disjoint
-// (boundaries neither cross nor touch); all coordinates are finite. Violations throw
+// their outer boundary and are disjoint from each other; polygons are pairwise disjoint; all
+// coordinates are finite. Different rings may touch at a vertex they share (a footprint whose
+// parts meet at a corner), but never cross or overlap along an edge. Violations throw
 // GeometryError naming the polygon, ring and vertex.
 //
 //   auto finger = Shape::Disk(0.00235);

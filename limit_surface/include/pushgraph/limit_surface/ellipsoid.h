@@ -25,11 +25,11 @@ struct Ellipsoid {
 Ellipsoid PaperEllipsoid(const Summary& summary);
 /// The load on the ellipsoid whose normal is the twist.
 Load EllipsoidLoad(const Ellipsoid& ellipsoid, const Twist& twist);
-/// Eq. 4 generalised: the twist direction (normal A F) for a load, scaled to |(v, c w)| = 1
-/// with c = 1 (callers compare directions only).
+/// Eq. 4 generalised: the twist direction (the normal A F) for a load, as a unit vector
+/// (vx, vy, omega); only its direction is meaningful.
 Twist EllipsoidTwist(const Ellipsoid& ellipsoid, const Load& load);
 
-/// Least-squares fit of F^T A F = 1 to `samples` exact loads of random twists (seeded).
+/// Least-squares fit of F^T A F = 1 to `samples` (>= 6) exact loads of random twists (seeded).
 Ellipsoid FitEllipsoid(const Support& support, int samples = 2000, std::uint64_t seed = 1);
 
 struct EllipsoidError {

@@ -17,7 +17,7 @@
 namespace pushgraph::limit_surface {
 
 /// Rotation centres farther than this many support sizes use the far-field integral.
-inline constexpr double kFarFieldRatio = 3.0;
+inline constexpr double kFarFieldRatio = 2.0;
 
 struct Twist {
   double vx = 0.0;

@@ -1,0 +1,42 @@
+#pragma once
+// The planar footprint of a mesh: its faces projected along an up axis and united exactly
+// (CGAL Boolean set operations, Epeck), holes and several parts kept, duplicate and collinear
+// vertices removed. Open and non-manifold meshes are fine (only the projected faces matter);
+// faces with zero projected area (the sides of a prism) are skipped.
+//
+//   io::FootprintOptions options;
+//   options.up = io::UpAxis::kY;                       // e.g. a cylinder lying along y
+//   io::FootprintReport report;
+//   geometry::Shape tip = io::MeshFootprint("tip.obj", options, &report);
+#include <pushgraph/geometry/shape.h>
+
+#include <string>
+#include <vector>
+
+namespace pushgraph::io {
+
+/// Projection: kZ -> (x, y), kY -> (z, x), kX -> (y, z) (right-handed: u x v = up).
+enum class UpAxis { kX, kY, kZ };
+
+/// Parses "x", "y" or "z" (throws IoError otherwise).
+UpAxis ParseUpAxis(const std::string& text);
+
+struct FootprintOptions {
+  UpAxis up = UpAxis::kZ;
+  std::string object;  ///< only this object/group of the file; empty: all of them together
+  double scale = 1.0;  ///< multiplies coordinates (e.g. 0.001 for a mesh in millimetres)
+};
+
+struct FootprintReport {
+  std::vector<std::string> objects;  ///< object/group names in the file
+  int faces = 0;                     ///< triangles read (after triangulation)
+  int faces_used = 0;                ///< with non-zero projected area
+  int vertices_removed = 0;          ///< collinear or duplicate vertices dropped from the outline
+};
+
+/// Throws IoError naming the file for unreadable, empty or broken meshes, an unknown object name,
+/// or a footprint of zero area.
+geometry::Shape MeshFootprint(const std::string& obj_path, const FootprintOptions& options = {},
+                              FootprintReport* report = nullptr);
+
+}  // namespace pushgraph::io

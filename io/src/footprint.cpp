@@ -1,0 +1,229 @@
+// Mesh footprints: tinyobjloader for the mesh, CGAL Polygon_set_2 (Epeck) for the exact union
+// of the projected triangles (aggregated divide-and-conquer join). This is the io module's only
+// CGAL Boolean-operations translation unit.
+#include <pushgraph/io/footprint.h>
+#include <pushgraph/io/trajectory_json.h>  // IoError
+
+#include <CGAL/Boolean_set_operations_2.h>
+#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
+#include <CGAL/Polygon_set_2.h>
+
+#include <tiny_obj_loader.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+
+namespace pushgraph::io {
+namespace {
+
+using K = CGAL::Exact_predicates_exact_constructions_kernel;
+using Point = K::Point_2;
+using Polygon2 = CGAL::Polygon_2<K>;
+using PolygonWithHoles = CGAL::Polygon_with_holes_2<K>;
+
+// Drops vertices equal to their predecessor or collinear with their neighbours (exactly).
+std::vector<Point> CleanRing(const Polygon2& ring, int* removed) {
+  std::vector<Point> pts(ring.vertices_begin(), ring.vertices_end());
+  bool changed = true;
+  while (changed && pts.size() >= 3) {
+    changed = false;
+    for (std::size_t i = 0; i < pts.size() && pts.size() >= 3; ++i) {
+      const Point& prev = pts[(i + pts.size() - 1) % pts.size()];
+      const Point& next = pts[(i + 1) % pts.size()];
+      if (pts[i] == prev || CGAL::collinear(prev, pts[i], next)) {
+        pts.erase(pts.begin() + static_cast<long>(i));
+        ++*removed;
+        changed = true;
+        --i;
+      }
+    }
+  }
+  return pts;
+}
+
+geometry::Ring ToRing(const std::vector<Point>& pts) {
+  geometry::Ring ring;
+  for (const Point& p : pts) {
+    const geometry::Vec2 v(CGAL::to_double(p.x()), CGAL::to_double(p.y()));
+    if (ring.empty() || ring.back() != v) ring.push_back(v);
+  }
+  if (ring.size() > 1 && ring.front() == ring.back()) ring.pop_back();
+  return ring;
+}
+
+// CGAL returns parts that touch at a vertex as one "relatively simple" ring passing through that
+// vertex twice; split such a ring into simple loops (each visiting every position once).
+void SplitPinchedRing(const geometry::Ring& ring, std::vector<geometry::Ring>* loops) {
+  for (std::size_t i = 0; i < ring.size(); ++i) {
+    for (std::size_t j = i + 1; j < ring.size(); ++j) {
+      if (ring[i] != ring[j]) continue;
+      geometry::Ring inner(ring.begin() + static_cast<long>(i), ring.begin() + static_cast<long>(j));
+      geometry::Ring outer(ring.begin() + static_cast<long>(j), ring.end());
+      outer.insert(outer.end(), ring.begin(), ring.begin() + static_cast<long>(i));
+      SplitPinchedRing(inner, loops);
+      SplitPinchedRing(outer, loops);
+      return;
+    }
+  }
+  if (ring.size() >= 3) loops->push_back(ring);
+}
+
+double TwiceSignedArea(const geometry::Ring& r) {
+  double a = 0.0;
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    const geometry::Vec2& p = r[i];
+    const geometry::Vec2& q = r[(i + 1) % r.size()];
+    a += (p.x() - r[0].x()) * (q.y() - r[0].y()) - (q.x() - r[0].x()) * (p.y() - r[0].y());
+  }
+  return a;
+}
+
+// Counter-clockwise loops are parts, clockwise loops holes; each hole goes to the smallest part
+// that contains one of its vertices not on that part's boundary.
+std::vector<geometry::Polygon> AssemblePolygons(const std::vector<geometry::Ring>& loops) {
+  using Ki = CGAL::Exact_predicates_exact_constructions_kernel;
+  std::vector<geometry::Polygon> parts;
+  std::vector<std::vector<Ki::Point_2>> outlines;
+  std::vector<double> areas;
+  for (const geometry::Ring& loop : loops) {
+    if (TwiceSignedArea(loop) <= 0.0) continue;
+    parts.push_back({loop, {}});
+    std::vector<Ki::Point_2> pts;
+    for (const geometry::Vec2& v : loop) pts.emplace_back(v.x(), v.y());
+    outlines.push_back(std::move(pts));
+    areas.push_back(TwiceSignedArea(loop));
+  }
+  for (const geometry::Ring& loop : loops) {
+    if (TwiceSignedArea(loop) > 0.0) continue;
+    int owner = -1;
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+      for (const geometry::Vec2& v : loop) {
+        const auto side = CGAL::bounded_side_2(outlines[k].begin(), outlines[k].end(), Ki::Point_2(v.x(), v.y()), Ki());
+        if (side == CGAL::ON_BOUNDARY) continue;
+        if (side == CGAL::ON_BOUNDED_SIDE && (owner < 0 || areas[k] < areas[owner])) owner = static_cast<int>(k);
+        break;
+      }
+    }
+    if (owner < 0) throw IoError("internal: a hole of the footprint lies in no part");
+    parts[owner].holes.push_back(loop);
+  }
+  return parts;
+}
+
+// tinyobjloader's number parser is not correctly rounded (it can be 1 ulp off); re-read the
+// vertex lines with strtod, which is. Returns empty if the file's vertex count differs.
+std::vector<double> ReadVertexCoordinates(const std::string& path, std::size_t expected) {
+  std::ifstream in(path);
+  std::vector<double> out;
+  std::string line;
+  while (std::getline(in, line)) {
+    const char* c = line.c_str();
+    while (*c == ' ' || *c == '\t') ++c;
+    if (c[0] != 'v' || (c[1] != ' ' && c[1] != '\t')) continue;
+    c += 2;
+    for (int k = 0; k < 3; ++k) {
+      char* end = nullptr;
+      const double v = std::strtod(c, &end);
+      if (end == c) return {};
+      out.push_back(v);
+      c = end;
+    }
+  }
+  if (out.size() != expected) return {};
+  return out;
+}
+
+}  // namespace
+
+UpAxis ParseUpAxis(const std::string& text) {
+  if (text == "x") return UpAxis::kX;
+  if (text == "y") return UpAxis::kY;
+  if (text == "z") return UpAxis::kZ;
+  throw IoError("up axis must be x, y or z, got '" + text + "'");
+}
+
+geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& options, FootprintReport* report) {
+  if (!(options.scale > 0.0) || !std::isfinite(options.scale)) throw IoError(path + ": scale must be finite and > 0");
+  tinyobj::ObjReaderConfig config;
+  config.triangulate = true;
+  config.vertex_color = false;
+  config.mtl_search_path = "";  // materials are irrelevant to a footprint
+  tinyobj::ObjReader reader;
+  if (!reader.ParseFromFile(path, config)) {
+    std::string message = reader.Error();
+    while (!message.empty() && (message.back() == '\n' || message.back() == '\r')) message.pop_back();
+    std::replace(message.begin(), message.end(), '\n', ' ');
+    throw IoError(path + ": cannot read mesh: " + (message.empty() ? std::string("unknown error") : message));
+  }
+  const tinyobj::attrib_t& attrib = reader.GetAttrib();
+  FootprintReport local;
+  FootprintReport& rep = report ? *report : local;
+  rep = FootprintReport{};
+  for (const tinyobj::shape_t& s : reader.GetShapes()) rep.objects.push_back(s.name);
+  if (!options.object.empty() && std::find(rep.objects.begin(), rep.objects.end(), options.object) == rep.objects.end()) {
+    std::string names;
+    for (const std::string& n : rep.objects) names += (names.empty() ? "" : ", ") + n;
+    throw IoError(path + ": no object named '" + options.object + "' (the file has: " + names + ")");
+  }
+  const int nv = static_cast<int>(attrib.vertices.size() / 3);
+  std::vector<double> coordinates = ReadVertexCoordinates(path, attrib.vertices.size());
+  if (coordinates.empty()) coordinates.assign(attrib.vertices.begin(), attrib.vertices.end());
+  auto project = [&](int index) -> Point {
+    const double x = coordinates[3 * index] * options.scale, y = coordinates[3 * index + 1] * options.scale,
+                 z = coordinates[3 * index + 2] * options.scale;
+    switch (options.up) {
+      case UpAxis::kX: return {y, z};
+      case UpAxis::kY: return {z, x};
+      default: return {x, y};
+    }
+  };
+  std::vector<Polygon2> triangles;
+  for (const tinyobj::shape_t& s : reader.GetShapes()) {
+    if (!options.object.empty() && s.name != options.object) continue;
+    const auto& idx = s.mesh.indices;
+    for (std::size_t f = 0; f + 2 < idx.size(); f += 3) {
+      ++rep.faces;
+      Point p[3];
+      for (int k = 0; k < 3; ++k) {
+        const int vi = idx[f + k].vertex_index;
+        if (vi < 0 || vi >= nv)
+          throw IoError(path + ": object '" + s.name + "' face " + std::to_string(f / 3) + " refers to missing vertex " +
+                        std::to_string(vi + 1));
+        p[k] = project(vi);
+      }
+      const CGAL::Orientation o = CGAL::orientation(p[0], p[1], p[2]);
+      if (o == CGAL::COLLINEAR) continue;
+      Polygon2 tri(p, p + 3);
+      if (o == CGAL::CLOCKWISE) tri.reverse_orientation();
+      triangles.push_back(std::move(tri));
+    }
+  }
+  rep.faces_used = static_cast<int>(triangles.size());
+  if (rep.faces == 0) throw IoError(path + ": the mesh has no faces");
+  if (triangles.empty()) throw IoError(path + ": every face has zero area seen along the up axis (wrong --up?)");
+  CGAL::Polygon_set_2<K> set;
+  set.join(triangles.begin(), triangles.end());
+  std::vector<PolygonWithHoles> parts;
+  set.polygons_with_holes(std::back_inserter(parts));
+  std::vector<geometry::Ring> loops;
+  for (const PolygonWithHoles& pwh : parts) {
+    SplitPinchedRing(ToRing(CleanRing(pwh.outer_boundary(), &rep.vertices_removed)), &loops);
+    for (auto h = pwh.holes_begin(); h != pwh.holes_end(); ++h)
+      SplitPinchedRing(ToRing(CleanRing(*h, &rep.vertices_removed)), &loops);
+  }
+  std::vector<geometry::Polygon> polygons;
+  try {
+    polygons = AssemblePolygons(loops);
+  } catch (const IoError& e) {
+    throw IoError(path + ": " + e.what());
+  }
+  try {
+    return geometry::Shape::FromPolygons(std::move(polygons));
+  } catch (const geometry::GeometryError& e) {
+    throw IoError(path + ": footprint is not a valid shape: " + e.what());
+  }
+}
+
+}  // namespace pushgraph::io

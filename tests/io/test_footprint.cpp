@@ -1,0 +1,145 @@
+// Mesh footprints: the real MIT meshes (from ../shared) and small meshes made here.
+#include <pushgraph/geometry/point_query.h>
+#include <pushgraph/io/footprint.h>
+#include <pushgraph/io/trajectory_json.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace pushgraph;
+
+const std::string kObj = std::string(PUSHGRAPH_SHARED_DIR) + "/data/mit-push/obj/";
+
+int Holes(const geometry::Shape& s) {
+  int h = 0;
+  for (const auto& p : s.polygons()) h += static_cast<int>(p.holes.size());
+  return h;
+}
+
+class Footprint : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("pushgraph_footprint_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string Write(const std::string& name, const std::string& text) {
+    std::ofstream(dir_ / name) << text;
+    return (dir_ / name).string();
+  }
+  void RequireShared() {
+    if (!fs::exists(kObj + "rect1.obj")) GTEST_SKIP() << "shared MIT meshes not found at " << kObj;
+  }
+  fs::path dir_;
+};
+
+TEST_F(Footprint, Rect1IsASquareWithFourThroughHoles) {
+  RequireShared();
+  io::FootprintReport report;
+  const geometry::Shape s = io::MeshFootprint(kObj + "rect1.obj", {}, &report);
+  ASSERT_EQ(s.polygons().size(), 1u);
+  EXPECT_EQ(Holes(s), 4);
+  EXPECT_GT(s.core_area(), 8.0e-3);
+  EXPECT_LT(s.core_area(), 0.09 * 0.09);
+  const geometry::Box2 b = s.bounds();
+  EXPECT_DOUBLE_EQ(b.min.x(), -0.045);
+  EXPECT_DOUBLE_EQ(b.max.y(), 0.045);
+  // The outline is the bare square: collinear vertices of the triangulation are removed.
+  EXPECT_EQ(s.polygons()[0].outer.size(), 4u);
+  EXPECT_LT(report.faces_used, report.faces);  // the side faces project to nothing
+  // Coordinates are the file's decimal values correctly rounded.
+  EXPECT_EQ(geometry::QueryPoint(s, geometry::Vec2(0.045, 0.0)).signed_distance, 0.0);
+}
+
+TEST_F(Footprint, Ellip1IsADiskWithHolesAndTheTipIsADiskAlongY) {
+  RequireShared();
+  const geometry::Shape e = io::MeshFootprint(kObj + "ellip1.obj");
+  EXPECT_EQ(e.polygons().size(), 1u);
+  EXPECT_GE(Holes(e), 1);
+  EXPECT_NEAR(e.bounds().max.x(), 0.0525, 1e-4);
+  io::FootprintOptions up_y;
+  up_y.up = io::UpAxis::kY;
+  const geometry::Shape tip = io::MeshFootprint(kObj + "tip.obj", up_y);
+  EXPECT_EQ(tip.polygons().size(), 1u);
+  EXPECT_EQ(Holes(tip), 0);
+  const double radius = std::sqrt(tip.core_area() / M_PI);
+  EXPECT_NEAR(radius, 0.0047, 2e-4);
+  EXPECT_TRUE(tip.is_convex());
+}
+
+TEST_F(Footprint, SeveralObjectsInOneFile) {
+  RequireShared();
+  io::FootprintReport report;
+  const geometry::Shape all = io::MeshFootprint(kObj + "tri3.obj", {}, &report);
+  ASSERT_EQ(report.objects.size(), 2u);
+  io::FootprintOptions one;
+  one.object = report.objects[1];
+  const geometry::Shape part = io::MeshFootprint(kObj + "tri3.obj", one);
+  EXPECT_LE(part.core_area(), all.core_area() * (1 + 1e-12));
+  one.object = "no_such_object";
+  try {
+    io::MeshFootprint(kObj + "tri3.obj", one);
+    FAIL() << "unknown object accepted";
+  } catch (const io::IoError& e) {
+    EXPECT_NE(std::string(e.what()).find(report.objects[0]), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(Footprint, UnionOfOverlappingAndOpenNonManifoldMeshes) {
+  // Two overlapping squares (each two triangles, no shared vertices) and a detached triangle
+  // sharing one corner with them: an exact union with two parts touching at a vertex.
+  const std::string mesh = Write("m.obj",
+                                 "o a\nv 0 0 0\nv 2 0 0\nv 2 2 0\nv 0 2 0\nf 1 2 3\nf 1 3 4\n"
+                                 "o b\nv 1 1 1\nv 3 1 1\nv 3 3 1\nv 1 3 1\nf 5 6 7\nf 5 7 8\n"
+                                 "o c\nv 3 3 0\nv 4 3 0\nv 4 4 0\nf 9 10 11\n"
+                                 "o degenerate\nv 0 0 0\nv 0 0 1\nv 1 0 1\nf 12 13 14\n");
+  io::FootprintReport report;
+  const geometry::Shape s = io::MeshFootprint(mesh, {}, &report);
+  EXPECT_EQ(report.faces, 6);
+  EXPECT_EQ(report.faces_used, 5);
+  EXPECT_EQ(s.polygons().size(), 2u);
+  EXPECT_DOUBLE_EQ(s.core_area(), 4 + 4 - 1 + 0.5);
+  EXPECT_EQ(geometry::QueryPoint(s, geometry::Vec2(1.5, 1.5)).containment, geometry::Containment::kInside);
+  EXPECT_EQ(geometry::QueryPoint(s, geometry::Vec2(3, 3)).containment, geometry::Containment::kOnBoundary);
+  // A ring of quads around a hole: the hole is kept.
+  const std::string frame = Write("frame.obj",
+                                  "v 0 0 0\nv 3 0 0\nv 3 3 0\nv 0 3 0\nv 1 1 0\nv 2 1 0\nv 2 2 0\nv 1 2 0\n"
+                                  "f 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n");
+  const geometry::Shape f = io::MeshFootprint(frame, {});
+  EXPECT_EQ(Holes(f), 1);
+  EXPECT_DOUBLE_EQ(f.core_area(), 8.0);
+  io::FootprintOptions mm;
+  mm.scale = 0.001;
+  EXPECT_DOUBLE_EQ(io::MeshFootprint(frame, mm).core_area(), 8.0e-6);
+}
+
+TEST_F(Footprint, ClearErrors) {
+  auto expect_error = [](const std::string& path, const io::FootprintOptions& o, const std::string& needle) {
+    try {
+      io::MeshFootprint(path, o);
+      ADD_FAILURE() << "no error, expected: " << needle;
+    } catch (const io::IoError& e) {
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+  };
+  expect_error((dir_ / "missing.obj").string(), {}, "cannot read mesh");
+  expect_error(Write("empty.obj", "# nothing here\n"), {}, "no faces");
+  io::FootprintOptions up_y;
+  up_y.up = io::UpAxis::kY;
+  expect_error(Write("flat.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), up_y, "zero area");
+  expect_error(Write("badidx.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"), {}, "");
+  io::FootprintOptions bad_scale;
+  bad_scale.scale = -1;
+  expect_error(Write("ok.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), bad_scale, "scale");
+  EXPECT_THROW(io::ParseUpAxis("w"), io::IoError);
+}
+
+}  // namespace

@@ -1,0 +1,129 @@
+// `pushgraph limit-surface`: the JSON contract, loads against the library and closed forms,
+// and one-line errors with a non-zero exit status on bad input.
+#include <pushgraph/limit_surface/limit_surface.h>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct ToolRun {
+  int status = 0;
+  std::string out, err;
+};
+
+class LimitSurfaceCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("pushgraph_ls_cli_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+    square_ = Write("square.json", R"({"polygons": [{"outer": [[0,0],[0.09,0],[0.09,0.09],[0,0.09]]}]})");
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string Write(const std::string& name, const std::string& text) {
+    const fs::path p = dir_ / name;
+    std::ofstream(p) << text;
+    return p.string();
+  }
+
+  ToolRun Exec(const std::string& args) {
+    const std::string err_path = (dir_ / "stderr.txt").string();
+    const std::string cmd = std::string(PUSHGRAPH_TOOL) + " limit-surface " + args + " 2>" + err_path;
+    ToolRun run;
+    FILE* pipe = ::popen(cmd.c_str(), "r");
+    std::array<char, 4096> buf{};
+    std::size_t n = 0;
+    while ((n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0) run.out.append(buf.data(), n);
+    const int status = ::pclose(pipe);
+    run.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    std::ifstream e(err_path);
+    std::stringstream ss;
+    ss << e.rdbuf();
+    run.err = ss.str();
+    return run;
+  }
+
+  void ExpectOneLineError(const std::string& args, const std::string& fragment) {
+    const ToolRun run = Exec(args);
+    EXPECT_NE(run.status, 0) << args;
+    EXPECT_TRUE(run.out.empty()) << args;
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+    EXPECT_NE(run.err.find(fragment), std::string::npos) << run.err;
+  }
+
+  fs::path dir_;
+  std::string square_;
+};
+
+TEST_F(LimitSurfaceCli, PrintsTheContract) {
+  const ToolRun run = Exec(square_ + " --mass 0.8374 --mu 0.35 --twist 0.05,0,0 --twist -0.01,0.02,0.5 --twist 0,0,-2");
+  ASSERT_EQ(run.status, 0) << run.err;
+  const nlohmann::json j = nlohmann::json::parse(run.out);
+  const double N = 0.8374 * 9.80665;
+  EXPECT_NEAR(j.at("area").get<double>(), 0.0081, 1e-17);
+  EXPECT_NEAR(j.at("centroid")[0].get<double>(), 0.045, 1e-17);
+  EXPECT_NEAR(j.at("normal_force").get<double>(), N, 1e-14);
+  EXPECT_NEAR(j.at("f_max").get<double>(), 0.35 * N, 1e-14);
+  EXPECT_NEAR(j.at("c").get<double>(), 0.034433807240890, 1e-14);
+  EXPECT_NEAR(j.at("tau_max").get<double>(), 0.35 * N * 0.034433807240890, 1e-14);
+  const auto& twists = j.at("twists");
+  ASSERT_EQ(twists.size(), 3u);
+  // Pure translation along x: the force is f_max along x, no torque about the centroid.
+  EXPECT_NEAR(twists[0].at("force")[0].get<double>(), 0.35 * N, 1e-14);
+  EXPECT_EQ(twists[0].at("torque").get<double>(), 0.0);
+  EXPECT_EQ(twists[1].at("twist")[2].get<double>(), 0.5);
+  // Clockwise spin: the torque is -tau_max.
+  EXPECT_NEAR(twists[2].at("torque").get<double>(), -j.at("tau_max").get<double>(), 1e-15);
+  // The mixed twist against the library.
+  pushgraph::limit_surface::SupportSpec spec;
+  spec.region = pushgraph::geometry::Shape::Box(0.09, 0.09);
+  spec.mass = 0.8374;
+  spec.mu = 0.35;
+  const auto load = pushgraph::limit_surface::SustainingLoad(pushgraph::limit_surface::MakeSupport(spec), {-0.01, 0.02, 0.5});
+  EXPECT_NEAR(twists[1].at("force")[0].get<double>(), load.force.x(), 1e-14);
+  EXPECT_NEAR(twists[1].at("force")[1].get<double>(), load.force.y(), 1e-14);
+  EXPECT_NEAR(twists[1].at("torque").get<double>(), load.torque, 1e-15);
+}
+
+TEST_F(LimitSurfaceCli, DiskAndEllipsoidReport) {
+  const std::string disk = Write("disk.json", R"({"polygons": [{"outer": [[0.1, 0.2]]}], "radius": 0.0525})");
+  const ToolRun run = Exec(disk + " --mass 0.8937 --mu 0.35 --gravity 9.81 --ellipsoid --samples 500");
+  ASSERT_EQ(run.status, 0) << run.err;
+  const nlohmann::json j = nlohmann::json::parse(run.out);
+  EXPECT_NEAR(j.at("c").get<double>(), 0.035, 1e-16);
+  EXPECT_NEAR(j.at("normal_force").get<double>(), 0.8937 * 9.81, 1e-14);
+  EXPECT_TRUE(j.at("twists").empty());
+  const double mean = j.at("ellipsoid").at("paper").at("mean_direction_error_deg").get<double>();
+  EXPECT_GT(mean, 3.0);
+  EXPECT_LT(mean, 7.0);
+}
+
+TEST_F(LimitSurfaceCli, BadInputIsAOneLineError) {
+  ExpectOneLineError(square_ + " --mass -1 --mu 0.3", "mass");
+  ExpectOneLineError(square_ + " --mass 1 --mu 0", "mu");
+  ExpectOneLineError(square_ + " --mass 1 --mu 0.3 --gravity -9.8", "gravity");
+  ExpectOneLineError(square_ + " --mass 1 --mu 0.3 --twist 0,0,0", "twist");
+  ExpectOneLineError(square_ + " --mass 1 --mu 0.3 --twist 1,2", "twist");
+  ExpectOneLineError(square_ + " --mass 1 --mu 0.3 --twist 1,nan,2", "twist");
+  ExpectOneLineError((dir_ / "missing.json").string() + " --mass 1 --mu 0.3", "missing.json");
+  const std::string rounded = Write("rounded.json", R"({"polygons": [{"outer": [[0,0],[1,0],[1,1]]}], "radius": 0.1})");
+  ExpectOneLineError(rounded + " --mass 1 --mu 0.3", "rounded");
+  EXPECT_NE(Exec(square_ + " --mu 0.3").status, 0);  // --mass is required
+}
+
+}  // namespace
