@@ -25,6 +25,7 @@ void RegisterSimulate(CLI::App& app);
 void RegisterDemo(CLI::App& app);
 void RegisterEstimate(CLI::App& app);
 void RegisterFootprint(CLI::App& app);
+void RegisterMitImport(CLI::App& app);
 
 /// Where the shipped data (shapes) are: $PUSHGRAPH_DATA_DIR if set, else ../share/pushgraph next
 /// to the installed executable, else the source tree's data/ folder.

@@ -1,5 +1,253 @@
-// Being written by the limit-surface work (replaced before commit).
+// pushgraph simulate -o OUT.json [options]: a quasi-static push (finger along a straight line
+// or waypoints at constant speed) of an object on a table, written as a pushgraph-trajectory-1
+// file with ground truth and noisy measured streams (docs/simulator.md). Prints a one-object
+// JSON summary (contact time, sticking/sliding steps, max penetration, load residual).
 #include "cli_common.h"
+
+#include <pushgraph/io/trajectory_json.h>
+#include <pushgraph/limit_surface/simulator.h>
+
+#include <cmath>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
 namespace pushgraph::cli {
-void RegisterSimulate(CLI::App&) {}
+namespace {
+
+namespace ls = limit_surface;
+
+struct SimulateOptions {
+  std::string output;
+  std::string object_path = DefaultDataDir() + "/shapes/notched_block.json";
+  std::string finger_path = DefaultDataDir() + "/shapes/disk_finger_5mm.json";
+  double mass = 0.5;
+  double mu_surface = 0.3;
+  double mu_contact = 0.4;
+  std::string surface = "exact";
+  std::string object_pose = "0,0,0";
+  double push_angle = M_PI / 2;
+  double offset = 0.01;
+  double standoff = 0.005;
+  double distance = 0.05;
+  std::string waypoints;
+  double speed = 0.05;
+  double duration = 0.0;
+  double rate_object = 25.0, rate_finger = 250.0, rate_contact = 250.0, rate_force = 250.0;
+  double internal_step = 1e-3;
+  std::uint64_t seed = 1;
+  std::string noise = "gaussian";
+  std::string sigma_object, sigma_finger, sigma_contact, sigma_force;
+  std::vector<std::string> occlusions;
+  std::string occlusion_mode = "stop";
+  double occlusion_scale = 10.0;
+  double outliers = 0.0;
+  std::vector<std::string> frozen;
+  bool no_ground_truth = false;
+};
+
+void Positive(double value, const std::string& name) {
+  if (!std::isfinite(value) || !(value > 0.0)) throw CliError(name + " must be a finite number > 0 (got " + FormatDouble(value) + ")");
+}
+void NonNegative(double value, const std::string& name) {
+  if (!std::isfinite(value) || value < 0.0) throw CliError(name + " must be a finite number >= 0 (got " + FormatDouble(value) + ")");
+}
+
+geometry::Shape LoadShape(const std::string& path, const std::string& what) {
+  try {
+    return geometry::LoadShapeJson(path);
+  } catch (const std::exception& e) {
+    throw CliError(what + " " + path + ": " + e.what());
+  }
+}
+
+std::vector<geometry::Vec2> ParseWaypoints(const std::string& text) {
+  std::vector<geometry::Vec2> points;
+  std::stringstream stream(text);
+  std::string item;
+  while (std::getline(stream, item, ';')) {
+    const std::vector<double> v = ParseNumbers(item, 2, "--waypoints (X,Y;X,Y;...)");
+    points.emplace_back(v[0], v[1]);
+  }
+  if (points.size() < 2) throw CliError("--waypoints needs at least 2 points X,Y;X,Y (got '" + text + "')");
+  return points;
+}
+
+std::pair<double, double> ParseWindow(const std::string& text, const std::string& what) {
+  const std::vector<double> v = ParseNumbers(text, 2, what + " (T0,T1)");
+  if (v[1] < v[0]) throw CliError(what + " " + text + ": T1 must be >= T0");
+  return {v[0], v[1]};
+}
+
+void Run(const SimulateOptions& o) {
+  ls::PushPlan plan;
+  Positive(o.mass, "--mass");
+  Positive(o.mu_surface, "--mu-surface");
+  NonNegative(o.mu_contact, "--mu-contact");
+  Positive(o.speed, "--speed");
+  NonNegative(o.duration, "--duration");
+  Positive(o.standoff, "--standoff");
+  Positive(o.distance, "--distance");
+  Positive(o.internal_step, "--internal-step");
+  if (!std::isfinite(o.push_angle)) throw CliError("--push-angle must be finite");
+  if (!std::isfinite(o.offset)) throw CliError("--offset must be finite");
+  NonNegative(o.rate_object, "--rate-object");
+  NonNegative(o.rate_finger, "--rate-finger");
+  NonNegative(o.rate_contact, "--rate-contact");
+  NonNegative(o.rate_force, "--rate-force");
+  if (!std::isfinite(o.outliers) || o.outliers < 0.0 || o.outliers > 1.0)
+    throw CliError("--outliers must be a probability in [0, 1] (got " + FormatDouble(o.outliers) + ")");
+  NonNegative(o.occlusion_scale, "--occlusion-scale");
+
+  plan.object = LoadShape(o.object_path, "--object");
+  plan.finger = LoadShape(o.finger_path, "--finger");
+  plan.mass = o.mass;
+  plan.mu_surface = o.mu_surface;
+  plan.mu_contact = o.mu_contact;
+  plan.surface = o.surface == "ellipsoid" ? ls::SurfaceModel::kEllipsoid : ls::SurfaceModel::kExact;
+  plan.object_pose = ParsePose(o.object_pose, "--object-pose");
+  plan.speed = o.speed;
+  plan.duration = o.duration;
+  plan.rates = {o.rate_object, o.rate_finger, o.rate_contact, o.rate_force};
+  plan.internal_step = o.internal_step;
+  plan.seed = o.seed;
+
+  const ls::NoiseKind kind = o.noise == "none"       ? ls::NoiseKind::kNone
+                             : o.noise == "bimodal" ? ls::NoiseKind::kBimodal
+                                                    : ls::NoiseKind::kGaussian;
+  plan.noise = ls::DefaultNoise(kind);
+  auto set_sigma = [&](const std::string& text, ls::StreamNoise& stream, bool with_angle, const std::string& what) {
+    if (text.empty()) return;
+    const std::vector<double> v = ParseNumbers(text, with_angle ? 2 : 1, what);
+    for (double x : v) NonNegative(x, what);
+    stream.position.sigma = v[0];
+    if (with_angle) stream.angle.sigma = v[1];
+  };
+  set_sigma(o.sigma_object, plan.noise.object_pose, true, "--sigma-object (M,RAD)");
+  set_sigma(o.sigma_finger, plan.noise.finger_pose, false, "--sigma-finger (M)");
+  set_sigma(o.sigma_contact, plan.noise.contact_point, false, "--sigma-contact (M)");
+  set_sigma(o.sigma_force, plan.noise.force, false, "--sigma-force (N)");
+  for (const std::string& text : o.occlusions) {
+    const auto [t0, t1] = ParseWindow(text, "--occlusion");
+    plan.noise.occlusions.push_back({t0, t1, o.occlusion_mode == "degrade" ? ls::OcclusionMode::kDegrade
+                                                                            : ls::OcclusionMode::kStop,
+                                     o.occlusion_scale});
+  }
+  for (const std::string& text : o.frozen) {
+    const auto [t0, t1] = ParseWindow(text, "--frozen-force");
+    plan.noise.frozen_force.push_back({t0, t1, std::nullopt});
+  }
+  if (o.outliers > 0.0) {
+    // Outliers: 2 cm / 0.5 rad jumps of the tracker, 1 cm contact or finger glitches, 1 N spikes.
+    plan.noise.object_pose.outlier_probability = o.outliers;
+    plan.noise.object_pose.outlier_magnitude = 0.02;
+    plan.noise.object_pose.outlier_angle = 0.5;
+    plan.noise.finger_pose.outlier_probability = o.outliers;
+    plan.noise.finger_pose.outlier_magnitude = 0.01;
+    plan.noise.contact_point.outlier_probability = o.outliers;
+    plan.noise.contact_point.outlier_magnitude = 0.01;
+    plan.noise.force.outlier_probability = o.outliers;
+    plan.noise.force.outlier_magnitude = 1.0;
+  }
+
+  plan.waypoints = o.waypoints.empty() ? ls::StraightPushPath(plan, o.push_angle, o.offset, o.standoff, o.distance)
+                                       : ParseWaypoints(o.waypoints);
+  const ls::SimulationResult result = ls::Simulate(plan);
+  ls::Trajectory trajectory = result.trajectory;
+  if (o.no_ground_truth) trajectory.ground_truth.reset();
+  io::SaveTrajectoryJson(trajectory, o.output);
+
+  const ls::SimulationStats& s = result.stats;
+  const auto& gt = *result.trajectory.ground_truth;
+  const geometry::Pose2 end = gt.object_pose.empty() ? plan.object_pose : gt.object_pose.back().pose;
+  nlohmann::json out;
+  out["output"] = o.output;
+  out["surface"] = ls::ToString(plan.surface);
+  out["duration"] = result.states.empty() ? 0.0 : result.states.back().t;
+  out["steps"] = s.steps;
+  out["sticking_steps"] = s.sticking_steps;
+  out["sliding_steps"] = s.sliding_steps;
+  out["separated_steps"] = s.separated_steps;
+  out["contact_time"] = s.contact_time;
+  out["max_penetration"] = s.max_penetration;
+  out["max_gap_in_contact"] = s.max_gap_in_contact;
+  out["max_torque_residual"] = s.max_torque_residual;
+  out["final_object_pose"] = {end.x, end.y, end.theta};
+  out["samples"] = {{"object_pose", trajectory.measured.object_pose.size()},
+                    {"finger_pose", trajectory.measured.finger_pose.size()},
+                    {"contact_point", trajectory.measured.contact_point.size()},
+                    {"force", trajectory.measured.force.size()}};
+  std::cout << DumpJson(out) << "\n";
+}
+
+}  // namespace
+
+void RegisterSimulate(CLI::App& app) {
+  auto o = std::make_shared<SimulateOptions>();
+  auto* cmd = app.add_subcommand("simulate", "Simulate a quasi-static push and write a trajectory file");
+  cmd->add_option("-o,--output", o->output, "Trajectory JSON file to write (pushgraph-trajectory-1)")->required();
+  cmd->add_option("--object", o->object_path, "Object shape JSON (also the support region; uniform pressure)")
+      ->capture_default_str();
+  cmd->add_option("--finger", o->finger_path, "Finger shape JSON (any shape)")->capture_default_str();
+  cmd->add_option("--mass", o->mass, "Object mass in kg (> 0)")->capture_default_str();
+  cmd->add_option("--mu-surface", o->mu_surface, "Object-table friction coefficient (> 0)")->capture_default_str();
+  cmd->add_option("--mu-contact", o->mu_contact, "Finger-object friction coefficient (>= 0)")->capture_default_str();
+  cmd->add_option("--surface", o->surface, "Limit surface model: exact or ellipsoid (the paper's Eq. 3)")
+      ->check(CLI::IsMember({"exact", "ellipsoid"}))
+      ->capture_default_str();
+  cmd->add_option("--object-pose", o->object_pose, "Initial object pose X,Y,THETA (m, m, rad), world")
+      ->capture_default_str();
+  cmd->add_option("--push-angle", o->push_angle, "Straight push: direction of the finger's motion (rad, world)")
+      ->capture_default_str();
+  cmd->add_option("--offset", o->offset,
+                  "Straight push: the push line passes this far (m) to the left of the object's centroid")
+      ->capture_default_str();
+  cmd->add_option("--standoff", o->standoff, "Straight push: the finger starts this far (m) from the object")
+      ->capture_default_str();
+  cmd->add_option("--distance", o->distance, "Straight push: finger travel (m) after reaching the object")
+      ->capture_default_str();
+  cmd->add_option("--waypoints", o->waypoints,
+                  "Finger path X,Y;X,Y;... (world, m) instead of the straight push; the finger starts at the first");
+  cmd->add_option("--speed", o->speed, "Finger speed along the path (m/s, > 0)")->capture_default_str();
+  cmd->add_option("--duration", o->duration, "Simulated time (s); 0: the time to travel the path")
+      ->capture_default_str();
+  cmd->add_option("--rate-object", o->rate_object, "Object pose stream rate (Hz; 0 disables)")->capture_default_str();
+  cmd->add_option("--rate-finger", o->rate_finger, "Finger pose stream rate (Hz; 0 disables)")->capture_default_str();
+  cmd->add_option("--rate-contact", o->rate_contact, "Contact point stream rate (Hz; 0 disables)")
+      ->capture_default_str();
+  cmd->add_option("--rate-force", o->rate_force, "Force stream rate (Hz; 0 disables)")->capture_default_str();
+  cmd->add_option("--internal-step", o->internal_step, "Largest integration step (s)")->capture_default_str();
+  cmd->add_option("--seed", o->seed, "Noise seed (same seed, same file)")->capture_default_str();
+  cmd->add_option("--noise", o->noise,
+                  "Measurement noise: gaussian, bimodal (mixture of two triangular densities, same sigma) or none")
+      ->check(CLI::IsMember({"gaussian", "bimodal", "none"}))
+      ->capture_default_str();
+  cmd->add_option("--sigma-object", o->sigma_object, "Object pose noise M,RAD (default 0.002,0.02)");
+  cmd->add_option("--sigma-finger", o->sigma_finger, "Finger position noise M (default 0.0005)");
+  cmd->add_option("--sigma-contact", o->sigma_contact, "Contact point noise M (default 0.001)");
+  cmd->add_option("--sigma-force", o->sigma_force, "Force noise N per axis (default 0.05)");
+  cmd->add_option("--occlusion", o->occlusions, "Occlude the object stream during T0,T1 (s); repeatable")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  cmd->add_option("--occlusion-mode", o->occlusion_mode,
+                  "stop: no object samples in the window; degrade: noise times --occlusion-scale")
+      ->check(CLI::IsMember({"stop", "degrade"}))
+      ->capture_default_str();
+  cmd->add_option("--occlusion-scale", o->occlusion_scale, "Noise multiplier for --occlusion-mode degrade")
+      ->capture_default_str();
+  cmd->add_option("--outliers", o->outliers,
+                  "Outlier probability per sample, every stream (object 2 cm + 0.5 rad, finger/contact 1 cm, force 1 N)")
+      ->capture_default_str();
+  cmd->add_option("--frozen-force", o->frozen, "Force sensor stuck at its last reading during T0,T1 (s); repeatable")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  cmd->add_flag("--no-ground-truth", o->no_ground_truth, "Leave the ground_truth streams out of the file");
+  cmd->footer(
+      "Quasi-static pushing with point contact and Coulomb friction (sticking/sliding by motion cones),\n"
+      "exact limit surface unless --surface ellipsoid. Default job: the 5 mm disk finger pushes\n"
+      "data/shapes/notched_block.json (0.5 kg) 5 cm along +y, 1 cm left of its centroid, at 5 cm/s.\n"
+      "Streams: object 25 Hz, finger/contact/force 250 Hz. Prints a JSON summary; see docs/simulator.md.");
+  cmd->callback([o] { Run(*o); });
+}
+
 }  // namespace pushgraph::cli

@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   RegisterEstimate(app);
 #endif
   RegisterFootprint(app);
+  RegisterMitImport(app);
 
   std::vector<std::string> args(argv + 1, argv + argc);
   // Every option that takes a value may be given a negative number after a space.

@@ -1,0 +1,63 @@
+#pragma once
+// Recordings of the MIT planar pushing dataset (Yu, Bauza, Fazeli, Rodriguez, IROS 2016), read
+// from the dataset's HDF5 files or its JSON variant, and repaired the way the data needs:
+//
+// - three unsynchronised N x 4 arrays, tip_pose [t, x, y, yaw], object_pose [t, x, y, yaw] and
+//   ft_wrench [t, fx, fy, tz]; time stamps sometimes out of order by ~2 ms: sorted (stable),
+//   exact duplicates dropped;
+// - ft_wrench is the force ON THE SENSOR: the force the probe applies to the object is -(fx, fy);
+// - object yaw is unwrapped, and the tracker's jumps by multiples of pi/2 (a square looks the
+//   same turned by 90 degrees) are removed: a step of more than 0.5 rad between samples ~4 ms apart
+//   is physically impossible, so it is snapped to the nearest multiple of pi/2 and subtracted;
+// - the tip's yaw is meaningless: the finger pose's theta is set to 0;
+// - a frozen force sensor (the rect1 files: 2 to 4 distinct values with spikes) is detected and
+//   the force stream dropped, with the reason in `force_fault`;
+// - the contact phase (files start and end without contact) is found from the force magnitude,
+//   or, when the force sensor is frozen, from the object's motion (it moves only while pushed).
+//   Not from the shapes' separation: with time-interpolated poses the probe stays 1 to 2 mm from
+//   the ellip1 block throughout its pushes (stream latencies, calibration), so a distance test
+//   is unreliable on this data.
+//
+//   io::MitReadOptions options;
+//   options.trim_to_contact = true;
+//   io::MitRecording rec = io::ReadMitPush("motion_surface=abs_shape=rect1_....h5", options);
+//   if (rec.force_frozen) std::cerr << rec.force_fault << "\n";
+#include <pushgraph/geometry/shape.h>
+#include <pushgraph/limit_surface/trajectory.h>
+
+#include <string>
+#include <vector>
+
+namespace pushgraph::io {
+
+struct MitReadOptions {
+  double contact_force = 0.3;         ///< force magnitude that means contact (N)
+  double moving_speed = 2e-3;         ///< object speed that means it is pushed, without force (m/s)
+  double max_yaw_step = 0.5;          ///< larger steps between samples are tracker jumps (rad)
+  int frozen_max_distinct = 8;        ///< at most this many distinct force values: frozen
+  bool trim_to_contact = false;       ///< keep only samples within the contact phase
+};
+
+struct MitRecording {
+  std::string file;
+  limit_surface::Streams streams;     ///< object_pose, finger_pose, force (probe on object)
+  bool force_frozen = false;
+  std::string force_fault;            ///< why the force stream was dropped
+  double contact_start = 0.0, contact_end = 0.0;  ///< contact phase (recording's own clock)
+  bool contact_found = false;
+  int samples_reordered = 0;          ///< samples that were out of time order
+  int duplicates_dropped = 0;
+  int yaw_jumps_repaired = 0;
+  std::vector<std::string> notes;     ///< one line per repair, for the user
+};
+
+/// Reads a .h5 (HDF5) or .json recording, chosen by the file's extension. Throws IoError naming
+/// the file and dataset/row for missing datasets, wrong shapes, non-finite values, empty streams.
+MitRecording ReadMitPush(const std::string& path, const MitReadOptions& options = {});
+
+/// The recording as a trajectory: the measured streams, and the same clean streams as ground
+/// truth (the dataset's motion capture is the paper's ground truth).
+limit_surface::Trajectory MitToTrajectory(const MitRecording& recording, const limit_surface::ObjectDescription& object,
+                                          const limit_surface::FingerDescription& finger);
+
+}  // namespace pushgraph::io

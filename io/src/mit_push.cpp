@@ -1,0 +1,198 @@
+// MIT pushing dataset reader (HDF5 C++ API and JSON), with the repairs listed in mit_push.h.
+#include <pushgraph/io/mit_push.h>
+#include <pushgraph/io/trajectory_json.h>  // IoError
+
+#include <H5Cpp.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace pushgraph::io {
+namespace {
+
+using Row = std::array<double, 4>;
+struct Raw {
+  std::vector<Row> tip, object, ft;
+};
+constexpr const char* kDatasets[3] = {"tip_pose", "object_pose", "ft_wrench"};
+
+std::vector<Row>& Slot(Raw& raw, int k) { return k == 0 ? raw.tip : k == 1 ? raw.object : raw.ft; }
+
+Raw ReadH5(const std::string& path) {
+  H5::Exception::dontPrint();
+  Raw raw;
+  try {
+    H5::H5File file(path, H5F_ACC_RDONLY);
+    for (int k = 0; k < 3; ++k) {
+      if (!file.nameExists(kDatasets[k])) throw IoError(path + ": missing dataset '" + std::string(kDatasets[k]) + "'");
+      H5::DataSet ds = file.openDataSet(kDatasets[k]);
+      H5::DataSpace space = ds.getSpace();
+      hsize_t dims[2] = {0, 0};
+      const int rank = space.getSimpleExtentNdims();
+      if (rank != 2) throw IoError(path + ": dataset '" + kDatasets[k] + "' must be N x 4, has rank " + std::to_string(rank));
+      space.getSimpleExtentDims(dims);
+      if (dims[1] != 4)
+        throw IoError(path + ": dataset '" + kDatasets[k] + "' must be N x 4, is " + std::to_string(dims[0]) + " x " +
+                      std::to_string(dims[1]));
+      if (ds.getTypeClass() != H5T_FLOAT && ds.getTypeClass() != H5T_INTEGER)
+        throw IoError(path + ": dataset '" + kDatasets[k] + "' is not numeric");
+      std::vector<Row>& rows = Slot(raw, k);
+      rows.resize(dims[0]);
+      if (dims[0] > 0) ds.read(rows.data(), H5::PredType::NATIVE_DOUBLE);
+    }
+  } catch (const H5::Exception& e) {
+    throw IoError(path + ": cannot read HDF5: " + e.getDetailMsg());
+  }
+  return raw;
+}
+
+Raw ReadJson(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw IoError(path + ": cannot open file");
+  nlohmann::json doc;
+  try {
+    doc = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw IoError(path + ": malformed JSON: " + e.what());
+  }
+  if (!doc.is_object()) throw IoError(path + ": top level must be an object with tip_pose, object_pose, ft_wrench");
+  Raw raw;
+  for (int k = 0; k < 3; ++k) {
+    if (!doc.contains(kDatasets[k])) throw IoError(path + ": missing field '" + std::string(kDatasets[k]) + "'");
+    const nlohmann::json& rows = doc[kDatasets[k]];
+    if (!rows.is_array()) throw IoError(path + ": '" + std::string(kDatasets[k]) + "' must be an array of rows");
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const nlohmann::json& r = rows[i];
+      const std::string where = path + ": " + kDatasets[k] + "[" + std::to_string(i) + "]";
+      if (!r.is_array() || r.size() != 4) throw IoError(where + " must be [t, a, b, c], got " + r.dump());
+      Row row;
+      for (int c = 0; c < 4; ++c) {
+        if (!r[c].is_number()) throw IoError(where + "[" + std::to_string(c) + "] is not a number");
+        row[c] = r[c].get<double>();
+      }
+      Slot(raw, k).push_back(row);
+    }
+  }
+  return raw;
+}
+
+// Validates, sorts by time (stable) and drops exact duplicate time stamps.
+void Clean(std::vector<Row>* rows, const std::string& path, const char* name, MitRecording* rec) {
+  if (rows->size() < 2) throw IoError(path + ": dataset '" + std::string(name) + "' has " + std::to_string(rows->size()) + " samples (need >= 2)");
+  for (std::size_t i = 0; i < rows->size(); ++i)
+    for (int c = 0; c < 4; ++c)
+      if (!std::isfinite((*rows)[i][c]))
+        throw IoError(path + ": dataset '" + name + "' row " + std::to_string(i) + " column " + std::to_string(c) + " is not finite");
+  int reordered = 0;
+  for (std::size_t i = 1; i < rows->size(); ++i) reordered += (*rows)[i][0] < (*rows)[i - 1][0];
+  std::stable_sort(rows->begin(), rows->end(), [](const Row& a, const Row& b) { return a[0] < b[0]; });
+  const std::size_t before = rows->size();
+  rows->erase(std::unique(rows->begin(), rows->end(), [](const Row& a, const Row& b) { return a[0] == b[0]; }), rows->end());
+  const int dropped = static_cast<int>(before - rows->size());
+  rec->samples_reordered += reordered;
+  rec->duplicates_dropped += dropped;
+  if (reordered > 0) rec->notes.push_back(std::string(name) + ": sorted " + std::to_string(reordered) + " out-of-order samples");
+  if (dropped > 0) rec->notes.push_back(std::string(name) + ": dropped " + std::to_string(dropped) + " duplicate time stamps");
+}
+
+double Wrap(double a) { return std::remainder(a, 2.0 * M_PI); }
+
+void FindContactPhase(MitRecording* rec, const MitReadOptions& o) {
+  std::vector<double> times;
+  const auto& s = rec->streams;
+  if (!rec->force_frozen) {
+    for (const auto& f : s.force)
+      if (f.force.norm() > o.contact_force) times.push_back(f.t);
+    rec->notes.push_back("contact phase from the force magnitude (> " + std::to_string(o.contact_force) + " N)");
+  } else {
+    // The object moves only while pushed: its speed over ~20 ms windows.
+    const auto& p = s.object_pose;
+    for (std::size_t i = 0, j = 0; i < p.size(); ++i) {
+      while (j < p.size() && p[j].t < p[i].t + 0.02) ++j;
+      if (j >= p.size()) break;
+      const double speed = (p[j].pose.translation() - p[i].pose.translation()).norm() / (p[j].t - p[i].t);
+      if (speed > o.moving_speed) times.push_back(p[i].t);
+    }
+    rec->notes.push_back("contact phase from the object's motion (force stream unusable)");
+  }
+  if (times.empty()) return;
+  rec->contact_found = true;
+  rec->contact_start = times.front();
+  rec->contact_end = times.back();
+}
+
+template <typename Sample>
+void Trim(std::vector<Sample>* v, double t0, double t1) {
+  v->erase(std::remove_if(v->begin(), v->end(), [&](const Sample& s) { return s.t < t0 || s.t > t1; }), v->end());
+}
+
+}  // namespace
+
+MitRecording ReadMitPush(const std::string& path, const MitReadOptions& o) {
+  const bool json = path.size() >= 5 && path.compare(path.size() - 5, 5, ".json") == 0;
+  Raw raw = json ? ReadJson(path) : ReadH5(path);
+  MitRecording rec;
+  rec.file = path;
+  for (int k = 0; k < 3; ++k) Clean(&Slot(raw, k), path, kDatasets[k], &rec);
+
+  for (const Row& r : raw.tip) rec.streams.finger_pose.push_back({r[0], {r[1], r[2], 0.0}});
+  double unwrapped = raw.object.front()[3];
+  for (std::size_t i = 0; i < raw.object.size(); ++i) {
+    if (i > 0) {
+      double step = Wrap(raw.object[i][3] - raw.object[i - 1][3]);
+      if (std::abs(step) > o.max_yaw_step) {
+        const double quarters = std::round(step / (0.5 * M_PI));
+        ++rec.yaw_jumps_repaired;
+        rec.notes.push_back("object yaw: removed a tracker jump of " + std::to_string(static_cast<int>(quarters)) +
+                            " x pi/2 at t = " + std::to_string(raw.object[i][0]));
+        step -= quarters * 0.5 * M_PI;
+      }
+      unwrapped += step;
+    }
+    rec.streams.object_pose.push_back({raw.object[i][0], {raw.object[i][1], raw.object[i][2], unwrapped}});
+  }
+
+  // A frozen sensor repeats a handful of values (the rect1 recordings: 2 to 4, with spikes).
+  std::set<std::pair<double, double>> distinct;
+  std::size_t longest_run = 1, run = 1;
+  for (std::size_t i = 0; i < raw.ft.size(); ++i) {
+    distinct.insert({raw.ft[i][1], raw.ft[i][2]});
+    run = (i > 0 && raw.ft[i][1] == raw.ft[i - 1][1] && raw.ft[i][2] == raw.ft[i - 1][2]) ? run + 1 : 1;
+    longest_run = std::max(longest_run, run);
+  }
+  if (raw.ft.size() > 20 && (static_cast<int>(distinct.size()) <= o.frozen_max_distinct || longest_run * 2 > raw.ft.size())) {
+    rec.force_frozen = true;
+    std::ostringstream why;
+    why << "force sensor frozen: " << distinct.size() << " distinct values in " << raw.ft.size()
+        << " samples, longest constant run " << longest_run << "; force stream not used";
+    rec.force_fault = why.str();
+    rec.notes.push_back(rec.force_fault);
+  } else {
+    for (const Row& r : raw.ft) rec.streams.force.push_back({r[0], {-r[1], -r[2]}});  // on the object = -(on the sensor)
+  }
+
+  FindContactPhase(&rec, o);
+  if (o.trim_to_contact && rec.contact_found) {
+    Trim(&rec.streams.object_pose, rec.contact_start, rec.contact_end);
+    Trim(&rec.streams.finger_pose, rec.contact_start, rec.contact_end);
+    Trim(&rec.streams.force, rec.contact_start, rec.contact_end);
+  }
+  return rec;
+}
+
+limit_surface::Trajectory MitToTrajectory(const MitRecording& rec, const limit_surface::ObjectDescription& object,
+                                          const limit_surface::FingerDescription& finger) {
+  limit_surface::Trajectory t;
+  t.object = object;
+  t.finger = finger;
+  t.measured = rec.streams;
+  t.ground_truth = rec.streams;
+  return t;
+}
+
+}  // namespace pushgraph::io

@@ -1,0 +1,183 @@
+// The MIT pushing-dataset reader on the real sample (../shared) and on synthetic recordings that
+// carry each known fault.
+#include <pushgraph/io/mit_push.h>
+#include <pushgraph/io/trajectory_json.h>
+
+#include <gtest/gtest.h>
+
+#include <H5Cpp.h>
+
+#include <array>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace pushgraph;
+using Row = std::array<double, 4>;
+
+const std::string kData = std::string(PUSHGRAPH_SHARED_DIR) + "/data/mit-push/abs/";
+
+std::string FirstFile(const std::string& dir) {
+  if (!fs::exists(kData + dir)) return "";
+  std::vector<std::string> files;
+  for (const auto& e : fs::directory_iterator(kData + dir)) files.push_back(e.path().string());
+  std::sort(files.begin(), files.end());
+  return files.empty() ? "" : files.front();
+}
+
+void WriteH5(const std::string& path, const std::vector<std::pair<std::string, std::vector<Row>>>& sets, int columns = 4) {
+  H5::H5File f(path, H5F_ACC_TRUNC);
+  for (const auto& [name, rows] : sets) {
+    hsize_t dims[2] = {rows.size(), static_cast<hsize_t>(columns)};
+    H5::DataSpace space(2, dims);
+    H5::DataSet ds = f.createDataSet(name, H5::PredType::NATIVE_DOUBLE, space);
+    std::vector<double> flat;
+    for (const Row& r : rows)
+      for (int c = 0; c < columns; ++c) flat.push_back(r[c % 4]);
+    ds.write(flat.data(), H5::PredType::NATIVE_DOUBLE);
+  }
+}
+
+// A clean straight push at 50 mm/s with 4 ms samples, and a constant force along the motion.
+std::vector<std::pair<std::string, std::vector<Row>>> CleanPush(int n = 200) {
+  std::vector<Row> tip, obj, ft;
+  for (int i = 0; i < n; ++i) {
+    const double t = 1000.0 + 0.004 * i;
+    const double moving = i >= n / 4 ? 0.05 * 0.004 * (i - n / 4) : 0.0;
+    tip.push_back({t, -0.05 + std::max(moving, 0.05 * 0.004 * i * 0.0), 0.0, 0.3});
+    obj.push_back({t + 0.001, moving, 0.0, 0.01});
+    ft.push_back({t + 0.002, i >= n / 4 ? -1.0 - 0.001 * i : 0.0, 0.001 * (i % 7), 0.0});
+  }
+  return {{"tip_pose", tip}, {"object_pose", obj}, {"ft_wrench", ft}};
+}
+
+class MitPush : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("pushgraph_mit_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+};
+
+TEST_F(MitPush, RealEllip1RecordingIsSortedSignFlippedAndHasAContactPhase) {
+  const std::string file = FirstFile("ellip1");
+  if (file.empty()) GTEST_SKIP() << "MIT sample not found under " << kData;
+  const io::MitRecording rec = io::ReadMitPush(file);
+  EXPECT_FALSE(rec.force_frozen) << rec.force_fault;
+  ASSERT_GT(rec.streams.force.size(), 100u);
+  for (std::size_t i = 1; i < rec.streams.object_pose.size(); ++i)
+    ASSERT_LT(rec.streams.object_pose[i - 1].t, rec.streams.object_pose[i].t);
+  ASSERT_TRUE(rec.contact_found);
+  EXPECT_GT(rec.contact_start, rec.streams.finger_pose.front().t);
+  EXPECT_LT(rec.contact_end, rec.streams.finger_pose.back().t + 1e-9);
+  // The probe pushes the object: the force on the object points along the object's motion.
+  const auto& p = rec.streams.object_pose;
+  const geometry::Vec2 motion = p.back().pose.translation() - p.front().pose.translation();
+  geometry::Vec2 mean_force = geometry::Vec2::Zero();
+  int in_contact = 0;
+  for (const auto& f : rec.streams.force)
+    if (f.t >= rec.contact_start && f.t <= rec.contact_end) mean_force += f.force, ++in_contact;
+  ASSERT_GT(in_contact, 10);
+  EXPECT_GT(mean_force.dot(motion), 0.0) << "force sign not flipped to 'probe on object'";
+}
+
+TEST_F(MitPush, RealRect1FrozenForceSensorIsDetected) {
+  const std::string file = FirstFile("rect1");
+  if (file.empty()) GTEST_SKIP() << "MIT sample not found under " << kData;
+  const io::MitRecording rec = io::ReadMitPush(file);
+  EXPECT_TRUE(rec.force_frozen);
+  EXPECT_NE(rec.force_fault.find("frozen"), std::string::npos);
+  EXPECT_TRUE(rec.streams.force.empty());
+  EXPECT_TRUE(rec.contact_found) << "the object's motion marks the contact phase";
+  EXPECT_GT(rec.streams.object_pose.size(), 100u);
+}
+
+TEST_F(MitPush, SyntheticFaultsAreRepaired) {
+  auto sets = CleanPush();
+  auto& obj = sets[1].second;
+  std::swap(obj[10], obj[11]);                  // out of order
+  obj.insert(obj.begin() + 20, obj[20]);        // duplicate time stamp
+  for (std::size_t i = 120; i < obj.size(); ++i) obj[i][3] += M_PI / 2;    // tracker flip by pi/2
+  for (std::size_t i = 160; i < obj.size(); ++i) obj[i][3] -= 2 * M_PI;   // and a wrap
+  const std::string path = (dir_ / "faults.h5").string();
+  WriteH5(path, sets);
+  const io::MitRecording rec = io::ReadMitPush(path);
+  EXPECT_EQ(rec.samples_reordered, 1);
+  EXPECT_EQ(rec.duplicates_dropped, 1);
+  EXPECT_EQ(rec.yaw_jumps_repaired, 1);
+  for (const auto& s : rec.streams.object_pose) EXPECT_NEAR(s.pose.theta, 0.01, 1e-12) << "at t = " << s.t;
+  for (const auto& s : rec.streams.finger_pose) EXPECT_EQ(s.pose.theta, 0.0);
+  EXPECT_FALSE(rec.force_frozen);
+  EXPECT_EQ(rec.streams.force[100].force.x(), 1.0 + 0.001 * 100);  // sign flipped
+  ASSERT_TRUE(rec.contact_found);
+  EXPECT_NEAR(rec.contact_start, 1000.0 + 0.004 * 50 + 0.002, 1e-9);
+  io::MitReadOptions trim;
+  trim.trim_to_contact = true;
+  const io::MitRecording trimmed = io::ReadMitPush(path, trim);
+  EXPECT_GE(trimmed.streams.force.front().t, trimmed.contact_start);
+  EXPECT_LT(trimmed.streams.object_pose.size(), rec.streams.object_pose.size());
+}
+
+TEST_F(MitPush, FrozenSyntheticSensorAndJsonVariant) {
+  auto sets = CleanPush();
+  for (std::size_t i = 0; i < sets[2].second.size(); ++i) {  // stuck, with spikes, like rect1
+    sets[2].second[i][1] = (i % 50 == 0) ? 3.0 : 0.105;
+    sets[2].second[i][2] = 0.084632;
+  }
+  const std::string json_path = (dir_ / "frozen.json").string();
+  std::ofstream out(json_path);
+  out << "{";
+  for (std::size_t k = 0; k < sets.size(); ++k) {
+    out << (k ? ", " : "") << '"' << sets[k].first << "\": [";
+    for (std::size_t i = 0; i < sets[k].second.size(); ++i) {
+      const Row& r = sets[k].second[i];
+      out << (i ? ", " : "") << "[" << std::setprecision(17) << r[0] << ", " << r[1] << ", " << r[2] << ", " << r[3] << "]";
+    }
+    out << "]";
+  }
+  out << "}";
+  out.close();
+  const io::MitRecording rec = io::ReadMitPush(json_path);
+  EXPECT_TRUE(rec.force_frozen);
+  EXPECT_TRUE(rec.streams.force.empty());
+  EXPECT_EQ(rec.streams.object_pose.size(), 200u);
+}
+
+TEST_F(MitPush, BrokenFilesGetClearErrors) {
+  auto expect_error = [](const std::string& path, const std::string& needle) {
+    try {
+      io::ReadMitPush(path);
+      ADD_FAILURE() << "no error, expected " << needle;
+    } catch (const io::IoError& e) {
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+  };
+  auto sets = CleanPush();
+  const std::string missing = (dir_ / "missing_ft.h5").string();
+  WriteH5(missing, {sets[0], sets[1]});
+  expect_error(missing, "ft_wrench");
+  const std::string three = (dir_ / "three_columns.h5").string();
+  WriteH5(three, sets, 3);
+  expect_error(three, "N x 4");
+  auto nan_sets = sets;
+  nan_sets[1].second[5][2] = std::nan("");
+  const std::string nan_path = (dir_ / "nan.h5").string();
+  WriteH5(nan_path, nan_sets);
+  expect_error(nan_path, "row 5 column 2");
+  const std::string empty = (dir_ / "empty.h5").string();
+  WriteH5(empty, {sets[0], {"object_pose", {}}, sets[2]});
+  expect_error(empty, "object_pose");
+  const std::string garbage = (dir_ / "garbage.h5").string();
+  std::ofstream(garbage) << "not hdf5";
+  expect_error(garbage, "cannot read HDF5");
+  expect_error((dir_ / "absent.h5").string(), "cannot read HDF5");
+}
+
+}  // namespace
