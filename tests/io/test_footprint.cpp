@@ -34,14 +34,12 @@ class Footprint : public ::testing::Test {
     std::ofstream(dir_ / name) << text;
     return (dir_ / name).string();
   }
-  void RequireShared() {
-    if (!fs::exists(kObj + "rect1.obj")) GTEST_SKIP() << "shared MIT meshes not found at " << kObj;
-  }
+  static bool SharedAvailable() { return fs::exists(kObj + "rect1.obj"); }
   fs::path dir_;
 };
 
 TEST_F(Footprint, Rect1IsASquareWithFourThroughHoles) {
-  RequireShared();
+  if (!SharedAvailable()) GTEST_SKIP() << "shared MIT meshes not found at " << kObj;
   io::FootprintReport report;
   const geometry::Shape s = io::MeshFootprint(kObj + "rect1.obj", {}, &report);
   ASSERT_EQ(s.polygons().size(), 1u);
@@ -59,7 +57,7 @@ TEST_F(Footprint, Rect1IsASquareWithFourThroughHoles) {
 }
 
 TEST_F(Footprint, Ellip1IsADiskWithHolesAndTheTipIsADiskAlongY) {
-  RequireShared();
+  if (!SharedAvailable()) GTEST_SKIP() << "shared MIT meshes not found at " << kObj;
   const geometry::Shape e = io::MeshFootprint(kObj + "ellip1.obj");
   EXPECT_EQ(e.polygons().size(), 1u);
   EXPECT_GE(Holes(e), 1);
@@ -75,7 +73,7 @@ TEST_F(Footprint, Ellip1IsADiskWithHolesAndTheTipIsADiskAlongY) {
 }
 
 TEST_F(Footprint, SeveralObjectsInOneFile) {
-  RequireShared();
+  if (!SharedAvailable()) GTEST_SKIP() << "shared MIT meshes not found at " << kObj;
   io::FootprintReport report;
   const geometry::Shape all = io::MeshFootprint(kObj + "tri3.obj", {}, &report);
   ASSERT_EQ(report.objects.size(), 2u);
