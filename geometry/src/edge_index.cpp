@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <numeric>
 
@@ -33,7 +34,7 @@ double PointSegmentDistance(const Vec2& p, const Vec2& a, const Vec2& b) {
 double PointBoxDistance(const Vec2& p, const Box2& box) {
   const double dx = std::max({box.min.x() - p.x(), 0.0, p.x() - box.max.x()});
   const double dy = std::max({box.min.y() - p.y(), 0.0, p.y() - box.max.y()});
-  return std::hypot(dx, dy);
+  return std::sqrt(dx * dx + dy * dy);  // std::hypot is several times slower here
 }
 
 // Liang-Barsky clip: does segment a-b meet the closed box?
@@ -74,19 +75,22 @@ struct EdgeIndex::Impl {
   double inv_cell_x = 0, inv_cell_y = 0;
   std::vector<int> cell_start;
   std::vector<int> cell_edges;
+  std::vector<char> fallback;  // cells answered by the R-tree (too many near-equidistant edges)
   std::vector<int> all_edges;
 
-  void NearbyEdges(const Vec2& p, double radius, std::vector<int>* out) const {
-    const BBox query(BPoint(p.x() - radius, p.y() - radius), BPoint(p.x() + radius, p.y() + radius));
+  // Every edge whose distance to p is within rounding of the nearest one, visiting the R-tree
+  // in increasing distance order (incremental nearest-neighbour query): only near-ties are read.
+  void NearestEdges(const Vec2& p, std::vector<int>* out) const {
     out->clear();
-    for (auto it = rtree.qbegin(bgi::intersects(query)); it != rtree.qend(); ++it) out->push_back(it->second);
+    double limit = std::numeric_limits<double>::infinity();
+    for (auto it = rtree.qbegin(bgi::nearest(BPoint(p.x(), p.y()), static_cast<unsigned>(a.size()))); it != rtree.qend(); ++it) {
+      const double d = PointSegmentDistance(p, a[it->second], b[it->second]);
+      if (d > limit) break;
+      if (out->empty()) limit = d * (1.0 + 1e-9) + 1e-300;
+      out->push_back(it->second);
+    }
   }
 
-  // An upper bound on the distance from p to the nearest edge.
-  double NearestEdgeDistance(const Vec2& p) const {
-    auto it = rtree.qbegin(bgi::nearest(BPoint(p.x(), p.y()), 1));
-    return PointSegmentDistance(p, a[it->second], b[it->second]);
-  }
 };
 
 EdgeIndex::EdgeIndex() : impl_(std::make_unique<Impl>()) {}
@@ -113,42 +117,80 @@ void EdgeIndex::Build(const std::vector<Vec2>& vertices, const std::vector<int>&
   m.nx = m.ny = 0;
   if (n <= kLinearScanEdges) return;
 
-  // Grid over the bounds plus a margin of a quarter of the size; about 16 cells per edge, so
-  // that a cell is small against the features and its candidate list short (1 to 3 edges).
+  // Grid over the bounds plus a margin of a quarter of the size, 2^k x 2^k cells with about 16
+  // cells per edge, so that a cell is small against the features and its candidate list short.
   const Vec2 size = bounds.max - bounds.min;
   const double extent = std::max(size.x(), size.y());
   const Vec2 margin = Vec2::Constant(0.25 * extent);
   m.grid = {bounds.min - margin, bounds.max + margin};
+  int levels = 5;
+  while (levels < 9 && (1 << (2 * levels)) < 16 * n) ++levels;
+  m.nx = m.ny = 1 << levels;
   const Vec2 gsize = m.grid.max - m.grid.min;
-  const int cells = std::clamp(16 * n, 1024, 1 << 18);
-  const double aspect = gsize.x() / std::max(gsize.y(), 1e-300);
-  m.nx = std::clamp(static_cast<int>(std::ceil(std::sqrt(cells * aspect))), 1, 1024);
-  m.ny = std::clamp(static_cast<int>(std::ceil(cells / static_cast<double>(m.nx))), 1, 1024);
   const double cx = gsize.x() / m.nx, cy = gsize.y() / m.ny;
   m.inv_cell_x = 1.0 / cx;
   m.inv_cell_y = 1.0 / cy;
-  m.cell_start.assign(static_cast<std::size_t>(m.nx) * m.ny + 1, 0);
-  m.cell_edges.clear();
-  std::vector<int> nearby;
-  const double half_diagonal = 0.5 * std::hypot(cx, cy);
-  for (int j = 0; j < m.ny; ++j) {
-    for (int i = 0; i < m.nx; ++i) {
-      // Cell boxes are padded by a relative 1e-9 so that rounding in the cell lookup can never
-      // place a point outside the box its list was made for.
-      const Vec2 lo = m.grid.min + Vec2(i * cx, j * cy);
-      const Vec2 pad(cx * 1e-9 + 1e-300, cy * 1e-9 + 1e-300);
-      const Box2 cell{lo - pad, lo + Vec2(cx, cy) + pad};
-      const Vec2 centre = lo + 0.5 * Vec2(cx, cy);
-      // Every point of the cell is within `upper` of the edge nearest to the centre, so only
-      // edges within `upper` of the cell can be closest to a point of the cell.
-      const double upper = (m.NearestEdgeDistance(centre) + half_diagonal) * (1.0 + 1e-9) + 1e-300;
-      m.NearbyEdges(centre, upper + half_diagonal, &nearby);
-      for (int k : nearby) {
-        if (SegmentBoxDistance(m.a[k], m.b[k], cell) <= upper) m.cell_edges.push_back(k);
-      }
-      m.cell_start[static_cast<std::size_t>(j) * m.nx + i + 1] = static_cast<int>(m.cell_edges.size());
+
+  // Quadtree refinement: a child cell's candidates are a subset of its parent's (its bound on
+  // the nearest-edge distance is no larger, its distance to every edge no smaller), so each
+  // node filters its parent's list instead of searching all edges.
+  std::vector<int> items;
+  std::vector<std::pair<int, int>> leaves;  // (cell, first item); lists are contiguous
+  std::function<void(int, int, int, const std::vector<int>&)> refine = [&](int ix, int iy, int span,
+                                                                          const std::vector<int>& parent) {
+    const Vec2 lo = m.grid.min + Vec2(ix * cx, iy * cy);
+    const Vec2 extent_cells(span * cx, span * cy);
+    // Padded by a relative 1e-9 so that rounding in the cell lookup never places a point outside
+    // the box its list was made for.
+    const Vec2 pad(cx * 1e-9 + 1e-300, cy * 1e-9 + 1e-300);
+    const Box2 box{lo - pad, lo + extent_cells + pad};
+    const Vec2 centre = lo + 0.5 * extent_cells;
+    const double half_diagonal = 0.5 * extent_cells.norm();
+    double nearest = std::numeric_limits<double>::infinity();
+    for (int k : parent) nearest = std::min(nearest, PointSegmentDistance(centre, m.a[k], m.b[k]));
+    // Every point of the box is within `upper` of the edge nearest to its centre, so only edges
+    // within `upper` of the box can be closest to one of its points.
+    const double upper = (nearest + half_diagonal) * (1.0 + 1e-9) + 1e-300;
+    std::vector<int> mine;
+    mine.reserve(parent.size());
+    for (int k : parent)
+      if (SegmentBoxDistance(m.a[k], m.b[k], box) <= upper) mine.push_back(k);
+    // Inside finely tessellated round shapes many edges are almost equidistant from a whole cell
+    // and lists stay long: such cells use the R-tree's incremental nearest query, which reads only
+    // the near-ties, instead of a long list.
+    const std::size_t cap = span == 1 ? 64 : 512;
+    if (span <= m.nx / 8 && mine.size() > cap) {
+      for (int y = iy; y < iy + span; ++y)
+        for (int x = ix; x < ix + span; ++x) leaves.emplace_back(y * m.nx + x, -1);
+      return;
     }
+    if (span == 1) {
+      leaves.emplace_back(iy * m.nx + ix, static_cast<int>(items.size()));
+      items.insert(items.end(), mine.begin(), mine.end());
+      return;
+    }
+    const int half = span / 2;
+    for (int q = 0; q < 4; ++q) refine(ix + (q & 1) * half, iy + (q >> 1) * half, half, mine);
+  };
+  refine(0, 0, m.nx, m.all_edges);
+  // Leaves come in quadtree order; lay the lists out by cell number.
+  std::vector<int> count(static_cast<std::size_t>(m.nx) * m.ny, 0), first(count.size(), 0);
+  m.fallback.assign(count.size(), 0);
+  int next_first = static_cast<int>(items.size());
+  for (std::size_t l = leaves.size(); l-- > 0;) {  // backwards: each list ends where the next begins
+    if (leaves[l].second < 0) {
+      m.fallback[leaves[l].first] = 1;
+      continue;
+    }
+    count[leaves[l].first] = next_first - leaves[l].second;
+    first[leaves[l].first] = leaves[l].second;
+    next_first = leaves[l].second;
   }
+  m.cell_start.assign(count.size() + 1, 0);
+  for (std::size_t c = 0; c < count.size(); ++c) m.cell_start[c + 1] = m.cell_start[c] + count[c];
+  m.cell_edges.resize(items.size());
+  for (std::size_t c = 0; c < count.size(); ++c)
+    std::copy(items.begin() + first[c], items.begin() + first[c] + count[c], m.cell_edges.begin() + m.cell_start[c]);
 }
 
 EdgeIndex::Span EdgeIndex::Candidates(const Vec2& p) const {
@@ -158,12 +200,11 @@ EdgeIndex::Span EdgeIndex::Candidates(const Vec2& p) const {
   const double fy = (p.y() - m.grid.min.y()) * m.inv_cell_y;
   if (fx >= 0.0 && fy >= 0.0 && fx < m.nx && fy < m.ny) {
     const std::size_t cell = static_cast<std::size_t>(fy) * m.nx + static_cast<std::size_t>(fx);
-    return {m.cell_edges.data() + m.cell_start[cell], m.cell_start[cell + 1] - m.cell_start[cell]};
+    if (!m.fallback[cell]) return {m.cell_edges.data() + m.cell_start[cell], m.cell_start[cell + 1] - m.cell_start[cell]};
   }
-  // Outside the grid: the nearest edge bounds the search radius.
+  // Outside the grid, or in a fallback cell.
   thread_local std::vector<int> scratch;
-  const double upper = m.NearestEdgeDistance(p) * (1.0 + 1e-9) + 1e-300;
-  m.NearbyEdges(p, upper, &scratch);
+  m.NearestEdges(p, &scratch);
   return {scratch.data(), static_cast<int>(scratch.size())};
 }
 
