@@ -1,0 +1,84 @@
+// Batch solve time against the number of steps (the push generator's 250 Hz clock with object
+// poses at 25 Hz), with and without marginal covariances, and the incremental (fixed-lag)
+// update time against trajectory length: it must stay flat.
+#include <pushgraph/graph/estimator.h>
+#include <pushgraph/graph/incremental.h>
+
+#include "graph/push_generator.h"
+
+#include <benchmark/benchmark.h>
+
+#include <map>
+
+namespace {
+
+using namespace pushgraph;
+
+const limit_surface::Trajectory& Push(int steps) {
+  static std::map<int, limit_surface::Trajectory> cache;
+  auto it = cache.find(steps);
+  if (it == cache.end()) {
+    graph::testing::PushSpec s;
+    s.contact_offset = 0.01;
+    s.duration = (steps - 1) / 250.0;
+    s.seed = 5;
+    it = cache.emplace(steps, graph::testing::GeneratePush(s)).first;
+  }
+  return it->second;
+}
+
+void Batch(benchmark::State& state, graph::Model model, bool covariance) {
+  const auto& traj = Push(static_cast<int>(state.range(0)));
+  graph::EstimatorConfig cfg;
+  cfg.covariance = covariance;
+  int iterations = 0;
+  for (auto _ : state) {
+    const graph::EstimationResult r = graph::Estimate(traj, model, graph::Mode::kBatch, cfg);
+    iterations = r.solver.iterations;
+    benchmark::DoNotOptimize(r.states.data());
+  }
+  state.counters["steps"] = static_cast<double>(state.range(0));
+  state.counters["lm_iterations"] = iterations;
+}
+
+void BM_BatchQs(benchmark::State& s) { Batch(s, graph::Model::kQs, false); }
+void BM_BatchQsWithCovariance(benchmark::State& s) { Batch(s, graph::Model::kQs, true); }
+void BM_BatchCp(benchmark::State& s) { Batch(s, graph::Model::kCp, false); }
+BENCHMARK(BM_BatchQs)->Arg(100)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_BatchCp)->Arg(100)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_BatchQsWithCovariance)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond)->Iterations(1);
+
+// Runs the whole incremental estimation; reports the mean and max update time and the mean of
+// the last quarter of the updates (flat against length means bounded cost).
+void Incremental(benchmark::State& state, bool covariance) {
+  const auto& traj = Push(static_cast<int>(state.range(0)));
+  graph::EstimatorConfig cfg;
+  cfg.covariance = covariance;
+  double mean = 0, worst = 0, last_quarter = 0;
+  for (auto _ : state) {
+    graph::IncrementalEstimator inc(traj, graph::Model::kQs, cfg);
+    std::vector<double> times;
+    while (!inc.Done()) times.push_back(inc.Update());
+    const auto r = inc.Finish();
+    benchmark::DoNotOptimize(r.states.data());
+    mean = worst = last_quarter = 0;
+    const std::size_t q = times.size() * 3 / 4;
+    for (std::size_t i = 0; i < times.size(); ++i) {
+      mean += times[i] / times.size();
+      worst = std::max(worst, times[i]);
+      if (i >= q) last_quarter += times[i] / (times.size() - q);
+    }
+  }
+  state.counters["steps"] = static_cast<double>(state.range(0));
+  state.counters["mean_update_ms"] = 1e3 * mean;
+  state.counters["last_quarter_update_ms"] = 1e3 * last_quarter;
+  state.counters["max_update_ms"] = 1e3 * worst;
+}
+void BM_IncrementalQs(benchmark::State& s) { Incremental(s, false); }
+void BM_IncrementalQsWithCovariance(benchmark::State& s) { Incremental(s, true); }
+BENCHMARK(BM_IncrementalQs)->Arg(500)->Arg(2000)->Arg(8000)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_IncrementalQsWithCovariance)->Arg(500)->Arg(2000)->Unit(benchmark::kMillisecond)->Iterations(1);
+
+}  // namespace
+
+BENCHMARK_MAIN();

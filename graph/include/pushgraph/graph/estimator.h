@@ -1,0 +1,90 @@
+#pragma once
+// Estimation of a whole pushing trajectory: object pose, finger pose, contact point and (QS,
+// baseline) contact force per step, with marginal covariances, from noisy, multi-rate and
+// partly missing measurements (Lambert et al. 2019, Sec. III, Fig. 2).
+//
+//   limit_surface::Trajectory traj = io::LoadTrajectoryJson("push.json");
+//   graph::EstimatorConfig cfg;                        // or graph::LoadEstimatorConfig(path)
+//   graph::EstimationResult r = graph::Estimate(traj, graph::Model::kQs, graph::Mode::kBatch, cfg);
+//   for (const graph::StateEstimate& s : r.states) { s.t, s.object_pose, *s.object_pose_cov ... }
+//   r.metrics["object_position_rms"]                   // when traj.ground_truth is present
+//
+// Models (Fig. 2): kCp = M + C + V; kSdf = CP + S; kQs = SDF + force variables, force M and the
+// non-singular quasi-static factor D; kYu = the Yu-Rodriguez 2018 baseline: M + C +
+// cross-multiplied quasi-static factor + zero-velocity (random-walk) priors, no S.
+// Steps: the sorted union of all measurement time stamps; a step has a factor for each
+// measurement it has, contact variables only while in contact (EstimatorConfig's gating).
+// Modes: kBatch solves everything at once (Ceres LM, SPARSE_NORMAL_CHOLESKY, ceres::Covariance);
+// kIncremental is a fixed-lag smoother (incremental.h).
+#include <pushgraph/graph/config.h>
+#include <pushgraph/graph/factors.h>
+#include <pushgraph/limit_surface/trajectory.h>
+
+#include <Eigen/Core>
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace pushgraph::graph {
+
+enum class Model { kCp, kSdf, kQs, kYu };
+enum class Mode { kBatch, kIncremental };
+
+/// "cp", "sdf", "qs", "yu"; throws GraphError naming the bad value.
+Model ParseModel(const std::string& name);
+std::string ModelName(Model model);
+/// "batch", "incremental".
+Mode ParseMode(const std::string& name);
+std::string ModeName(Mode mode);
+bool ModelHasForce(Model model);
+
+struct StateEstimate {
+  double t = 0.0;
+  Pose2 object_pose;
+  Pose2 finger_pose;
+  std::optional<Vec2> contact;  ///< while in contact
+  std::optional<Vec2> force;    ///< QS and baseline, while in contact
+  std::optional<Eigen::Matrix3d> object_pose_cov, finger_pose_cov;  ///< (x, y, theta)
+  std::optional<Eigen::Matrix2d> contact_cov, force_cov;
+};
+
+struct SolverStats {
+  int iterations = 0;      ///< LM iterations (summed over updates when incremental)
+  double time_s = 0.0;     ///< wall time of solving and covariance estimation
+  double final_cost = 0.0; ///< batch: final cost; incremental: cost of the last window
+  int updates = 0;         ///< incremental updates (1 for batch)
+  double max_update_time_s = 0.0;
+  double mean_update_time_s = 0.0;
+  std::string covariance_status = "not computed";
+};
+
+struct EstimationResult {
+  Model model = Model::kQs;
+  Mode mode = Mode::kBatch;
+  std::vector<StateEstimate> states;
+  SolverStats solver;
+  /// RMS errors against the trajectory's ground truth (empty without it): object_position_rms
+  /// (m), object_rotation_rms (rad), finger_position_rms, finger_rotation_rms, contact_rms (m),
+  /// force_rms (N); the same of the raw measurements as measured_*; and the mean normalized
+  /// estimation error squared object_pose_nees (dimension 3) etc. where covariances exist.
+  std::map<std::string, double> metrics;
+};
+
+/// Runs the estimator. Throws GraphError for unusable input (no object or finger
+/// measurements, non-finite samples, missing shapes, a model needing mass/friction without them).
+EstimationResult Estimate(const limit_surface::Trajectory& trajectory, Model model, Mode mode,
+                          const EstimatorConfig& config = {});
+
+/// The metrics of EstimationResult for given states.
+std::map<std::string, double> ComputeMetrics(const limit_surface::Trajectory& trajectory,
+                                             const std::vector<StateEstimate>& states);
+
+/// The limit-surface ratio c used by D for this trajectory and config (config.c if set, else
+/// the uniform-pressure limit surface of the object's shape; times config.c_scale), and the
+/// centre of pressure in the object frame.
+QuasiStaticGeometry QuasiStaticGeometryFor(const limit_surface::Trajectory& trajectory,
+                                           const EstimatorConfig& config);
+
+}  // namespace pushgraph::graph

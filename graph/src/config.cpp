@@ -1,0 +1,170 @@
+#include <pushgraph/graph/config.h>
+#include <pushgraph/graph/factors.h>
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+namespace pushgraph::graph {
+namespace {
+
+using Json = nlohmann::json;
+
+std::map<std::string, double EstimatorConfig::*> DoubleFields() {
+  return {
+      {"object_pose_sigma_trans", &EstimatorConfig::object_pose_sigma_trans},
+      {"object_pose_sigma_rot", &EstimatorConfig::object_pose_sigma_rot},
+      {"finger_pose_sigma_trans", &EstimatorConfig::finger_pose_sigma_trans},
+      {"finger_pose_sigma_rot", &EstimatorConfig::finger_pose_sigma_rot},
+      {"contact_sigma", &EstimatorConfig::contact_sigma},
+      {"force_sigma", &EstimatorConfig::force_sigma},
+      {"contact_object_sigma", &EstimatorConfig::contact_object_sigma},
+      {"contact_finger_sigma", &EstimatorConfig::contact_finger_sigma},
+      {"touching_sigma", &EstimatorConfig::touching_sigma},
+      {"intersection_sigma", &EstimatorConfig::intersection_sigma},
+      {"accel_trans", &EstimatorConfig::accel_trans},
+      {"accel_rot", &EstimatorConfig::accel_rot},
+      {"quasi_static_sigma", &EstimatorConfig::quasi_static_sigma},
+      {"eps_velocity", &EstimatorConfig::eps_velocity},
+      {"eps_force", &EstimatorConfig::eps_force},
+      {"c", &EstimatorConfig::c},
+      {"c_scale", &EstimatorConfig::c_scale},
+      {"force_prior_sigma", &EstimatorConfig::force_prior_sigma},
+      {"force_random_walk", &EstimatorConfig::force_random_walk},
+      {"limit_surface_sigma", &EstimatorConfig::limit_surface_sigma},
+      {"yu_quasi_static_sigma", &EstimatorConfig::yu_quasi_static_sigma},
+      {"random_walk_trans", &EstimatorConfig::random_walk_trans},
+      {"random_walk_rot", &EstimatorConfig::random_walk_rot},
+      {"contact_max_gap", &EstimatorConfig::contact_max_gap},
+      {"contact_force_threshold", &EstimatorConfig::contact_force_threshold},
+      {"function_tolerance", &EstimatorConfig::function_tolerance},
+  };
+}
+
+std::map<std::string, int EstimatorConfig::*> IntFields() {
+  return {
+      {"max_iterations", &EstimatorConfig::max_iterations},
+      {"incremental_window", &EstimatorConfig::incremental_window},
+      {"incremental_update_every", &EstimatorConfig::incremental_update_every},
+      {"incremental_max_iterations", &EstimatorConfig::incremental_max_iterations},
+  };
+}
+
+std::map<std::string, LossConfig EstimatorConfig::*> LossFields() {
+  return {
+      {"object_pose", &EstimatorConfig::object_pose_loss},
+      {"finger_pose", &EstimatorConfig::finger_pose_loss},
+      {"contact", &EstimatorConfig::contact_loss},
+      {"force", &EstimatorConfig::force_loss},
+  };
+}
+
+[[noreturn]] void Fail(const std::string& source, const std::string& key, const std::string& what) {
+  throw GraphError(source + ": config key '" + key + "': " + what);
+}
+
+LossConfig ParseLoss(const Json& j, const std::string& source, const std::string& key) {
+  if (!j.is_object()) Fail(source, key, "expected an object {\"type\": ..., \"scale\": ...}");
+  LossConfig loss;
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    if (it.key() == "type") {
+      if (!it->is_string()) Fail(source, key + ".type", "expected a string");
+      const std::string t = it->get<std::string>();
+      if (t == "none") loss.type = LossConfig::Type::kNone;
+      else if (t == "huber") loss.type = LossConfig::Type::kHuber;
+      else if (t == "cauchy") loss.type = LossConfig::Type::kCauchy;
+      else Fail(source, key + ".type", "unknown loss '" + t + "' (none, huber, cauchy)");
+    } else if (it.key() == "scale") {
+      if (!it->is_number()) Fail(source, key + ".scale", "expected a number");
+      loss.scale = it->get<double>();
+    } else {
+      Fail(source, key + "." + it.key(), "unknown key");
+    }
+  }
+  return loss;
+}
+
+void CheckPositive(double v, const std::string& key) {
+  if (!(v > 0.0) || !std::isfinite(v)) {
+    throw GraphError("config key '" + key + "' must be finite and > 0, got " + std::to_string(v));
+  }
+}
+
+}  // namespace
+
+EstimatorConfig ParseEstimatorConfig(const std::string& json_text, const std::string& source) {
+  Json j;
+  try {
+    j = Json::parse(json_text);
+  } catch (const Json::parse_error& e) {
+    throw GraphError(source + ": invalid JSON: " + e.what());
+  }
+  if (!j.is_object()) throw GraphError(source + ": the configuration must be a JSON object");
+  EstimatorConfig cfg;
+  const auto doubles = DoubleFields();
+  const auto ints = IntFields();
+  const auto losses = LossFields();
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    const std::string& key = it.key();
+    if (auto d = doubles.find(key); d != doubles.end()) {
+      if (!it->is_number()) Fail(source, key, "expected a number");
+      cfg.*(d->second) = it->get<double>();
+    } else if (auto i = ints.find(key); i != ints.end()) {
+      if (!it->is_number_integer()) Fail(source, key, "expected an integer");
+      cfg.*(i->second) = it->get<int>();
+    } else if (key == "covariance") {
+      if (!it->is_boolean()) Fail(source, key, "expected true or false");
+      cfg.covariance = it->get<bool>();
+    } else if (key == "losses") {
+      if (!it->is_object()) Fail(source, key, "expected an object");
+      for (auto l = it->begin(); l != it->end(); ++l) {
+        auto f = losses.find(l.key());
+        if (f == losses.end()) {
+          Fail(source, "losses." + l.key(), "unknown measurement (object_pose, finger_pose, contact, force)");
+        }
+        cfg.*(f->second) = ParseLoss(*l, source, "losses." + l.key());
+      }
+    } else {
+      Fail(source, key, "unknown key (see docs/estimation.md)");
+    }
+  }
+  try {
+    ValidateConfig(cfg);
+  } catch (const GraphError& e) {
+    throw GraphError(source + ": " + e.what());
+  }
+  return cfg;
+}
+
+EstimatorConfig LoadEstimatorConfig(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw GraphError("cannot open config file '" + path + "'");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ParseEstimatorConfig(ss.str(), path);
+}
+
+void ValidateConfig(const EstimatorConfig& cfg) {
+  for (const auto& [key, member] : DoubleFields()) {
+    const double v = cfg.*member;
+    if (key == "c") {
+      if (!(v >= 0.0) || !std::isfinite(v)) {
+        throw GraphError("config key 'c' must be finite and >= 0 (0: from the limit surface)");
+      }
+    } else {
+      CheckPositive(v, key);
+    }
+  }
+  for (const auto& [key, member] : LossFields()) CheckPositive((cfg.*member).scale, "losses." + key + ".scale");
+  for (const auto& [key, member] : IntFields()) {
+    if (cfg.*member < 1) throw GraphError("config key '" + key + "' must be >= 1");
+  }
+  if (cfg.incremental_window < cfg.incremental_update_every) {
+    throw GraphError("config: incremental_window must be >= incremental_update_every");
+  }
+}
+
+}  // namespace pushgraph::graph

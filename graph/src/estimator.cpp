@@ -1,0 +1,613 @@
+#include "graph_builder.h"
+
+#include <pushgraph/geometry/point_query.h>
+#include <pushgraph/graph/incremental.h>
+#include <pushgraph/limit_surface/limit_surface.h>
+#include <pushgraph/limit_surface/support.h>
+
+#include <Eigen/Cholesky>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <tuple>
+
+namespace pushgraph::graph {
+
+Model ParseModel(const std::string& name) {
+  if (name == "cp") return Model::kCp;
+  if (name == "sdf") return Model::kSdf;
+  if (name == "qs") return Model::kQs;
+  if (name == "yu") return Model::kYu;
+  throw GraphError("unknown model '" + name + "' (expected cp, sdf, qs or yu)");
+}
+
+std::string ModelName(Model model) {
+  switch (model) {
+    case Model::kCp: return "cp";
+    case Model::kSdf: return "sdf";
+    case Model::kQs: return "qs";
+    case Model::kYu: return "yu";
+  }
+  return "?";
+}
+
+Mode ParseMode(const std::string& name) {
+  if (name == "batch") return Mode::kBatch;
+  if (name == "incremental") return Mode::kIncremental;
+  throw GraphError("unknown mode '" + name + "' (expected batch or incremental)");
+}
+
+std::string ModeName(Mode mode) { return mode == Mode::kBatch ? "batch" : "incremental"; }
+
+bool ModelHasForce(Model model) { return model == Model::kQs || model == Model::kYu; }
+
+QuasiStaticGeometry QuasiStaticGeometryFor(const limit_surface::Trajectory& traj,
+                                           const EstimatorConfig& cfg) {
+  QuasiStaticGeometry g;
+  if (traj.object.shape.empty()) throw GraphError("trajectory: object.shape is missing or empty");
+  // For uniform pressure c and the centre of pressure do not depend on mass or mu.
+  auto summarize = [&](const geometry::Shape& region) {
+    limit_surface::SupportSpec spec;
+    spec.region = region;
+    spec.mass = traj.object.mass > 0.0 ? traj.object.mass : 1.0;
+    spec.mu = traj.object.mu_surface > 0.0 ? traj.object.mu_surface : 1.0;
+    return limit_surface::Summarize(limit_surface::MakeSupport(spec));
+  };
+  limit_surface::Summary s;
+  try {
+    s = summarize(traj.object.shape);
+  } catch (const std::exception& first) {
+    // Rounded polygons are not supported by the limit-surface module: use the core polygons.
+    if (traj.object.shape.radius() > 0.0 && !traj.object.shape.is_degenerate_core()) {
+      s = summarize(traj.object.shape.WithRadius(0.0));
+    } else if (cfg.c > 0.0) {
+      s.c = cfg.c;
+    } else {
+      throw GraphError(std::string("cannot compute the limit surface of the object (set config 'c'): ") +
+                       first.what());
+    }
+  }
+  g.c = (cfg.c > 0.0 ? cfg.c : s.c) * cfg.c_scale;
+  g.centre_of_pressure = s.centre_of_pressure;
+  return g;
+}
+
+namespace internal {
+namespace {
+
+template <class Sample, class Get>
+auto Interpolate(const std::vector<Sample>& samples, double t, Get get) {
+  auto it = std::lower_bound(samples.begin(), samples.end(), t,
+                             [](const Sample& s, double tt) { return s.t < tt; });
+  if (it == samples.begin()) return get(samples.front());
+  if (it == samples.end()) return get(samples.back());
+  const Sample& b = *it;
+  const Sample& a = *(it - 1);
+  const double w = (t - a.t) / (b.t - a.t);
+  return decltype(get(a))(get(a) + w * (get(b) - get(a)));
+}
+
+Pose2 InterpolatePose(const std::vector<limit_surface::PoseSample>& all, double t, double limit) {
+  // Only the samples up to `limit`.
+  const auto end = std::upper_bound(all.begin(), all.end(), limit,
+                                    [](double tt, const limit_surface::PoseSample& a) { return tt < a.t; });
+  if (end == all.begin()) return all.front().pose;
+  auto it = std::lower_bound(all.begin(), end, t,
+                             [](const limit_surface::PoseSample& a, double tt) { return a.t < tt; });
+  if (it == all.begin()) return all.front().pose;
+  if (it == end) return (end - 1)->pose;
+  const Pose2& a = (it - 1)->pose;
+  const Pose2& b = it->pose;
+  const double w = (t - (it - 1)->t) / (it->t - (it - 1)->t);
+  return {a.x + w * (b.x - a.x), a.y + w * (b.y - a.y),
+          a.theta + w * geometry::WrapAngle(b.theta - a.theta)};
+}
+
+template <class Sample>
+double NearestGap(const std::vector<Sample>& s, double t, int* index = nullptr) {
+  if (s.empty()) return INFINITY;
+  auto it = std::lower_bound(s.begin(), s.end(), t, [](const Sample& a, double tt) { return a.t < tt; });
+  double best = INFINITY;
+  int bi = -1;
+  if (it != s.end()) { best = it->t - t; bi = static_cast<int>(it - s.begin()); }
+  if (it != s.begin() && t - (it - 1)->t < best) { best = t - (it - 1)->t; bi = static_cast<int>(it - s.begin()) - 1; }
+  if (index != nullptr) *index = bi;
+  return best;
+}
+
+void CheckFinite(bool ok, const std::string& stream, std::size_t i) {
+  if (!ok) throw GraphError("trajectory: non-finite value in streams." + stream + "[" + std::to_string(i) + "]");
+}
+
+template <class Sample>
+void CheckSorted(const std::vector<Sample>& s, const std::string& stream) {
+  for (std::size_t i = 1; i < s.size(); ++i) {
+    if (!(s[i].t > s[i - 1].t)) {
+      throw GraphError("trajectory: streams." + stream + " is not strictly increasing in time at sample " +
+                       std::to_string(i));
+    }
+  }
+}
+
+void ValidateTrajectory(const limit_surface::Trajectory& traj) {
+  if (traj.object.shape.empty()) throw GraphError("trajectory: object.shape is missing or empty");
+  if (traj.finger.shape.empty()) throw GraphError("trajectory: finger.shape is missing or empty");
+  const auto& m = traj.measured;
+  for (std::size_t i = 0; i < m.object_pose.size(); ++i) {
+    CheckFinite(std::isfinite(m.object_pose[i].t) && m.object_pose[i].pose.vector().allFinite(), "object_pose", i);
+  }
+  for (std::size_t i = 0; i < m.finger_pose.size(); ++i) {
+    CheckFinite(std::isfinite(m.finger_pose[i].t) && m.finger_pose[i].pose.vector().allFinite(), "finger_pose", i);
+  }
+  for (std::size_t i = 0; i < m.contact_point.size(); ++i) {
+    CheckFinite(std::isfinite(m.contact_point[i].t) && m.contact_point[i].point.allFinite(), "contact_point", i);
+  }
+  for (std::size_t i = 0; i < m.force.size(); ++i) {
+    CheckFinite(std::isfinite(m.force[i].t) && m.force[i].force.allFinite(), "force", i);
+  }
+  CheckSorted(m.object_pose, "object_pose");
+  CheckSorted(m.finger_pose, "finger_pose");
+  CheckSorted(m.contact_point, "contact_point");
+  CheckSorted(m.force, "force");
+  if (m.object_pose.empty()) {
+    throw GraphError("trajectory: no object pose measurements (streams.object_pose is empty): nothing anchors the object");
+  }
+  if (m.finger_pose.empty()) {
+    throw GraphError("trajectory: no finger pose measurements (streams.finger_pose is empty)");
+  }
+}
+
+}  // namespace
+
+GraphBuilder::GraphBuilder(const limit_surface::Trajectory& trajectory, Model model,
+                           const EstimatorConfig& config)
+    : traj_(trajectory), model_(model), cfg_(config) {
+  ValidateConfig(cfg_);
+  ValidateTrajectory(traj_);
+  const auto& m = traj_.measured;
+  // Steps: the union of all time stamps (merged when closer than 1e-9 s).
+  std::vector<std::tuple<double, int, int>> events;  // t, stream, index
+  for (std::size_t i = 0; i < m.object_pose.size(); ++i) events.emplace_back(m.object_pose[i].t, 0, int(i));
+  for (std::size_t i = 0; i < m.finger_pose.size(); ++i) events.emplace_back(m.finger_pose[i].t, 1, int(i));
+  for (std::size_t i = 0; i < m.contact_point.size(); ++i) events.emplace_back(m.contact_point[i].t, 2, int(i));
+  for (std::size_t i = 0; i < m.force.size(); ++i) events.emplace_back(m.force[i].t, 3, int(i));
+  std::sort(events.begin(), events.end());
+  for (const auto& [t, stream, index] : events) {
+    if (steps_.empty() || t - steps_.back().t > 1e-9) {
+      steps_.push_back(Step{});
+      steps_.back().t = t;
+    }
+    Step& s = steps_.back();
+    int* slot = stream == 0 ? &s.object : stream == 1 ? &s.finger : stream == 2 ? &s.contact : &s.force;
+    *slot = index;
+  }
+  // Contact gating.
+  for (Step& s : steps_) {
+    if (!m.contact_point.empty()) {
+      s.in_contact = NearestGap(m.contact_point, s.t) <= cfg_.contact_max_gap;
+    } else if (!m.force.empty()) {
+      int k = -1;
+      const double gap = NearestGap(m.force, s.t, &k);
+      s.in_contact = gap <= cfg_.contact_max_gap && m.force[k].force.norm() >= cfg_.contact_force_threshold;
+    } else {
+      s.in_contact = true;
+    }
+  }
+  vars_.resize(steps_.size());
+  querier_ = std::make_shared<geometry::ShapePairQuerier>(traj_.object.shape, traj_.finger.shape);
+  if (ModelHasForce(model_)) qs_ = QuasiStaticGeometryFor(traj_, cfg_);
+  if (traj_.object.mass > 0.0 && traj_.object.mu_surface > 0.0) {
+    f_max_ = traj_.object.mu_surface * traj_.object.mass * limit_surface::kStandardGravity;
+  }
+}
+
+void GraphBuilder::Initialize(int i, double limit) {
+  const bool causal = std::isfinite(limit);
+  const auto& m = traj_.measured;
+  const Step& s = steps_[i];
+  StepVars& v = vars_[i];
+  const StepVars* prev = i > 0 ? &vars_[i - 1] : nullptr;
+  auto set_pose = [](double* dst, const Pose2& p) { dst[0] = p.x; dst[1] = p.y; dst[2] = p.theta; };
+  auto continuous = [](double* dst, const double* ref) {  // keep theta continuous with ref
+    dst[2] = ref[2] + geometry::WrapAngle(dst[2] - ref[2]);
+  };
+  // Measurements interpolated, using only samples up to `limit` (causal in incremental mode;
+  // beyond the newest sample its value is held).
+  if (s.object >= 0) set_pose(v.x, m.object_pose[s.object].pose);
+  else set_pose(v.x, InterpolatePose(m.object_pose, s.t, limit));
+  if (s.finger >= 0) set_pose(v.e, m.finger_pose[s.finger].pose);
+  else set_pose(v.e, InterpolatePose(m.finger_pose, s.t, limit));
+  if (prev != nullptr) {
+    continuous(v.x, prev->x);
+    continuous(v.e, prev->e);
+  }
+  if (s.in_contact) {
+    if (s.contact >= 0) {
+      const Vec2 c = m.contact_point[s.contact].point;
+      v.p[0] = c.x(); v.p[1] = c.y();
+    } else if (!m.contact_point.empty() && !causal) {
+      const Vec2 c = Interpolate(m.contact_point, s.t, [](const limit_surface::PointSample& a) { return Vec2(a.point); });
+      v.p[0] = c.x(); v.p[1] = c.y();
+    } else if (causal && prev != nullptr && steps_[i - 1].in_contact) {
+      v.p[0] = prev->p[0]; v.p[1] = prev->p[1];
+    } else {
+      // The object boundary point closest to the finger's reference point.
+      const auto q = geometry::QueryPoint(traj_.object.shape, Pose2{v.x[0], v.x[1], v.x[2]}, Vec2(v.e[0], v.e[1]));
+      v.p[0] = q.closest_point.x(); v.p[1] = q.closest_point.y();
+    }
+    if (s.force >= 0) {
+      v.f[0] = m.force[s.force].force.x(); v.f[1] = m.force[s.force].force.y();
+    } else if (!m.force.empty() && !causal) {
+      const Vec2 f = Interpolate(m.force, s.t, [](const limit_surface::ForceSample& a) { return Vec2(a.force); });
+      v.f[0] = f.x(); v.f[1] = f.y();
+    } else if (causal && prev != nullptr && steps_[i - 1].in_contact) {
+      v.f[0] = prev->f[0]; v.f[1] = prev->f[1];
+    } else {
+      // Towards the object's centre, small: D's gradient in f is well defined for any f.
+      Vec2 d = Vec2(v.x[0], v.x[1]) - Vec2(v.p[0], v.p[1]);
+      d = d.norm() > 0 ? Vec2(0.1 * d.normalized()) : Vec2(0.1, 0.0);
+      v.f[0] = d.x(); v.f[1] = d.y();
+    }
+  }
+}
+
+ceres::LossFunction* GraphBuilder::MakeLoss(const LossConfig& loss) const {
+  switch (loss.type) {
+    case LossConfig::Type::kNone: return nullptr;
+    case LossConfig::Type::kHuber: return new ceres::HuberLoss(loss.scale);
+    case LossConfig::Type::kCauchy: return new ceres::CauchyLoss(loss.scale);
+  }
+  return nullptr;
+}
+
+void GraphBuilder::AddFactors(ceres::Problem& problem, int i, int parts) {
+  const Step& s = steps_[i];
+  StepVars& v = vars_[i];
+  if (parts & kKinematic) {
+    problem.AddParameterBlock(v.x, 3);
+    problem.AddParameterBlock(v.e, 3);
+    if (s.in_contact) problem.AddParameterBlock(v.p, 2);
+    AddKinematicFactors(problem, i);
+  }
+  if ((parts & kDynamic) && HasForceVars(i)) {
+    problem.AddParameterBlock(v.f, 2);
+    AddDynamicFactors(problem, i);
+  }
+}
+
+void GraphBuilder::AddKinematicFactors(ceres::Problem& problem, int i) {
+  const auto& m = traj_.measured;
+  const Step& s = steps_[i];
+  StepVars& v = vars_[i];
+  // M
+  if (s.object >= 0) {
+    problem.AddResidualBlock(new PoseMeasurementFactor(m.object_pose[s.object].pose, cfg_.object_pose_sigma_trans,
+                                                       cfg_.object_pose_sigma_rot),
+                             MakeLoss(cfg_.object_pose_loss), v.x);
+  }
+  if (s.finger >= 0) {
+    problem.AddResidualBlock(new PoseMeasurementFactor(m.finger_pose[s.finger].pose, cfg_.finger_pose_sigma_trans,
+                                                       cfg_.finger_pose_sigma_rot),
+                             MakeLoss(cfg_.finger_pose_loss), v.e);
+  }
+  if (s.in_contact) {
+    if (s.contact >= 0) {
+      problem.AddResidualBlock(new VectorMeasurementFactor(m.contact_point[s.contact].point, cfg_.contact_sigma),
+                               MakeLoss(cfg_.contact_loss), v.p);
+    }
+    // C: contact point on both boundaries, finger touching the object.
+    problem.AddResidualBlock(new BoundaryPointFactor(traj_.object.shape, cfg_.contact_object_sigma), nullptr, v.x, v.p);
+    problem.AddResidualBlock(new BoundaryPointFactor(traj_.finger.shape, cfg_.contact_finger_sigma), nullptr, v.e, v.p);
+    // The finger touches the object (signed separation 0): in QS and the baseline (Yu and
+    // Rodriguez's contact factor). CP and SDF link finger and object through p only (Fig. 2a-b).
+    if (model_ == Model::kQs || model_ == Model::kYu) {
+      problem.AddResidualBlock(new TouchingFactor(querier_, cfg_.touching_sigma), nullptr, v.x, v.e);
+    }
+  }
+  // S
+  if (model_ == Model::kSdf || model_ == Model::kQs) {
+    problem.AddResidualBlock(new IntersectionFactor(querier_, cfg_.intersection_sigma), nullptr, v.x, v.e);
+  }
+  // V or the baseline's zero-velocity priors.
+  if (model_ == Model::kYu) {
+    if (i >= 1) {
+      const double dt = s.t - steps_[i - 1].t;
+      problem.AddResidualBlock(new RandomWalkFactor(dt, cfg_.random_walk_trans, cfg_.random_walk_rot), nullptr,
+                               vars_[i - 1].x, v.x);
+      problem.AddResidualBlock(new RandomWalkFactor(dt, cfg_.random_walk_trans, cfg_.random_walk_rot), nullptr,
+                               vars_[i - 1].e, v.e);
+    }
+  } else if (i >= 2) {
+    const double dt1 = steps_[i - 1].t - steps_[i - 2].t, dt2 = s.t - steps_[i - 1].t;
+    const double st = ConstantVelocitySigma(cfg_.accel_trans, dt1, dt2);
+    const double sr = ConstantVelocitySigma(cfg_.accel_rot, dt1, dt2);
+    problem.AddResidualBlock(new ConstantVelocityFactor(dt1, dt2, st, sr), nullptr, vars_[i - 2].x, vars_[i - 1].x, v.x);
+    problem.AddResidualBlock(new ConstantVelocityFactor(dt1, dt2, st, sr), nullptr, vars_[i - 2].e, vars_[i - 1].e, v.e);
+  }
+}
+
+void GraphBuilder::AddDynamicFactors(ceres::Problem& problem, int i) {
+  const auto& m = traj_.measured;
+  const Step& s = steps_[i];
+  StepVars& v = vars_[i];
+  // Force: measurement, weak prior, quasi-static factor.
+  {
+    if (s.force >= 0) {
+      problem.AddResidualBlock(new VectorMeasurementFactor(m.force[s.force].force, cfg_.force_sigma),
+                               MakeLoss(cfg_.force_loss), v.f);
+    }
+    problem.AddResidualBlock(new VectorMeasurementFactor(Vec2::Zero(), cfg_.force_prior_sigma), nullptr, v.f);
+    if (i >= 1 && HasForceVars(i - 1)) {
+      problem.AddResidualBlock(new VectorRandomWalkFactor(s.t - steps_[i - 1].t, cfg_.force_random_walk), nullptr,
+                               vars_[i - 1].f, v.f);
+    }
+    if (i >= 1) {
+      QuasiStaticGeometry g = qs_;
+      g.dt = s.t - steps_[i - 1].t;
+      const double rate_scale = std::sqrt(0.01 / g.dt);  // per-10-ms sigmas (config.h)
+      if (model_ == Model::kQs) {
+        problem.AddResidualBlock(new QuasiStaticFactor(g, cfg_.eps_velocity, cfg_.eps_force,
+                                                       cfg_.quasi_static_sigma * rate_scale),
+                                 nullptr, vars_[i - 1].x, v.x, v.p, v.f);
+        if (f_max_ > 0.0) {
+          problem.AddResidualBlock(new LimitSurfaceLoadFactor(g, f_max_, cfg_.eps_velocity, cfg_.eps_force,
+                                                              cfg_.limit_surface_sigma * rate_scale),
+                                   nullptr, vars_[i - 1].x, v.x, v.p, v.f);
+        }
+      } else {
+        problem.AddResidualBlock(new CrossMultipliedQuasiStaticFactor(g, cfg_.yu_quasi_static_sigma * rate_scale), nullptr,
+                                 vars_[i - 1].x, v.x, v.p, v.f);
+      }
+    }
+  }
+}
+
+std::vector<double*> GraphBuilder::Blocks(int i) {
+  std::vector<double*> b{vars_[i].x, vars_[i].e};
+  if (HasContactVars(i)) b.push_back(vars_[i].p);
+  if (HasForceVars(i)) b.push_back(vars_[i].f);
+  return b;
+}
+
+StateEstimate GraphBuilder::State(int i) const {
+  StateEstimate s;
+  const StepVars& v = vars_[i];
+  s.t = steps_[i].t;
+  s.object_pose = {v.x[0], v.x[1], v.x[2]};
+  s.finger_pose = {v.e[0], v.e[1], v.e[2]};
+  if (HasContactVars(i)) s.contact = Vec2(v.p[0], v.p[1]);
+  if (HasForceVars(i)) s.force = Vec2(v.f[0], v.f[1]);
+  return s;
+}
+
+std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder, const std::vector<int>& steps,
+                               std::vector<StateEstimate>& states) {
+  ceres::Covariance::Options options;
+  options.algorithm_type = ceres::SPARSE_QR;
+  options.num_threads = 1;
+  ceres::Covariance covariance(options);
+  std::vector<std::pair<const double*, const double*>> pairs;
+  for (int i : steps) {
+    for (double* b : builder.Blocks(i)) pairs.emplace_back(b, b);
+  }
+  if (!covariance.Compute(pairs, &problem)) return "failed (rank-deficient Jacobian)";
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    const int i = steps[k];
+    StepVars& v = builder.vars()[i];
+    StateEstimate& s = states[k];
+    Eigen::Matrix<double, 3, 3, Eigen::RowMajor> c3;
+    Eigen::Matrix<double, 2, 2, Eigen::RowMajor> c2;
+    covariance.GetCovarianceBlock(v.x, v.x, c3.data());
+    s.object_pose_cov = Eigen::Matrix3d(c3);
+    covariance.GetCovarianceBlock(v.e, v.e, c3.data());
+    s.finger_pose_cov = Eigen::Matrix3d(c3);
+    if (builder.HasContactVars(i)) {
+      covariance.GetCovarianceBlock(v.p, v.p, c2.data());
+      s.contact_cov = Eigen::Matrix2d(c2);
+    }
+    if (builder.HasForceVars(i)) {
+      covariance.GetCovarianceBlock(v.f, v.f, c2.data());
+      s.force_cov = Eigen::Matrix2d(c2);
+    }
+  }
+  return "ok";
+}
+
+ceres::Solver::Options SolverOptions(int max_iterations, double function_tolerance) {
+  ceres::Solver::Options o;
+  o.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  o.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  o.max_num_iterations = max_iterations;
+  o.function_tolerance = function_tolerance;
+  o.gradient_tolerance = 1e-12;
+  o.parameter_tolerance = 1e-10;
+  o.num_threads = 1;
+  o.logging_type = ceres::SILENT;
+  return o;
+}
+
+}  // namespace internal
+
+namespace {
+
+EstimationResult EstimateBatch(const limit_surface::Trajectory& traj, Model model, const EstimatorConfig& cfg) {
+  internal::GraphBuilder builder(traj, model, cfg);
+  const int n = static_cast<int>(builder.steps().size());
+  const auto start = std::chrono::steady_clock::now();
+  ceres::Problem problem;
+  for (int i = 0; i < n; ++i) builder.Initialize(i, INFINITY);
+  int stage_iterations = 0;
+  if (ModelHasForce(model)) {
+    // Staged start: the kinematic SDF graph first (interpolated measurements are far from
+    // satisfying D's per-step velocity directions), then the full graph from its solution.
+    internal::GraphBuilder kinematic(traj, Model::kSdf, cfg);
+    ceres::Problem pre;
+    for (int i = 0; i < n; ++i) kinematic.Initialize(i, INFINITY);
+    for (int i = 0; i < n; ++i) kinematic.AddFactors(pre, i);
+    ceres::Solver::Summary pre_summary;
+    ceres::Solve(internal::SolverOptions(cfg.max_iterations, cfg.function_tolerance), &pre, &pre_summary);
+    stage_iterations = pre_summary.num_successful_steps + pre_summary.num_unsuccessful_steps;
+    for (int i = 0; i < n; ++i) {
+      auto& dst = builder.vars()[i];
+      const auto& src = kinematic.vars()[i];
+      std::copy(src.x, src.x + 3, dst.x);
+      std::copy(src.e, src.e + 3, dst.e);
+      std::copy(src.p, src.p + 2, dst.p);
+    }
+  }
+  for (int i = 0; i < n; ++i) builder.AddFactors(problem, i);
+  ceres::Solver::Summary summary;
+  ceres::Solve(internal::SolverOptions(cfg.max_iterations, cfg.function_tolerance), &problem, &summary);
+  if (summary.termination_type == ceres::FAILURE) {
+    throw GraphError("batch solve failed: " + summary.message);
+  }
+  EstimationResult r;
+  r.model = model;
+  r.mode = Mode::kBatch;
+  std::vector<int> idx(n);
+  for (int i = 0; i < n; ++i) {
+    idx[i] = i;
+    r.states.push_back(builder.State(i));
+  }
+  if (cfg.covariance) r.solver.covariance_status = internal::ComputeCovariances(problem, builder, idx, r.states);
+  r.solver.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  r.solver.iterations = stage_iterations + summary.num_successful_steps + summary.num_unsuccessful_steps;
+  r.solver.final_cost = summary.final_cost;
+  r.solver.updates = 1;
+  r.solver.max_update_time_s = r.solver.mean_update_time_s = r.solver.time_s;
+  r.metrics = ComputeMetrics(traj, r.states);
+  return r;
+}
+
+// Ground-truth helpers: interpolation only between samples at most `gap` apart.
+template <class Sample, class Get>
+bool GroundTruthAt(const std::vector<Sample>& s, double t, double gap, Get get, decltype(get(s[0]))* out) {
+  if (s.empty() || t < s.front().t - 1e-9 || t > s.back().t + 1e-9) return false;
+  auto it = std::lower_bound(s.begin(), s.end(), t - 1e-9, [](const Sample& a, double tt) { return a.t < tt; });
+  if (it == s.end()) it = s.end() - 1;
+  if (std::abs(it->t - t) <= 1e-9) { *out = get(*it); return true; }
+  if (it == s.begin()) return false;
+  const Sample& a = *(it - 1);
+  const Sample& b = *it;
+  if (b.t - a.t > gap) return false;
+  const double w = (t - a.t) / (b.t - a.t);
+  *out = get(a) + w * (get(b) - get(a));
+  return true;
+}
+
+bool GroundTruthPose(const std::vector<limit_surface::PoseSample>& s, double t, double gap, Eigen::Vector3d* out) {
+  if (!GroundTruthAt(s, t, gap, [](const limit_surface::PoseSample& a) { return Eigen::Vector3d(a.pose.vector()); }, out)) {
+    return false;
+  }
+  return true;
+}
+
+struct Accumulator {
+  double sum = 0.0;
+  int n = 0;
+  void Add(double sq) { sum += sq; ++n; }
+  void Put(std::map<std::string, double>& m, const std::string& key, bool rms = true) const {
+    if (n > 0) m[key] = rms ? std::sqrt(sum / n) : sum / n;
+  }
+};
+
+}  // namespace
+
+std::map<std::string, double> ComputeMetrics(const limit_surface::Trajectory& traj,
+                                             const std::vector<StateEstimate>& states) {
+  std::map<std::string, double> m;
+  if (!traj.ground_truth) return m;
+  const auto& gt = *traj.ground_truth;
+  const double gap = 0.1;
+  Accumulator op, orot, fp, frot, cp, fo, nees_o, nees_f, nees_c, nees_force;
+  auto pose_err = [](const Pose2& est, const Eigen::Vector3d& g) {
+    return Eigen::Vector3d(est.x - g.x(), est.y - g.y(), geometry::WrapAngle(est.theta - g.z()));
+  };
+  // Gauge-free NEES: covariance matrices here are well conditioned, LDLT is enough.
+  auto nees = [](const auto& e, const auto& cov) { return e.dot(cov.ldlt().solve(e)); };
+  for (const StateEstimate& s : states) {
+    Eigen::Vector3d g;
+    if (GroundTruthPose(gt.object_pose, s.t, gap, &g)) {
+      const Eigen::Vector3d e = pose_err(s.object_pose, g);
+      op.Add(e.head<2>().squaredNorm());
+      orot.Add(e.z() * e.z());
+      if (s.object_pose_cov) nees_o.Add(nees(e, *s.object_pose_cov));
+    }
+    if (GroundTruthPose(gt.finger_pose, s.t, gap, &g)) {
+      const Eigen::Vector3d e = pose_err(s.finger_pose, g);
+      fp.Add(e.head<2>().squaredNorm());
+      frot.Add(e.z() * e.z());
+      if (s.finger_pose_cov) nees_f.Add(nees(e, *s.finger_pose_cov));
+    }
+    Vec2 v;
+    if (s.contact && GroundTruthAt(gt.contact_point, s.t, gap, [](const limit_surface::PointSample& a) { return Vec2(a.point); }, &v)) {
+      const Vec2 e = *s.contact - v;
+      cp.Add(e.squaredNorm());
+      if (s.contact_cov) nees_c.Add(nees(e, *s.contact_cov));
+    }
+    if (s.force && GroundTruthAt(gt.force, s.t, gap, [](const limit_surface::ForceSample& a) { return Vec2(a.force); }, &v)) {
+      const Vec2 e = *s.force - v;
+      fo.Add(e.squaredNorm());
+      if (s.force_cov) nees_force.Add(nees(e, *s.force_cov));
+    }
+  }
+  op.Put(m, "object_position_rms");
+  orot.Put(m, "object_rotation_rms");
+  fp.Put(m, "finger_position_rms");
+  frot.Put(m, "finger_rotation_rms");
+  cp.Put(m, "contact_rms");
+  fo.Put(m, "force_rms");
+  nees_o.Put(m, "object_pose_nees", false);
+  nees_f.Put(m, "finger_pose_nees", false);
+  nees_c.Put(m, "contact_nees", false);
+  nees_force.Put(m, "force_nees", false);
+  // The raw measurements against the same ground truth.
+  Accumulator mop, morot, mfp, mfrot, mcp, mfo;
+  const auto& meas = traj.measured;
+  for (const auto& s : meas.object_pose) {
+    Eigen::Vector3d g;
+    if (GroundTruthPose(gt.object_pose, s.t, gap, &g)) {
+      const Eigen::Vector3d e = pose_err(s.pose, g);
+      mop.Add(e.head<2>().squaredNorm());
+      morot.Add(e.z() * e.z());
+    }
+  }
+  for (const auto& s : meas.finger_pose) {
+    Eigen::Vector3d g;
+    if (GroundTruthPose(gt.finger_pose, s.t, gap, &g)) {
+      const Eigen::Vector3d e = pose_err(s.pose, g);
+      mfp.Add(e.head<2>().squaredNorm());
+      mfrot.Add(e.z() * e.z());
+    }
+  }
+  for (const auto& s : meas.contact_point) {
+    Vec2 v;
+    if (GroundTruthAt(gt.contact_point, s.t, gap, [](const limit_surface::PointSample& a) { return Vec2(a.point); }, &v)) {
+      mcp.Add((s.point - v).squaredNorm());
+    }
+  }
+  for (const auto& s : meas.force) {
+    Vec2 v;
+    if (GroundTruthAt(gt.force, s.t, gap, [](const limit_surface::ForceSample& a) { return Vec2(a.force); }, &v)) {
+      mfo.Add((s.force - v).squaredNorm());
+    }
+  }
+  mop.Put(m, "measured_object_position_rms");
+  morot.Put(m, "measured_object_rotation_rms");
+  mfp.Put(m, "measured_finger_position_rms");
+  mfrot.Put(m, "measured_finger_rotation_rms");
+  mcp.Put(m, "measured_contact_rms");
+  mfo.Put(m, "measured_force_rms");
+  return m;
+}
+
+EstimationResult Estimate(const limit_surface::Trajectory& trajectory, Model model, Mode mode,
+                          const EstimatorConfig& config) {
+  if (mode == Mode::kBatch) return EstimateBatch(trajectory, model, config);
+  IncrementalEstimator inc(trajectory, model, config);
+  while (!inc.Done()) inc.Update();
+  return inc.Finish();
+}
+
+}  // namespace pushgraph::graph

@@ -1,0 +1,379 @@
+#include <pushgraph/graph/factors.h>
+
+#include <pushgraph/geometry/point_query.h>
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <exception>
+#include <utility>
+
+namespace pushgraph::graph {
+namespace {
+
+using RowMat33 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+using RowMat32 = Eigen::Matrix<double, 3, 2, Eigen::RowMajor>;
+using RowMat23 = Eigen::Matrix<double, 2, 3, Eigen::RowMajor>;
+using RowMat22 = Eigen::Matrix<double, 2, 2, Eigen::RowMajor>;
+
+double CheckedWeight(double sigma, const char* what) {
+  if (!(sigma > 0.0) || !std::isfinite(sigma)) {
+    throw GraphError(std::string("factor sigma '") + what + "' must be finite and > 0, got " +
+                     std::to_string(sigma));
+  }
+  return 1.0 / sigma;
+}
+
+Pose2 PoseFrom(const double* v) { return {v[0], v[1], v[2]}; }
+
+Eigen::Matrix3d Skew(const Eigen::Vector3d& a) {
+  Eigen::Matrix3d S;
+  S << 0.0, -a.z(), a.y(), a.z(), 0.0, -a.x(), -a.y(), a.x(), 0.0;
+  return S;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------- M
+PoseMeasurementFactor::PoseMeasurementFactor(const Pose2& measured, double sigma_trans,
+                                             double sigma_rot)
+    : measured_(measured),
+      w_(CheckedWeight(sigma_trans, "pose translation"), CheckedWeight(sigma_trans, "pose translation"),
+         CheckedWeight(sigma_rot, "pose rotation")) {}
+
+bool PoseMeasurementFactor::Evaluate(double const* const* parameters, double* residuals,
+                                     double** jacobians) const {
+  Eigen::Matrix3d J_d_est, J_log_d;
+  const Pose2 d = geometry::Between(measured_, PoseFrom(parameters[0]), nullptr, &J_d_est);
+  const Eigen::Vector3d log = geometry::Log(d, &J_log_d);
+  Eigen::Map<Eigen::Vector3d>{residuals} = w_.asDiagonal() * log;
+  if (jacobians != nullptr && jacobians[0] != nullptr) {
+    Eigen::Map<RowMat33>{jacobians[0]} = w_.asDiagonal() * (J_log_d * J_d_est);
+  }
+  return true;
+}
+
+VectorMeasurementFactor::VectorMeasurementFactor(const Vec2& measured, double sigma)
+    : measured_(measured), w_(CheckedWeight(sigma, "point/force measurement")) {}
+
+bool VectorMeasurementFactor::Evaluate(double const* const* parameters, double* residuals,
+                                       double** jacobians) const {
+  Eigen::Map<Eigen::Vector2d>{residuals} =
+      w_ * (Eigen::Map<const Eigen::Vector2d>(parameters[0]) - measured_);
+  if (jacobians != nullptr && jacobians[0] != nullptr) {
+    Eigen::Map<RowMat22>{jacobians[0]} = w_ * Eigen::Matrix2d::Identity();
+  }
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------- C
+BoundaryPointFactor::BoundaryPointFactor(geometry::Shape shape, double sigma)
+    : shape_(std::move(shape)), w_(CheckedWeight(sigma, "contact on boundary")) {
+  if (shape_.empty()) throw GraphError("BoundaryPointFactor: empty shape");
+}
+
+bool BoundaryPointFactor::Evaluate(double const* const* parameters, double* residuals,
+                                   double** jacobians) const {
+  const Vec2 p(parameters[1][0], parameters[1][1]);
+  geometry::PointQueryJacobians J;
+  geometry::PointQuery q;
+  try {
+    q = geometry::QueryPoint(shape_, PoseFrom(parameters[0]), p, &J);
+  } catch (const std::exception&) {
+    return false;  // non-finite parameters: let the solver reject the step
+  }
+  Eigen::Map<Eigen::Vector2d>{residuals} = w_ * (p - q.closest_point);
+  if (jacobians != nullptr) {
+    if (jacobians[0] != nullptr) Eigen::Map<RowMat23>{jacobians[0]} = -w_ * J.J_closest_pose;
+    if (jacobians[1] != nullptr) {
+      Eigen::Map<RowMat22>{jacobians[1]} = w_ * (Eigen::Matrix2d::Identity() - J.J_closest_point);
+    }
+  }
+  return true;
+}
+
+// Object pose in parameters[0], finger pose in parameters[1]. A geometry error (non-finite
+// poses during a bad step) makes Ceres reject the step rather than abort the solve.
+static bool QueryPair(const geometry::ShapePairQuerier& querier, double const* const* parameters,
+               geometry::ShapePairResult* r, geometry::ShapePairJacobians* J) {
+  try {
+    *r = querier.Query(PoseFrom(parameters[0]), PoseFrom(parameters[1]), J);
+  } catch (const std::exception&) {
+    return false;
+  }
+  return true;
+}
+
+TouchingFactor::TouchingFactor(std::shared_ptr<const geometry::ShapePairQuerier> querier,
+                               double sigma)
+    : querier_(std::move(querier)), w_(CheckedWeight(sigma, "touching")) {
+  if (!querier_) throw GraphError("TouchingFactor: null shape-pair querier");
+}
+
+bool TouchingFactor::Evaluate(double const* const* parameters, double* residuals,
+                              double** jacobians) const {
+  geometry::ShapePairJacobians J;
+  geometry::ShapePairResult r;
+  if (!QueryPair(*querier_, parameters, &r, &J)) return false;
+  residuals[0] = w_ * r.signed_distance;
+  if (jacobians != nullptr) {
+    if (jacobians[0] != nullptr) Eigen::Map<Eigen::RowVector3d>{jacobians[0]} = w_ * J.J_sd_object_pose;
+    if (jacobians[1] != nullptr) Eigen::Map<Eigen::RowVector3d>{jacobians[1]} = w_ * J.J_sd_finger_pose;
+  }
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------- S
+IntersectionFactor::IntersectionFactor(std::shared_ptr<const geometry::ShapePairQuerier> querier,
+                                       double sigma)
+    : querier_(std::move(querier)), w_(CheckedWeight(sigma, "intersection")) {
+  if (!querier_) throw GraphError("IntersectionFactor: null shape-pair querier");
+}
+
+bool IntersectionFactor::Evaluate(double const* const* parameters, double* residuals,
+                                  double** jacobians) const {
+  geometry::ShapePairJacobians J;
+  geometry::ShapePairResult r;
+  if (!QueryPair(*querier_, parameters, &r, &J)) return false;
+  Eigen::Map<Eigen::Vector2d> res(residuals);
+  if (!r.intersecting) {
+    res.setZero();
+    if (jacobians != nullptr) {
+      if (jacobians[0] != nullptr) Eigen::Map<RowMat23>{jacobians[0]}.setZero();
+      if (jacobians[1] != nullptr) Eigen::Map<RowMat23>{jacobians[1]}.setZero();
+    }
+    return true;
+  }
+  res = w_ * (r.object_point - r.finger_point);  // G_delta - delta
+  if (jacobians != nullptr) {
+    if (jacobians[0] != nullptr) {
+      Eigen::Map<RowMat23>{jacobians[0]} =
+          w_ * (J.J_object_point_object_pose - J.J_finger_point_object_pose);
+    }
+    if (jacobians[1] != nullptr) {
+      Eigen::Map<RowMat23>{jacobians[1]} =
+          w_ * (J.J_object_point_finger_pose - J.J_finger_point_finger_pose);
+    }
+  }
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------- V
+double ConstantVelocitySigma(double q, double dt1, double dt2) {
+  return q * std::sqrt(0.5 * (dt1 + dt2));
+}
+
+ConstantVelocityFactor::ConstantVelocityFactor(double dt1, double dt2, double sigma_trans,
+                                               double sigma_rot)
+    : dt1_(dt1),
+      dt2_(dt2),
+      w_(CheckedWeight(sigma_trans, "velocity translation"),
+         CheckedWeight(sigma_trans, "velocity translation"), CheckedWeight(sigma_rot, "velocity rotation")) {
+  if (!(dt1 > 0.0) || !(dt2 > 0.0) || !std::isfinite(dt1) || !std::isfinite(dt2)) {
+    throw GraphError("ConstantVelocityFactor: time steps must be finite and > 0, got " +
+                     std::to_string(dt1) + ", " + std::to_string(dt2));
+  }
+}
+
+bool ConstantVelocityFactor::Evaluate(double const* const* parameters, double* residuals,
+                                      double** jacobians) const {
+  const Pose2 a = PoseFrom(parameters[0]), b = PoseFrom(parameters[1]), c = PoseFrom(parameters[2]);
+  Eigen::Matrix3d J_d1_a, J_d1_b, J_d2_b, J_d2_c, J_l1_d1, J_l2_d2;
+  const Eigen::Vector3d l1 = geometry::Log(geometry::Between(a, b, &J_d1_a, &J_d1_b), &J_l1_d1);
+  const Eigen::Vector3d l2 = geometry::Log(geometry::Between(b, c, &J_d2_b, &J_d2_c), &J_l2_d2);
+  Eigen::Map<Eigen::Vector3d>{residuals} = w_.asDiagonal() * (l1 / dt1_ - l2 / dt2_);
+  if (jacobians != nullptr) {
+    const auto W = w_.asDiagonal();
+    if (jacobians[0] != nullptr) Eigen::Map<RowMat33>{jacobians[0]} = W * (J_l1_d1 * J_d1_a / dt1_);
+    if (jacobians[1] != nullptr) {
+      Eigen::Map<RowMat33>{jacobians[1]} = W * (J_l1_d1 * J_d1_b / dt1_ - J_l2_d2 * J_d2_b / dt2_);
+    }
+    if (jacobians[2] != nullptr) Eigen::Map<RowMat33>{jacobians[2]} = W * (-J_l2_d2 * J_d2_c / dt2_);
+  }
+  return true;
+}
+
+RandomWalkFactor::RandomWalkFactor(double dt, double q_trans, double q_rot) {
+  if (!(dt > 0.0) || !std::isfinite(dt)) {
+    throw GraphError("RandomWalkFactor: time step must be finite and > 0, got " + std::to_string(dt));
+  }
+  const double st = CheckedWeight(q_trans, "random walk translation");
+  const double sr = CheckedWeight(q_rot, "random walk rotation");
+  const double s = 1.0 / std::sqrt(dt);
+  w_ = Eigen::Vector3d(st * s, st * s, sr * s);
+}
+
+bool RandomWalkFactor::Evaluate(double const* const* parameters, double* residuals,
+                                double** jacobians) const {
+  Eigen::Matrix3d J_d_a, J_d_b, J_l_d;
+  const Eigen::Vector3d l = geometry::Log(
+      geometry::Between(PoseFrom(parameters[0]), PoseFrom(parameters[1]), &J_d_a, &J_d_b), &J_l_d);
+  Eigen::Map<Eigen::Vector3d>{residuals} = w_.asDiagonal() * l;
+  if (jacobians != nullptr) {
+    if (jacobians[0] != nullptr) Eigen::Map<RowMat33>{jacobians[0]} = w_.asDiagonal() * (J_l_d * J_d_a);
+    if (jacobians[1] != nullptr) Eigen::Map<RowMat33>{jacobians[1]} = w_.asDiagonal() * (J_l_d * J_d_b);
+  }
+  return true;
+}
+
+VectorRandomWalkFactor::VectorRandomWalkFactor(double dt, double q) {
+  if (!(dt > 0.0) || !std::isfinite(dt)) {
+    throw GraphError("VectorRandomWalkFactor: time step must be finite and > 0, got " + std::to_string(dt));
+  }
+  w_ = CheckedWeight(q, "vector random walk") / std::sqrt(dt);
+}
+
+bool VectorRandomWalkFactor::Evaluate(double const* const* parameters, double* residuals,
+                                      double** jacobians) const {
+  Eigen::Map<Eigen::Vector2d>{residuals} =
+      w_ * (Eigen::Map<const Eigen::Vector2d>(parameters[1]) - Eigen::Map<const Eigen::Vector2d>(parameters[0]));
+  if (jacobians != nullptr) {
+    if (jacobians[0] != nullptr) Eigen::Map<RowMat22>{jacobians[0]} = -w_ * Eigen::Matrix2d::Identity();
+    if (jacobians[1] != nullptr) Eigen::Map<RowMat22>{jacobians[1]} = w_ * Eigen::Matrix2d::Identity();
+  }
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------- D
+QuasiStaticTerms ComputeQuasiStaticTerms(const QuasiStaticGeometry& geo, const Pose2& x_prev,
+                                         const Pose2& x, const Vec2& p, const Vec2& f) {
+  QuasiStaticTerms t;
+  // Body twist of the frame origin, then of the centre of pressure r: v + omega z x r.
+  Eigen::Matrix3d J_d_xprev, J_d_x, J_l_d;
+  const Eigen::Vector3d xi =
+      geometry::Log(geometry::Between(x_prev, x, &J_d_xprev, &J_d_x), &J_l_d) / geo.dt;
+  const Vec2& r = geo.centre_of_pressure;
+  Eigen::Matrix3d A;
+  A << 1.0, 0.0, -r.y(), 0.0, 1.0, r.x(), 0.0, 0.0, geo.c;
+  t.V = A * xi;
+  const Eigen::Matrix3d J_V_l = A / geo.dt;
+  t.J_V_xprev = J_V_l * J_l_d * J_d_xprev;
+  t.J_V_x = J_V_l * J_l_d * J_d_x;
+
+  // Load in the object frame: f_b = R^T f, moment arm q = x^-1 p - r, tau = q x f_b.
+  const double cs = std::cos(x.theta), sn = std::sin(x.theta);
+  Eigen::Matrix2d Rt;
+  Rt << cs, sn, -sn, cs;
+  const Vec2 fb = Rt * f;
+  Eigen::Matrix<double, 2, 3> J_fb_x = Eigen::Matrix<double, 2, 3>::Zero();
+  J_fb_x(0, 2) = fb.y();
+  J_fb_x(1, 2) = -fb.x();
+  Eigen::Matrix<double, 2, 3> J_q_x;
+  Eigen::Matrix2d J_q_p;
+  const Vec2 q = geometry::InverseAct(x, p, &J_q_x, &J_q_p) - r;
+  const double tau = q.x() * fb.y() - q.y() * fb.x();
+  const Eigen::RowVector2d J_tau_q(fb.y(), -fb.x());
+  const Eigen::RowVector2d J_tau_fb(-q.y(), q.x());
+  t.g << fb.x(), fb.y(), tau / geo.c;
+  t.J_g_x.topRows<2>() = J_fb_x;
+  t.J_g_x.row(2) = (J_tau_q * J_q_x + J_tau_fb * J_fb_x) / geo.c;
+  t.J_g_p.topRows<2>().setZero();
+  t.J_g_p.row(2) = J_tau_q * J_q_p / geo.c;
+  t.J_g_f.topRows<2>() = Rt;
+  t.J_g_f.row(2) = J_tau_fb * Rt / geo.c;
+  return t;
+}
+
+namespace {
+void CheckGeometry(const QuasiStaticGeometry& g) {
+  if (!(g.c > 0.0) || !std::isfinite(g.c)) throw GraphError("quasi-static factor: c must be finite and > 0");
+  if (!(g.dt > 0.0) || !std::isfinite(g.dt)) {
+    throw GraphError("quasi-static factor: dt must be finite and > 0, got " + std::to_string(g.dt));
+  }
+  if (!g.centre_of_pressure.allFinite()) throw GraphError("quasi-static factor: non-finite centre of pressure");
+}
+}  // namespace
+
+QuasiStaticFactor::QuasiStaticFactor(const QuasiStaticGeometry& geometry, double eps_velocity,
+                                     double eps_force, double sigma)
+    : geometry_(geometry),
+      eps_v_(eps_velocity),
+      eps_f_(eps_force),
+      w_(CheckedWeight(sigma, "quasi-static")) {
+  CheckGeometry(geometry_);
+  if (!(eps_v_ > 0.0) || !(eps_f_ > 0.0)) {
+    throw GraphError("quasi-static factor: eps_velocity and eps_force must be > 0");
+  }
+}
+
+bool QuasiStaticFactor::Evaluate(double const* const* parameters, double* residuals,
+                                 double** jacobians) const {
+  const QuasiStaticTerms t = ComputeQuasiStaticTerms(
+      geometry_, PoseFrom(parameters[0]), PoseFrom(parameters[1]),
+      Vec2(parameters[2][0], parameters[2][1]), Vec2(parameters[3][0], parameters[3][1]));
+  const Eigen::Vector3d u = t.V.cross(t.g);
+  const double a = std::sqrt(t.V.squaredNorm() + eps_v_ * eps_v_);
+  const double b = std::sqrt(t.g.squaredNorm() + eps_f_ * eps_f_);
+  const double s = w_ / (a * b);
+  Eigen::Map<Eigen::Vector3d>{residuals} = s * u;
+  if (jacobians == nullptr) return true;
+  // r = w u / (a b):  dr/dV = w (-[g]x / (a b) - u V^T / (a^3 b)),
+  //                   dr/dg = w ( [V]x / (a b) - u g^T / (a b^3)).
+  const Eigen::Matrix3d J_r_V = s * (-Skew(t.g) - u * t.V.transpose() / (a * a));
+  const Eigen::Matrix3d J_r_g = s * (Skew(t.V) - u * t.g.transpose() / (b * b));
+  if (jacobians[0] != nullptr) Eigen::Map<RowMat33>{jacobians[0]} = J_r_V * t.J_V_xprev;
+  if (jacobians[1] != nullptr) Eigen::Map<RowMat33>{jacobians[1]} = J_r_V * t.J_V_x + J_r_g * t.J_g_x;
+  if (jacobians[2] != nullptr) Eigen::Map<RowMat32>{jacobians[2]} = J_r_g * t.J_g_p;
+  if (jacobians[3] != nullptr) Eigen::Map<RowMat32>{jacobians[3]} = J_r_g * t.J_g_f;
+  return true;
+}
+
+LimitSurfaceLoadFactor::LimitSurfaceLoadFactor(const QuasiStaticGeometry& geometry, double f_max,
+                                               double eps_velocity, double eps_force, double sigma)
+    : geometry_(geometry), f_max_(f_max), eps_v_(eps_velocity), eps_f_(eps_force),
+      w_(CheckedWeight(sigma, "limit-surface load")) {
+  CheckGeometry(geometry_);
+  if (!(f_max > 0.0) || !std::isfinite(f_max)) throw GraphError("limit-surface load factor: f_max must be > 0");
+  if (!(eps_v_ > 0.0) || !(eps_f_ > 0.0)) throw GraphError("limit-surface load factor: eps must be > 0");
+}
+
+bool LimitSurfaceLoadFactor::Evaluate(double const* const* parameters, double* residuals,
+                                      double** jacobians) const {
+  const QuasiStaticTerms t = ComputeQuasiStaticTerms(
+      geometry_, PoseFrom(parameters[0]), PoseFrom(parameters[1]),
+      Vec2(parameters[2][0], parameters[2][1]), Vec2(parameters[3][0], parameters[3][1]));
+  const double v2 = t.V.squaredNorm(), e2 = eps_v_ * eps_v_;
+  const double sv = v2 / (v2 + e2);
+  const double b = std::sqrt(t.g.squaredNorm() + eps_f_ * eps_f_);
+  const double k = w_ / f_max_;
+  residuals[0] = k * sv * (b - f_max_);
+  if (jacobians == nullptr) return true;
+  // ds_v/dV' = 2 eps^2 V'^T / (|V'|^2 + eps^2)^2;  d b / d g' = g'^T / b.
+  const Eigen::RowVector3d J_r_V = k * (b - f_max_) * 2.0 * e2 * t.V.transpose() / ((v2 + e2) * (v2 + e2));
+  const Eigen::RowVector3d J_r_g = k * sv * t.g.transpose() / b;
+  if (jacobians[0] != nullptr) Eigen::Map<Eigen::RowVector3d>{jacobians[0]} = J_r_V * t.J_V_xprev;
+  if (jacobians[1] != nullptr) Eigen::Map<Eigen::RowVector3d>{jacobians[1]} = J_r_V * t.J_V_x + J_r_g * t.J_g_x;
+  if (jacobians[2] != nullptr) Eigen::Map<Eigen::RowVector2d>{jacobians[2]} = J_r_g * t.J_g_p;
+  if (jacobians[3] != nullptr) Eigen::Map<Eigen::RowVector2d>{jacobians[3]} = J_r_g * t.J_g_f;
+  return true;
+}
+
+CrossMultipliedQuasiStaticFactor::CrossMultipliedQuasiStaticFactor(
+    const QuasiStaticGeometry& geometry, double sigma)
+    : geometry_(geometry), w_(CheckedWeight(sigma, "cross-multiplied quasi-static")) {
+  CheckGeometry(geometry_);
+}
+
+bool CrossMultipliedQuasiStaticFactor::Evaluate(double const* const* parameters,
+                                                double* residuals, double** jacobians) const {
+  const QuasiStaticTerms t = ComputeQuasiStaticTerms(
+      geometry_, PoseFrom(parameters[0]), PoseFrom(parameters[1]),
+      Vec2(parameters[2][0], parameters[2][1]), Vec2(parameters[3][0], parameters[3][1]));
+  // v_x tau - c^2 f_x omega = c (V_x g_z - V_z g_x);  v_y tau - c^2 f_y omega = c (V_y g_z - V_z g_y).
+  const double k = w_ * geometry_.c;
+  Eigen::Map<Eigen::Vector2d> res(residuals);
+  res << k * (t.V.x() * t.g.z() - t.V.z() * t.g.x()), k * (t.V.y() * t.g.z() - t.V.z() * t.g.y());
+  if (jacobians == nullptr) return true;
+  Eigen::Matrix<double, 2, 3> J_r_V, J_r_g;
+  J_r_V << t.g.z(), 0.0, -t.g.x(), 0.0, t.g.z(), -t.g.y();
+  J_r_g << -t.V.z(), 0.0, t.V.x(), 0.0, -t.V.z(), t.V.y();
+  J_r_V *= k;
+  J_r_g *= k;
+  if (jacobians[0] != nullptr) Eigen::Map<RowMat23>{jacobians[0]} = J_r_V * t.J_V_xprev;
+  if (jacobians[1] != nullptr) Eigen::Map<RowMat23>{jacobians[1]} = J_r_V * t.J_V_x + J_r_g * t.J_g_x;
+  if (jacobians[2] != nullptr) Eigen::Map<RowMat22>{jacobians[2]} = J_r_g * t.J_g_p;
+  if (jacobians[3] != nullptr) Eigen::Map<RowMat22>{jacobians[3]} = J_r_g * t.J_g_f;
+  return true;
+}
+
+}  // namespace pushgraph::graph

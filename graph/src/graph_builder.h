@@ -1,0 +1,74 @@
+#pragma once
+// Internal: steps, variables and factor assembly shared by the batch and incremental solvers.
+#include <pushgraph/graph/estimator.h>
+
+#include <ceres/ceres.h>
+
+#include <memory>
+#include <vector>
+
+namespace pushgraph::graph::internal {
+
+/// One estimation step: a time stamp and the index of the measurement of each stream taken at
+/// that time (-1 when the step has none).
+struct Step {
+  double t = 0.0;
+  int object = -1, finger = -1, contact = -1, force = -1;
+  bool in_contact = false;
+};
+
+/// Parameter blocks of one step (addresses stay fixed: Ceres keeps pointers to them).
+struct StepVars {
+  double x[3] = {0, 0, 0};
+  double e[3] = {0, 0, 0};
+  double p[2] = {0, 0};
+  double f[2] = {0, 0};
+};
+
+class GraphBuilder {
+ public:
+  GraphBuilder(const limit_surface::Trajectory& trajectory, Model model, const EstimatorConfig& config);
+
+  const std::vector<Step>& steps() const { return steps_; }
+  std::vector<StepVars>& vars() { return vars_; }
+  const std::vector<StepVars>& vars() const { return vars_; }
+  Model model() const { return model_; }
+  bool HasContactVars(int i) const { return steps_[i].in_contact; }
+  bool HasForceVars(int i) const { return steps_[i].in_contact && ModelHasForce(model_); }
+
+  /// Initial values of step i from the measurements with time stamps <= limit (interpolated;
+  /// the newest held). limit = INFINITY in batch; the update time in incremental mode.
+  void Initialize(int i, double limit);
+  /// Parts of a step's factors: kinematic (M of poses and contact, C, S, V, random walk) and
+  /// dynamic (force variable, its M and prior, D, the limit-surface load).
+  static constexpr int kKinematic = 1, kDynamic = 2, kAll = 3;
+  /// Adds the factors whose newest step is i (steps i-2, i-1 must already be in the problem).
+  void AddFactors(ceres::Problem& problem, int i, int parts = kAll);
+  /// Parameter blocks of step i present in the problem.
+  std::vector<double*> Blocks(int i);
+  /// The estimate of step i (no covariances).
+  StateEstimate State(int i) const;
+
+ private:
+  ceres::LossFunction* MakeLoss(const LossConfig& loss) const;
+  void AddKinematicFactors(ceres::Problem& problem, int i);
+  void AddDynamicFactors(ceres::Problem& problem, int i);
+
+  const limit_surface::Trajectory& traj_;
+  Model model_;
+  EstimatorConfig cfg_;
+  std::vector<Step> steps_;
+  std::vector<StepVars> vars_;
+  std::shared_ptr<const geometry::ShapePairQuerier> querier_;
+  QuasiStaticGeometry qs_;
+  double f_max_ = 0.0;  ///< mu m g; 0 when the trajectory lacks mass or friction
+};
+
+/// Fills the covariances of `states` (indices `steps` into builder steps) with ceres::Covariance
+/// over `problem`; returns a status string ("ok" or the reason of failure).
+std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder,
+                               const std::vector<int>& steps, std::vector<StateEstimate>& states);
+
+ceres::Solver::Options SolverOptions(int max_iterations, double function_tolerance);
+
+}  // namespace pushgraph::graph::internal

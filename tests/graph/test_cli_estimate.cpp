@@ -1,0 +1,118 @@
+// `pushgraph estimate`: RESULT.json layout (the issue's format) for every model and both modes,
+// and one-line errors for bad input.
+#include <pushgraph/io/result_json.h>
+#include <pushgraph/io/trajectory_json.h>
+
+#include "graph/push_generator.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace pushgraph::graph {
+namespace {
+
+struct ToolRun {
+  int status;
+  std::string err;
+};
+
+const std::string kDir = ::testing::TempDir();
+
+ToolRun Tool(const std::string& args) {
+  const std::string err_path = kDir + "/estimate_stderr.txt";
+  const std::string cmd = std::string(PUSHGRAPH_TOOL) + " " + args + " > /dev/null 2> " + err_path;
+  const int rc = std::system(cmd.c_str());
+  std::ifstream in(err_path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, ss.str()};
+}
+
+nlohmann::json Load(const std::string& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+std::string WritePush() {
+  testing::PushSpec s;
+  s.contact_offset = 0.015;
+  s.duration = 0.6;
+  const std::string path = kDir + "/estimate_push.json";
+  io::SaveTrajectoryJson(testing::GeneratePush(s), path);
+  return path;
+}
+
+TEST(EstimateCli, WritesTheResultFormatForEveryModelAndMode) {
+  const std::string in = WritePush();
+  for (const std::string model : {"cp", "sdf", "qs", "yu"}) {
+    for (const std::string mode : {"batch", "incremental"}) {
+      const std::string out = kDir + "/result_" + model + "_" + mode + ".json";
+      const ToolRun r = Tool("estimate " + in + " --model " + model + " --mode " + mode + " -o " + out);
+      ASSERT_EQ(r.status, 0) << r.err;
+      const nlohmann::json j = Load(out);
+      EXPECT_EQ(j["model"], model);
+      EXPECT_EQ(j["mode"], mode);
+      ASSERT_EQ(j["states"].size(), 151u);  // 0.6 s on the 250 Hz clock
+      const auto& s = j["states"][75];
+      EXPECT_DOUBLE_EQ(s["t"].get<double>(), 0.3);
+      EXPECT_EQ(s["object_pose"].size(), 3u);
+      EXPECT_EQ(s["finger_pose"].size(), 3u);
+      EXPECT_EQ(s["contact"].size(), 2u);
+      EXPECT_EQ(s["object_pose_cov"].size(), 3u);
+      EXPECT_EQ(s["object_pose_cov"][0].size(), 3u);
+      EXPECT_EQ(s["contact_cov"].size(), 2u);
+      const bool forces = model == "qs" || model == "yu";
+      EXPECT_EQ(s.contains("force"), forces);
+      EXPECT_EQ(s.contains("force_cov"), forces);
+      EXPECT_GT(j["solver"]["iterations"].get<int>(), 0);
+      EXPECT_GE(j["solver"]["time_s"].get<double>(), 0.0);
+      EXPECT_GE(j["solver"]["final_cost"].get<double>(), 0.0);
+      EXPECT_LT(j["metrics"]["object_position_rms"].get<double>(), j["metrics"]["measured_object_position_rms"].get<double>());
+    }
+  }
+}
+
+TEST(EstimateCli, ConfigFileIsApplied) {
+  const std::string in = WritePush();
+  const std::string cfg = kDir + "/estimate_cfg.json";
+  std::ofstream(cfg) << R"({"covariance": false, "losses": {"force": {"type": "cauchy", "scale": 2}}})";
+  const std::string out = kDir + "/result_cfg.json";
+  ASSERT_EQ(Tool("estimate " + in + " --model qs -o " + out + " --config " + cfg).status, 0);
+  EXPECT_FALSE(Load(out)["states"][10].contains("object_pose_cov"));
+}
+
+TEST(EstimateCli, BadInputGetsOneLineErrors) {
+  const std::string in = WritePush();
+  const std::string out = kDir + "/result_bad.json";
+  ToolRun r = Tool("estimate " + in + " --model qs3 -o " + out);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("unknown model 'qs3'"), std::string::npos) << r.err;
+  r = Tool("estimate " + in + " --mode online -o " + out);
+  EXPECT_NE(r.err.find("unknown mode 'online'"), std::string::npos) << r.err;
+  r = Tool("estimate /nonexistent/push.json -o " + out);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("/nonexistent/push.json"), std::string::npos) << r.err;
+  // No object measurements at all.
+  limit_surface::Trajectory t = io::LoadTrajectoryJson(in);
+  t.measured.object_pose.clear();
+  const std::string empty = kDir + "/estimate_no_object.json";
+  io::SaveTrajectoryJson(t, empty);
+  r = Tool("estimate " + empty + " -o " + out);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("no object pose measurements"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  const std::string cfg = kDir + "/estimate_bad_cfg.json";
+  std::ofstream(cfg) << R"({"window": 3})";
+  r = Tool("estimate " + in + " -o " + out + " --config " + cfg);
+  EXPECT_NE(r.err.find("'window'"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace pushgraph::graph

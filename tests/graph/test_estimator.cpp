@@ -1,0 +1,246 @@
+// Graph assembly, batch and incremental solving, recovery, consistency and occlusion on
+// simulated pushes (push_generator.h) with the paper's noise.
+#include <pushgraph/graph/estimator.h>
+#include <pushgraph/graph/incremental.h>
+
+#include <pushgraph/geometry/shape_pair.h>
+
+#include "graph/push_generator.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+namespace pushgraph::graph {
+namespace {
+
+using testing::GeneratePush;
+using testing::PushSpec;
+
+PushSpec OffsetPush(unsigned seed, double duration = 1.5) {
+  PushSpec s;
+  s.contact_offset = 0.02;
+  s.duration = duration;
+  s.seed = seed;
+  return s;
+}
+
+TEST(Estimator, ModelAndModeNames) {
+  for (Model m : {Model::kCp, Model::kSdf, Model::kQs, Model::kYu}) EXPECT_EQ(ParseModel(ModelName(m)), m);
+  EXPECT_EQ(ParseMode("incremental"), Mode::kIncremental);
+  EXPECT_THROW(ParseModel("QS2"), GraphError);
+  EXPECT_THROW(ParseMode("online"), GraphError);
+}
+
+TEST(Estimator, ConfigParsingNamesBadKeys) {
+  const EstimatorConfig c = ParseEstimatorConfig(
+      R"({"quasi_static_sigma": 0.2, "losses": {"force": {"type": "huber", "scale": 2}}, "incremental_window": 30})");
+  EXPECT_EQ(c.quasi_static_sigma, 0.2);
+  EXPECT_EQ(c.force_loss.type, LossConfig::Type::kHuber);
+  EXPECT_EQ(c.force_loss.scale, 2.0);
+  EXPECT_EQ(c.incremental_window, 30);
+  auto message = [](const std::string& text) {
+    try {
+      ParseEstimatorConfig(text, "cfg.json");
+    } catch (const GraphError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message(R"({"sigma_typo": 1})").find("sigma_typo"), std::string::npos);
+  EXPECT_NE(message(R"({"force_sigma": -1})").find("force_sigma"), std::string::npos);
+  EXPECT_NE(message(R"({"losses": {"force": {"type": "tukey"}}})").find("tukey"), std::string::npos);
+  EXPECT_NE(message(R"({"max_iterations": 2.5})").find("max_iterations"), std::string::npos);
+  EXPECT_NE(message("{").find("cfg.json"), std::string::npos);
+}
+
+TEST(Estimator, BadTrajectoriesGetClearErrors) {
+  limit_surface::Trajectory t = GeneratePush(OffsetPush(1, 0.3));
+  auto message = [](const limit_surface::Trajectory& tr) {
+    try {
+      Estimate(tr, Model::kQs, Mode::kBatch);
+    } catch (const GraphError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  auto no_object = t;
+  no_object.measured.object_pose.clear();
+  EXPECT_NE(message(no_object).find("object_pose"), std::string::npos);
+  auto nan = t;
+  nan.measured.force[3].force.x() = NAN;
+  EXPECT_NE(message(nan).find("force[3]"), std::string::npos);
+  auto no_shape = t;
+  no_shape.finger.shape = geometry::Shape();
+  EXPECT_NE(message(no_shape).find("finger.shape"), std::string::npos);
+}
+
+TEST(Estimator, StepsFollowTheInputClocks) {
+  const limit_surface::Trajectory t = GeneratePush(OffsetPush(2, 0.4));
+  EstimatorConfig cfg;
+  cfg.covariance = false;
+  const EstimationResult r = Estimate(t, Model::kCp, Mode::kBatch, cfg);
+  // Object at 25 Hz and the rest at 250 Hz share the 250 Hz clock: 101 steps over 0.4 s.
+  ASSERT_EQ(r.states.size(), 101u);
+  EXPECT_DOUBLE_EQ(r.states[10].t, 0.04);
+  for (const StateEstimate& s : r.states) {
+    EXPECT_TRUE(s.contact.has_value());
+    EXPECT_FALSE(s.force.has_value());  // CP has no force variables
+  }
+}
+
+// Recovery with the paper's noise (0.5 cm, 0.5 N): every model beats the raw measurements on
+// every quantity it estimates; the force and contact estimates too.
+TEST(Estimator, EveryModelBeatsTheRawMeasurements) {
+  const limit_surface::Trajectory t = GeneratePush(OffsetPush(3));
+  for (Model m : {Model::kCp, Model::kSdf, Model::kQs, Model::kYu}) {
+    const EstimationResult r = Estimate(t, m, Mode::kBatch);
+    const auto& x = r.metrics;
+    std::printf("[recovery] %-3s object %.2f mm (raw %.2f) %.4f rad (raw %.4f) finger %.2f mm (raw %.2f) contact %.2f mm (raw %.2f)",
+                ModelName(m).c_str(), 1e3 * x.at("object_position_rms"), 1e3 * x.at("measured_object_position_rms"),
+                x.at("object_rotation_rms"), x.at("measured_object_rotation_rms"), 1e3 * x.at("finger_position_rms"),
+                1e3 * x.at("measured_finger_position_rms"), 1e3 * x.at("contact_rms"), 1e3 * x.at("measured_contact_rms"));
+    if (x.count("force_rms")) std::printf(" force %.3f N (raw %.3f)", x.at("force_rms"), x.at("measured_force_rms"));
+    std::printf("  [%d it, %.3f s]\n", r.solver.iterations, r.solver.time_s);
+    EXPECT_EQ(r.solver.covariance_status, "ok");
+    EXPECT_LT(x.at("object_position_rms"), 0.6 * x.at("measured_object_position_rms")) << ModelName(m);
+    EXPECT_LT(x.at("object_rotation_rms"), 0.6 * x.at("measured_object_rotation_rms")) << ModelName(m);
+    EXPECT_LT(x.at("finger_position_rms"), 0.6 * x.at("measured_finger_position_rms")) << ModelName(m);
+    EXPECT_LT(x.at("contact_rms"), 0.6 * x.at("measured_contact_rms")) << ModelName(m);
+    if (m == Model::kQs) {
+      EXPECT_LT(x.at("force_rms"), 0.5 * x.at("measured_force_rms"));
+    }
+    if (m == Model::kYu) {  // no limit-surface magnitude: only the force's continuity helps
+      EXPECT_LT(x.at("force_rms"), 0.8 * x.at("measured_force_rms")) << ModelName(m);
+    }
+  }
+}
+
+// Averaged over seeds: QS beats SDF beats CP on object pose (position and rotation combined as
+// the mean of the normalized errors). Prints the table and the NEES.
+TEST(Estimator, QsBeatsSdfBeatsCpOnObjectPoseAndCovariancesAreConsistent) {
+  const int seeds = 4;
+  std::map<Model, double> pos, rot, nees;
+  for (int seed = 0; seed < seeds; ++seed) {
+    PushSpec spec = OffsetPush(100 + seed);
+    spec.contact_offset = (seed % 2 == 0 ? 1 : -1) * (0.01 + 0.01 * seed);
+    const limit_surface::Trajectory t = GeneratePush(spec);
+    for (Model m : {Model::kCp, Model::kSdf, Model::kQs, Model::kYu}) {
+      const EstimationResult r = Estimate(t, m, Mode::kBatch);
+      pos[m] += r.metrics.at("object_position_rms") / seeds;
+      rot[m] += r.metrics.at("object_rotation_rms") / seeds;
+      nees[m] += r.metrics.at("object_pose_nees") / seeds;
+    }
+  }
+  for (Model m : {Model::kCp, Model::kSdf, Model::kQs, Model::kYu}) {
+    std::printf("[ordering] %-3s object position %.3f mm, rotation %.5f rad, object-pose NEES %.2f (dim 3)\n",
+                ModelName(m).c_str(), 1e3 * pos[m], rot[m], nees[m]);
+  }
+  auto score = [&](Model m) { return pos[m] / pos[Model::kCp] + rot[m] / rot[Model::kCp]; };
+  EXPECT_LT(score(Model::kQs), score(Model::kSdf));
+  EXPECT_LE(score(Model::kSdf), score(Model::kCp) * 1.0001);
+  // Consistency: mean NEES of the object pose within a factor 3 of its dimension (the measured
+  // values, 2 to 4.5, are printed above and reported in docs/estimation.md).
+  for (Model m : {Model::kCp, Model::kSdf, Model::kQs}) {
+    EXPECT_GT(nees[m], 1.0) << ModelName(m);
+    EXPECT_LT(nees[m], 9.0) << ModelName(m);
+  }
+}
+
+// The paper's Sec. V: bimodal (mixture of two triangular) noise on contact points and forces;
+// QS still recovers both.
+TEST(Estimator, ForcesAndContactsRecoveredUnderBimodalNoise) {
+  PushSpec spec = OffsetPush(7);
+  spec.bimodal_contact_force = true;
+  spec.sigma_contact = 0.004;
+  spec.sigma_force = 0.4;
+  const limit_surface::Trajectory t = GeneratePush(spec);
+  EstimatorConfig cfg;
+  cfg.contact_sigma = 0.006;
+  cfg.force_sigma = 0.6;
+  cfg.covariance = false;
+  const EstimationResult r = Estimate(t, Model::kQs, Mode::kBatch, cfg);
+  std::printf("[bimodal] contact %.2f mm (raw %.2f), force %.3f N (raw %.3f)\n", 1e3 * r.metrics.at("contact_rms"),
+              1e3 * r.metrics.at("measured_contact_rms"), r.metrics.at("force_rms"), r.metrics.at("measured_force_rms"));
+  EXPECT_LT(r.metrics.at("contact_rms"), 0.3 * r.metrics.at("measured_contact_rms"));
+  EXPECT_LT(r.metrics.at("force_rms"), 0.45 * r.metrics.at("measured_force_rms"));
+}
+
+// Occlusion: no object measurements for the middle of the push. QS keeps the object on the
+// physical path (close to the truth, touching the finger, never penetrated).
+TEST(Estimator, OcclusionQsKeepsAPhysicalPath) {
+  PushSpec spec = OffsetPush(11, 2.0);
+  spec.occlusion_begin = 0.5;
+  spec.occlusion_end = 1.5;
+  const limit_surface::Trajectory t = GeneratePush(spec);
+  geometry::ShapePairQuerier pair(t.object.shape, t.finger.shape);
+  const auto& gt = t.ground_truth->object_pose;
+  std::map<Model, double> occluded_rms;
+  for (Model m : {Model::kCp, Model::kQs}) {
+    const EstimationResult r = Estimate(t, m, Mode::kBatch);
+    double sum = 0.0, worst_sep = 0.0;
+    int n = 0;
+    for (const StateEstimate& s : r.states) {
+      if (s.t <= 0.5 || s.t >= 1.5) continue;
+      worst_sep = std::max(worst_sep, std::abs(pair.Query(s.object_pose, s.finger_pose).signed_distance));
+      for (const auto& g : gt) {
+        if (std::abs(g.t - s.t) < 1e-9) {
+          sum += (s.object_pose.translation() - g.pose.translation()).squaredNorm();
+          ++n;
+        }
+      }
+    }
+    ASSERT_GT(n, 20);
+    occluded_rms[m] = std::sqrt(sum / n);
+    std::printf("[occlusion] %-3s object position RMS while occluded %.2f mm, worst |separation| %.3f mm\n",
+                ModelName(m).c_str(), 1e3 * occluded_rms[m], 1e3 * worst_sep);
+    // QS keeps the finger on the object's boundary; CP (p on both boundaries only, no S) lets
+    // the finger sink into the object while the object is unseen (printed, not asserted).
+    if (m == Model::kQs) {
+      EXPECT_LT(worst_sep, 1e-3);
+    }
+  }
+  EXPECT_LT(occluded_rms[Model::kQs], 0.005);
+  EXPECT_LT(occluded_rms[Model::kQs], occluded_rms[Model::kCp]);
+}
+
+// Incremental fixed-lag smoothing: the window stays bounded as the trajectory grows, and the
+// final estimate is close to the batch one.
+TEST(Incremental, BoundedWindowAndCloseToBatch) {
+  const limit_surface::Trajectory t = GeneratePush(OffsetPush(21, 3.0));
+  for (Model m : {Model::kQs, Model::kSdf}) {
+    const EstimationResult batch = Estimate(t, m, Mode::kBatch);
+    IncrementalEstimator inc(t, m);
+    int max_window = 0;
+    while (!inc.Done()) {
+      inc.Update();
+      max_window = std::max(max_window, inc.WindowSteps());
+    }
+    const EstimationResult r = inc.Finish();
+    ASSERT_EQ(r.states.size(), batch.states.size());
+    double diff = 0.0, worst = 0.0;
+    for (std::size_t i = 0; i < r.states.size(); ++i) {
+      const double d = (r.states[i].object_pose.translation() - batch.states[i].object_pose.translation()).norm();
+      diff += d * d;
+      worst = std::max(worst, d);
+      ASSERT_TRUE(r.states[i].object_pose_cov.has_value());
+    }
+    diff = std::sqrt(diff / r.states.size());
+    std::printf("[incremental] %-3s window <= %d of %zu steps, %d updates; RMS |inc - batch| %.3f mm (worst %.3f); "
+                "object RMS inc %.3f mm vs batch %.3f mm; NEES inc %.2f\n",
+                ModelName(m).c_str(), max_window, r.states.size(), r.solver.updates, 1e3 * diff, 1e3 * worst,
+                1e3 * r.metrics.at("object_position_rms"), 1e3 * batch.metrics.at("object_position_rms"),
+                r.metrics.at("object_pose_nees"));
+    // Window: incremental_window + incremental_update_every object periods of 250 Hz steps.
+    EXPECT_LE(max_window, (20 + 5) * 10 + 5);
+    // Closer to the batch estimate than either is to the truth, and as accurate.
+    EXPECT_LT(diff, batch.metrics.at("object_position_rms"));
+    EXPECT_LT(r.metrics.at("object_position_rms"), 1.5 * batch.metrics.at("object_position_rms"));
+    EXPECT_LT(r.metrics.at("object_position_rms"), 0.6 * r.metrics.at("measured_object_position_rms"));
+  }
+}
+
+}  // namespace
+}  // namespace pushgraph::graph

@@ -1,0 +1,347 @@
+// Every factor's analytic Jacobians against central differences (the geometry tests' harness,
+// with its kink detector) over many seeded random configurations, including contact at a
+// vertex, pure translation, pure rotation and near-zero rotation; plus the semantics of D.
+#include <pushgraph/graph/factors.h>
+
+#include <pushgraph/geometry/point_query.h>
+
+#include "geometry/numeric_diff.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <random>
+#include <vector>
+
+namespace pushgraph::graph {
+namespace {
+
+using geometry::Shape;
+using geometry::testing::CheckJacobian;
+using geometry::testing::JacobianTally;
+using geometry::testing::NumericDiffOptions;
+
+// Worst relative error of all checked Jacobians, per factor (printed for the report).
+struct WorstError {
+  const char* name;
+  double worst = 0.0;
+  ~WorstError() { std::printf("[jacobian] %-28s worst |J - Jnum| / max(1, max|Jnum|) = %.3g\n", name, worst); }
+};
+
+// Checks all parameter blocks of `cost` at `values` (one vector per block).
+void CheckCost(const ceres::CostFunction& cost, std::vector<Eigen::VectorXd> values, JacobianTally& tally,
+               WorstError& worst, const std::string& context) {
+  const int m = cost.num_residuals();
+  const auto& sizes = cost.parameter_block_sizes();
+  ASSERT_EQ(values.size(), sizes.size());
+  std::vector<const double*> ptrs;
+  for (auto& v : values) ptrs.push_back(v.data());
+  Eigen::VectorXd r(m);
+  std::vector<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> J(sizes.size());
+  std::vector<double*> jp;
+  for (std::size_t k = 0; k < sizes.size(); ++k) {
+    J[k].resize(m, sizes[k]);
+    jp.push_back(J[k].data());
+  }
+  ASSERT_TRUE(cost.Evaluate(ptrs.data(), r.data(), jp.data())) << context;
+  for (std::size_t k = 0; k < sizes.size(); ++k) {
+    auto f = [&](const Eigen::VectorXd& v) {
+      std::vector<Eigen::VectorXd> vv = values;
+      vv[k] = v;
+      std::vector<const double*> pp;
+      for (auto& x : vv) pp.push_back(x.data());
+      Eigen::VectorXd out(m);
+      if (!cost.Evaluate(pp.data(), out.data(), nullptr)) out.setConstant(NAN);
+      return out;
+    };
+    NumericDiffOptions o;
+    o.h = 1e-7;
+    o.rel_tol = 1e-5;
+    // Entries are compared relative to the whole block's scale: whitened residuals and
+    // 1/dt velocities make some entries 1e5 times larger than others in the same block.
+    o.abs_tol = 1e-5 + 1e-6 * J[k].cwiseAbs().maxCoeff();
+    const auto rep = CheckJacobian(f, values[k], Eigen::MatrixXd(J[k]), o);
+    if (rep.status == geometry::testing::JacobianCheck::kPassed) {
+      const Eigen::MatrixXd d = Eigen::MatrixXd(J[k]) - rep.numeric;
+      for (int i = 0; i < d.rows(); ++i)
+        for (int j = 0; j < d.cols(); ++j)
+          worst.worst = std::max(worst.worst, std::abs(d(i, j)) / std::max(1.0, rep.numeric.cwiseAbs().maxCoeff()));
+    }
+    EXPECT_TRUE(tally.Record(rep, context + " block " + std::to_string(k)));
+  }
+}
+
+Eigen::VectorXd V(std::initializer_list<double> l) {
+  Eigen::VectorXd v(l.size());
+  int i = 0;
+  for (double x : l) v[i++] = x;
+  return v;
+}
+Eigen::VectorXd V(const Pose2& p) { return p.vector(); }
+Eigen::VectorXd V(const Vec2& p) { return Eigen::VectorXd(p); }
+
+struct Rng {
+  std::mt19937_64 g{12345};
+  double U(double a, double b) { return std::uniform_real_distribution<double>(a, b)(g); }
+  Pose2 P(double s = 0.3) { return {U(-s, s), U(-s, s), U(-M_PI, M_PI)}; }
+};
+
+TEST(FactorJacobians, PoseMeasurement) {
+  Rng rng;
+  JacobianTally tally("M pose");
+  WorstError worst{"M pose (Log of Between)"};
+  for (int i = 0; i < 300; ++i) {
+    const Pose2 meas = rng.P();
+    Pose2 est = i % 3 == 0 ? Pose2{meas.x + rng.U(-0.01, 0.01), meas.y, meas.theta + rng.U(-1e-9, 1e-9)} : rng.P();
+    if (i % 7 == 0) est.theta = meas.theta + M_PI - 1e-3;  // near the wrap of Log's angle
+    PoseMeasurementFactor f(meas, 0.01, 0.1);
+    CheckCost(f, {V(est)}, tally, worst, "case " + std::to_string(i));
+  }
+  EXPECT_TRUE(tally.MostlyChecked(0.95));
+}
+
+TEST(FactorJacobians, VectorMeasurement) {
+  Rng rng;
+  JacobianTally tally("M vector");
+  WorstError worst{"M point/force"};
+  for (int i = 0; i < 50; ++i) {
+    VectorMeasurementFactor f(Vec2(rng.U(-1, 1), rng.U(-1, 1)), 0.5);
+    CheckCost(f, {V({rng.U(-1, 1), rng.U(-1, 1)})}, tally, worst, "case " + std::to_string(i));
+  }
+  JacobianTally trw("force random walk");
+  WorstError wrw{"force random walk"};
+  for (int i = 0; i < 50; ++i) {
+    VectorRandomWalkFactor f(rng.U(0.001, 0.05), 5.0);
+    CheckCost(f, {V({rng.U(-1, 1), rng.U(-1, 1)}), V({rng.U(-1, 1), rng.U(-1, 1)})}, trw, wrw, "rw " + std::to_string(i));
+  }
+  EXPECT_TRUE(tally.MostlyChecked(1.0));
+  EXPECT_TRUE(trw.MostlyChecked(1.0));
+}
+
+std::vector<Shape> Objects() {
+  return {Shape::Box(0.09, 0.09), Shape::RegularPolygon(3, 0.06), Shape::Box(0.1, 0.05, 0.005),
+          Shape::Disk(0.04), Shape::RegularPolygon(6, 0.05)};
+}
+
+TEST(FactorJacobians, BoundaryPointNearBoundaryAndVertices) {
+  Rng rng;
+  JacobianTally tally("C boundary");
+  WorstError worst{"C contact on boundary"};
+  int n = 0;
+  for (const Shape& shape : Objects()) {
+    BoundaryPointFactor f(shape, 1e-3);
+    for (int i = 0; i < 150; ++i, ++n) {
+      const Pose2 pose = rng.P(0.2);
+      Vec2 local;
+      const auto& ring = shape.polygons()[0].outer;
+      if (i % 3 == 0) {
+        // Contact at a vertex: a point in the vertex's outer region (the finger on a corner).
+        const Vec2 v = ring[i % ring.size()];
+        const Vec2 c = Vec2::Zero();
+        local = v + (v - c).normalized() * rng.U(1e-4, 5e-3) + shape.radius() * (v - c).normalized();
+      } else {
+        local = Vec2(rng.U(-0.07, 0.07), rng.U(-0.07, 0.07));
+      }
+      const Vec2 p = geometry::Act(pose, local);
+      CheckCost(f, {V(pose), V(p)}, tally, worst, "shape/case " + std::to_string(n));
+    }
+  }
+  // The finger side: a disk finger.
+  BoundaryPointFactor finger(Shape::Disk(0.005), 1e-3);
+  for (int i = 0; i < 100; ++i) {
+    const Pose2 e = rng.P(0.2);
+    const double a = rng.U(-M_PI, M_PI), r = rng.U(0.001, 0.01);
+    CheckCost(finger, {V(e), V(Vec2(e.x + r * std::cos(a), e.y + r * std::sin(a)))}, tally, worst, "finger");
+  }
+  EXPECT_TRUE(tally.MostlyChecked(0.9));
+}
+
+TEST(FactorJacobians, TouchingAndIntersection) {
+  Rng rng;
+  JacobianTally t_touch("C touching"), t_int("S");
+  WorstError w_touch{"C touching (separation)"}, w_int{"S intersection"};
+  const std::vector<Shape> fingers = {Shape::Disk(0.005), Shape::Box(0.01, 0.004)};
+  int intersecting = 0, apart = 0;
+  for (const Shape& obj : {Shape::Box(0.09, 0.09), Shape::RegularPolygon(3, 0.06)}) {
+    for (const Shape& fin : fingers) {
+      auto querier = std::make_shared<const geometry::ShapePairQuerier>(obj, fin);
+      TouchingFactor touch(querier, 1e-3);
+      IntersectionFactor inter(querier, 1e-3);
+      for (int i = 0; i < 120; ++i) {
+        const Pose2 x = rng.P(0.1);
+        // A boundary point of the object (edges and vertices), then the finger near it.
+        const auto& ring = obj.polygons()[0].outer;
+        const int k = i % static_cast<int>(ring.size());
+        const Vec2 a = ring[k], b = ring[(k + 1) % ring.size()];
+        const double s = i % 4 == 0 ? 0.0 : rng.U(0.1, 0.9);  // s = 0: at a vertex
+        const Vec2 on = a + s * (b - a);
+        const Vec2 n_out = s == 0.0 ? on.normalized() : Vec2((b - a).y(), -(b - a).x()).normalized();
+        const double depth = rng.U(-0.004, 0.004);  // < 0: overlapping
+        const Vec2 c = on + n_out * (0.005 + depth);
+        const Pose2 e = geometry::Compose(x, Pose2{c.x(), c.y(), rng.U(-0.3, 0.3)});
+        const auto res = querier->Query(x, e);
+        (res.intersecting ? intersecting : apart)++;
+        CheckCost(touch, {V(x), V(e)}, t_touch, w_touch, "touch " + std::to_string(i));
+        CheckCost(inter, {V(x), V(e)}, t_int, w_int, "S " + std::to_string(i));
+        if (!res.intersecting) {
+          double r[2];
+          const double* ps[2] = {x.vector().data(), e.vector().data()};
+          Eigen::Vector3d xv = x.vector(), ev = e.vector();
+          ps[0] = xv.data();
+          ps[1] = ev.data();
+          ASSERT_TRUE(inter.Evaluate(ps, r, nullptr));
+          EXPECT_EQ(r[0], 0.0);
+          EXPECT_EQ(r[1], 0.0);
+        }
+      }
+    }
+  }
+  EXPECT_GT(intersecting, 50);
+  EXPECT_GT(apart, 50);
+  EXPECT_TRUE(t_touch.MostlyChecked(0.8));
+  EXPECT_TRUE(t_int.MostlyChecked(0.8));
+}
+
+TEST(FactorJacobians, ConstantVelocityAndRandomWalk) {
+  Rng rng;
+  JacobianTally tv("V"), tr("random walk");
+  WorstError wv{"V constant velocity"}, wr{"zero-velocity prior (yu)"};
+  for (int i = 0; i < 300; ++i) {
+    const double dt1 = rng.U(0.002, 0.05), dt2 = rng.U(0.002, 0.05);
+    const Pose2 a = rng.P();
+    const double w = i % 3 == 0 ? 0.0 : (i % 3 == 1 ? rng.U(-1e-9, 1e-9) : rng.U(-2, 2));  // pure translation, near-zero rotation
+    const Pose2 b = geometry::Compose(a, geometry::Exp(Eigen::Vector3d(rng.U(-0.1, 0.1), rng.U(-0.1, 0.1), w) * dt1));
+    const Pose2 c = geometry::Compose(b, geometry::Exp(Eigen::Vector3d(rng.U(-0.1, 0.1), rng.U(-0.1, 0.1), w) * dt2));
+    ConstantVelocityFactor v(dt1, dt2, 0.01, 0.1);
+    CheckCost(v, {V(a), V(b), V(c)}, tv, wv, "V " + std::to_string(i));
+    RandomWalkFactor r(dt1, 0.05, 0.5);
+    CheckCost(r, {V(a), V(b)}, tr, wr, "RW " + std::to_string(i));
+  }
+  EXPECT_TRUE(tv.MostlyChecked(0.95));
+  EXPECT_TRUE(tr.MostlyChecked(0.95));
+}
+
+TEST(FactorSemantics, ConstantVelocityIsZeroOnAnArcWithUnequalSteps) {
+  const Eigen::Vector3d xi(0.05, 0.01, 0.7);
+  const Pose2 a{0.1, -0.2, 2.9};
+  const Pose2 b = geometry::Compose(a, geometry::Exp(xi * 0.01));
+  const Pose2 c = geometry::Compose(b, geometry::Exp(xi * 0.03));  // crosses theta = pi
+  ConstantVelocityFactor v(0.01, 0.03, 0.01, 0.1);
+  Eigen::Vector3d av = a.vector(), bv = b.vector(), cv = c.vector(), r;
+  const double* ps[3] = {av.data(), bv.data(), cv.data()};
+  ASSERT_TRUE(v.Evaluate(ps, r.data(), nullptr));
+  EXPECT_LT(r.norm(), 1e-9);
+  cv[2] += 0.01;  // a change of angular velocity is penalized
+  ASSERT_TRUE(v.Evaluate(ps, r.data(), nullptr));
+  EXPECT_GT(std::abs(r[2]), 1.0);
+}
+
+// Quasi-static configurations: pure translation, pure rotation, near-zero rotation, general.
+struct QsCase {
+  Pose2 x_prev, x;
+  Vec2 p, f;
+};
+
+std::vector<QsCase> QuasiStaticCases(Rng& rng, const QuasiStaticGeometry& g) {
+  std::vector<QsCase> cases;
+  for (int i = 0; i < 400; ++i) {
+    QsCase c;
+    c.x_prev = rng.P(0.2);
+    Eigen::Vector3d xi(rng.U(-0.1, 0.1), rng.U(-0.1, 0.1), rng.U(-2, 2));
+    switch (i % 4) {
+      case 0: xi.z() = 0.0; break;                                   // pure translation
+      case 1: xi.z() = rng.U(-1e-9, 1e-9); break;                    // near-zero rotation
+      case 2: xi.head<2>() = Vec2(g.centre_of_pressure.y(), -g.centre_of_pressure.x()) * xi.z(); break;  // pure rotation about the centre of pressure
+      default: break;
+    }
+    c.x = geometry::Compose(c.x_prev, geometry::Exp(xi * g.dt));
+    c.p = geometry::Act(c.x, Vec2(-0.045, rng.U(-0.045, 0.045)));
+    c.f = i % 10 == 9 ? Vec2::Zero() : Vec2(rng.U(-3, 3), rng.U(-3, 3));
+    cases.push_back(c);
+  }
+  return cases;
+}
+
+TEST(FactorJacobians, QuasiStaticBothForms) {
+  Rng rng;
+  QuasiStaticGeometry g;
+  g.c = 0.0344;
+  g.centre_of_pressure = Vec2(0.003, -0.002);
+  g.dt = 0.004;
+  JacobianTally td("D"), ty("D yu"), tl("limit-surface load");
+  WorstError wd{"D normalized cross product"}, wy{"D cross-multiplied (yu)"}, wl{"D limit-surface load"};
+  QuasiStaticFactor d(g, 1e-3, 0.05, 0.1);
+  LimitSurfaceLoadFactor l(g, 2.0, 1e-3, 0.05, 0.1);
+  CrossMultipliedQuasiStaticFactor y(g, 1e-3);
+  int n = 0;
+  for (const QsCase& c : QuasiStaticCases(rng, g)) {
+    const std::string ctx = "case " + std::to_string(n++);
+    CheckCost(d, {V(c.x_prev), V(c.x), V(c.p), V(c.f)}, td, wd, ctx);
+    CheckCost(y, {V(c.x_prev), V(c.x), V(c.p), V(c.f)}, ty, wy, ctx);
+    CheckCost(l, {V(c.x_prev), V(c.x), V(c.p), V(c.f)}, tl, wl, ctx);
+  }
+  EXPECT_TRUE(tl.MostlyChecked(0.95));
+  EXPECT_TRUE(td.MostlyChecked(0.95));
+  EXPECT_TRUE(ty.MostlyChecked(0.95));
+}
+
+// Evaluates a 4-block quasi-static factor.
+Eigen::VectorXd Residual(const ceres::CostFunction& f, const QsCase& c) {
+  Eigen::Vector3d a = c.x_prev.vector(), b = c.x.vector();
+  Eigen::Vector2d p = c.p, fo = c.f;
+  const double* ps[4] = {a.data(), b.data(), p.data(), fo.data()};
+  Eigen::VectorXd r(f.num_residuals());
+  EXPECT_TRUE(f.Evaluate(ps, r.data(), nullptr));
+  return r;
+}
+
+// A consistent quasi-static step: for a load (f_b, tau) the ellipsoid's twist is parallel to
+// (f_b, tau / c^2) (paper Eq. 4), so D must vanish; rotating the motion must not.
+TEST(FactorSemantics, QuasiStaticVanishesExactlyOnTheEllipsoidAndIsInformativeInTranslation) {
+  QuasiStaticGeometry g;
+  g.c = 0.0344;
+  g.dt = 0.004;
+  QuasiStaticFactor d(g, 1e-3, 0.05, 0.1);
+  CrossMultipliedQuasiStaticFactor y(g, 1e-3);
+  for (double offset : {0.0, 1e-7, 0.01, 0.03}) {  // 0: centred push, pure translation
+    const Vec2 q(-0.045, offset);                  // contact in the object frame
+    const Vec2 fb(1.5, 0.0);                       // pushing along +x
+    const double tau = q.x() * fb.y() - q.y() * fb.x();
+    const double k = 0.05 / fb.norm();
+    const Eigen::Vector3d xi(k * fb.x(), k * fb.y(), k * tau / (g.c * g.c));
+    QsCase c;
+    c.x_prev = Pose2{0.1, 0.2, 0.3};
+    c.x = geometry::Compose(c.x_prev, geometry::Exp(xi * g.dt));
+    c.p = geometry::Act(c.x, q);
+    c.f = c.x.rotation() * fb;
+    EXPECT_LT(Residual(d, c).norm(), 1e-9) << offset;
+    EXPECT_LT(Residual(y, c).norm(), 1e-9) << offset;
+    // Same force, the object moving 20 degrees off the force direction.
+    QsCase bad = c;
+    const Eigen::Vector3d xi_bad(xi.x() * std::cos(0.35) - xi.y() * std::sin(0.35),
+                                 xi.x() * std::sin(0.35) + xi.y() * std::cos(0.35), xi.z());
+    bad.x = geometry::Compose(c.x_prev, geometry::Exp(xi_bad * g.dt));
+    bad.p = geometry::Act(bad.x, q);
+    bad.f = bad.x.rotation() * fb;
+    EXPECT_GT(Residual(d, bad).norm() * 0.1, 0.2) << offset;  // about sin(20 deg)
+    if (offset == 0.0) {
+      // The baseline's cross-multiplied form cannot see it in pure translation.
+      EXPECT_LT(Residual(y, bad).norm(), 1e-12);
+    }
+  }
+}
+
+TEST(FactorSemantics, BadSigmasAndStepsAreRejected) {
+  EXPECT_THROW(PoseMeasurementFactor(Pose2{}, 0.0, 1.0), GraphError);
+  EXPECT_THROW(VectorMeasurementFactor(Vec2::Zero(), NAN), GraphError);
+  EXPECT_THROW(ConstantVelocityFactor(0.0, 0.01, 1, 1), GraphError);
+  QuasiStaticGeometry g;
+  g.c = -1.0;
+  EXPECT_THROW(QuasiStaticFactor(g, 1e-3, 0.05, 0.1), GraphError);
+  EXPECT_THROW(BoundaryPointFactor(geometry::Shape(), 1.0), GraphError);
+}
+
+}  // namespace
+}  // namespace pushgraph::graph

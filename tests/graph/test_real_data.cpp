@@ -1,0 +1,64 @@
+// Real input: MIT planar pushing recordings (../shared/data/mit-push) with the paper's Sec. IV
+// protocol: seeded Gaussian noise added to the motion-capture streams, which are the ground truth.
+#include <pushgraph/graph/estimator.h>
+#include <pushgraph/io/mit_push.h>
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <random>
+
+namespace pushgraph::graph {
+namespace {
+
+limit_surface::Trajectory NoisyMit(const std::string& file, const geometry::Shape& shape, double mass, unsigned seed) {
+  io::MitReadOptions options;
+  options.trim_to_contact = true;
+  const io::MitRecording rec = io::ReadMitPush(file, options);
+  limit_surface::ObjectDescription object;
+  object.shape = shape;
+  object.mass = mass;
+  object.mu_surface = 0.35;  // the apparent mu of these files (README)
+  limit_surface::FingerDescription finger;
+  finger.shape = geometry::Shape::Disk(0.00235);
+  finger.mu_contact = 0.2;
+  limit_surface::Trajectory t = io::MitToTrajectory(rec, object, finger);
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> n(0.0, 1.0);
+  for (auto& s : t.measured.object_pose) s.pose = {s.pose.x + 0.005 * n(rng), s.pose.y + 0.005 * n(rng), s.pose.theta + 0.05 * n(rng)};
+  for (auto& s : t.measured.finger_pose) s.pose = {s.pose.x + 0.005 * n(rng), s.pose.y + 0.005 * n(rng), s.pose.theta};
+  for (auto& s : t.measured.force) s.force += geometry::Vec2(0.5 * n(rng), 0.5 * n(rng));
+  return t;
+}
+
+TEST(RealData, MitEllip1AndRect1PushesAreRecovered) {
+  const std::string dir = std::string(PUSHGRAPH_SHARED_DIR) + "/data/mit-push/abs/";
+  const std::string ellip = dir + "ellip1/motion_surface=abs_shape=ellip1_a=0_v=50_i=0.000_s=0.175_t=-0.349.h5";
+  const std::string rect = dir + "rect1/motion_surface=abs_shape=rect1_a=0_v=75_i=2.000_s=0.800_t=0.349.h5";
+  if (!std::filesystem::exists(ellip) || !std::filesystem::exists(rect)) GTEST_SKIP() << "no MIT data at " << dir;
+  struct Case {
+    std::string file;
+    geometry::Shape shape;
+    double mass;
+  };
+  for (const Case& c : {Case{ellip, geometry::Shape::Disk(0.0525), 0.8937}, Case{rect, geometry::Shape::Box(0.09, 0.09), 0.8374}}) {
+    const limit_surface::Trajectory t = NoisyMit(c.file, c.shape, c.mass, 3);
+    for (Model m : {Model::kSdf, Model::kQs}) {
+      EstimatorConfig cfg;
+      cfg.covariance = false;
+      const EstimationResult r = Estimate(t, m, Mode::kBatch, cfg);
+      const auto& x = r.metrics;
+      std::printf("[mit] %s %-3s %zu steps: object %.2f mm (raw %.2f), %.4f rad (raw %.4f)", c.file.substr(c.file.rfind('/') + 1, 40).c_str(),
+                  ModelName(m).c_str(), r.states.size(), 1e3 * x.at("object_position_rms"), 1e3 * x.at("measured_object_position_rms"),
+                  x.at("object_rotation_rms"), x.at("measured_object_rotation_rms"));
+      if (x.count("force_rms")) std::printf(", force %.3f N (raw %.3f)", x.at("force_rms"), x.at("measured_force_rms"));
+      std::printf(" [%d it, %.2f s]\n", r.solver.iterations, r.solver.time_s);
+      EXPECT_LT(x.at("object_position_rms"), 0.7 * x.at("measured_object_position_rms"));
+      EXPECT_LT(x.at("object_rotation_rms"), 0.7 * x.at("measured_object_rotation_rms"));
+    }
+  }
+}
+
+}  // namespace
+}  // namespace pushgraph::graph
