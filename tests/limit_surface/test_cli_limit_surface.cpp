@@ -2,6 +2,8 @@
 // and one-line errors with a non-zero exit status on bad input.
 #include <pushgraph/limit_surface/limit_surface.h>
 
+#include "tool_runner.h"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -20,43 +22,16 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct ToolRun {
-  int status = 0;
-  std::string out, err;
-};
+using pushgraph::testing::ToolRun;
 
-class LimitSurfaceCli : public ::testing::Test {
+class LimitSurfaceCli : public pushgraph::testing::ToolTest {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("pushgraph_ls_cli_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
+    ToolTest::SetUp();
     square_ = Write("square.json", R"({"polygons": [{"outer": [[0,0],[0.09,0],[0.09,0.09],[0,0.09]]}]})");
   }
-  void TearDown() override { fs::remove_all(dir_); }
 
-  std::string Write(const std::string& name, const std::string& text) {
-    const fs::path p = dir_ / name;
-    std::ofstream(p) << text;
-    return p.string();
-  }
-
-  ToolRun Exec(const std::string& args) {
-    const std::string err_path = (dir_ / "stderr.txt").string();
-    const std::string cmd = std::string(PUSHGRAPH_TOOL) + " limit-surface " + args + " 2>" + err_path;
-    ToolRun run;
-    FILE* pipe = ::popen(cmd.c_str(), "r");
-    std::array<char, 4096> buf{};
-    std::size_t n = 0;
-    while ((n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0) run.out.append(buf.data(), n);
-    const int status = ::pclose(pipe);
-    run.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    std::ifstream e(err_path);
-    std::stringstream ss;
-    ss << e.rdbuf();
-    run.err = ss.str();
-    return run;
-  }
+  ToolRun Exec(const std::string& args) { return ToolTest::Exec("limit-surface " + args); }
 
   void ExpectOneLineError(const std::string& args, const std::string& fragment) {
     const ToolRun run = Exec(args);
@@ -66,7 +41,6 @@ class LimitSurfaceCli : public ::testing::Test {
     EXPECT_NE(run.err.find(fragment), std::string::npos) << run.err;
   }
 
-  fs::path dir_;
   std::string square_;
 };
 

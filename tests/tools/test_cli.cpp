@@ -1,6 +1,8 @@
 // Runs the pushgraph tool as a user would and checks the contracts of its subcommands.
 #include <pushgraph/geometry/point_query.h>
 
+#include "tool_runner.h"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -20,45 +22,8 @@ namespace {
 namespace fs = std::filesystem;
 using pushgraph::geometry::Vec2;
 
-struct ToolRun {
-  int status = 0;
-  std::string out, err;
-};
-
-class CliTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("pushgraph_cli_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  std::string Write(const std::string& name, const std::string& text) {
-    const fs::path p = dir_ / name;
-    std::ofstream(p) << text;
-    return p.string();
-  }
-
-  ToolRun Exec(const std::string& args) {
-    const std::string err_path = (dir_ / "stderr.txt").string();
-    const std::string cmd = std::string(PUSHGRAPH_TOOL) + " " + args + " 2>" + err_path;
-    ToolRun run;
-    FILE* pipe = ::popen(cmd.c_str(), "r");
-    std::array<char, 4096> buf{};
-    std::size_t n = 0;
-    while ((n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0) run.out.append(buf.data(), n);
-    const int status = ::pclose(pipe);
-    run.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    std::ifstream e(err_path);
-    std::stringstream ss;
-    ss << e.rdbuf();
-    run.err = ss.str();
-    return run;
-  }
-
-  fs::path dir_;
-};
+using pushgraph::testing::ToolRun;
+using CliTest = pushgraph::testing::ToolTest;
 
 const char* kSquareWithHole =
     R"({"polygons": [{"outer": [[0,0],[1,0],[1,1],[0,1]], "holes": [[[0.4,0.4],[0.4,0.6],[0.6,0.6],[0.6,0.4]]]}]})";
