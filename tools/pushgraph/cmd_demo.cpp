@@ -114,8 +114,8 @@ void RegisterDemo(CLI::App& app) {
     svg << "<svg xmlns='http://www.w3.org/2000/svg' width='" << 0.14 * scale << "' height='" << 0.15 * scale
         << "' style='background:white'>\n<path d='" << SvgPath(object, scale, origin)
         << "' fill='lightsteelblue' stroke='navy' fill-rule='evenodd'/>\n"
-        << markers << "<text x='10' y='20' font-family='sans-serif' font-size='14'>pushgraph demo: disk finger"
-        << " positions (red: overlapping), witness segments in black</text>\n</svg>\n";
+        << markers << "<text x='10' y='20' font-family='sans-serif' font-size='13'>disk finger sweep: red overlapping,"
+        << " black: witness pairs</text>\n</svg>\n";
     std::printf("picture: %s\n", svg_path->c_str());
     if (mismatches != 0) throw CliError("accelerated queries disagree with the brute-force reference");
   });
