@@ -133,14 +133,8 @@ int SideByParity(const Shape::Impl& m, const Vec2& p) {
   return count % 2 == 1 ? -1 : 1;
 }
 
-bool SharesVertexWithOtherRing(const Shape::Impl& m, int v) {
-  for (std::size_t i = 0; i < m.vertices.size(); ++i)
-    if (static_cast<int>(i) != v && m.vertices[i] == m.vertices[v]) return true;
-  return false;
-}
-
 int VertexSide(const Shape::Impl& m, int v, const Vec2& p) {
-  if (m.has_touching_vertices && SharesVertexWithOtherRing(m, v)) return SideByParity(m, p);
+  if (m.shared_vertex[v]) return SideByParity(m, p);
   const Vec2& u = m.vertices[m.prev[v]];
   const Vec2& q = m.vertices[v];
   const Vec2& w = m.vertices[m.next[v]];

@@ -252,12 +252,16 @@ std::shared_ptr<Shape::Impl> BuildShapeImpl(std::vector<Polygon> polygons, doubl
     for (int i = 0; i < n && impl->convex; ++i)
       impl->convex = exact::OrientationSign(r[(i + n - 1) % n], r[i], r[(i + 1) % n]) >= 0;
   }
-  // Rings sharing a vertex position (possible only in internally built obstacles).
-  std::vector<Vec2> sorted = impl->vertices;
-  std::sort(sorted.begin(), sorted.end(), [](const Vec2& a, const Vec2& b) {
-    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  // Vertices at the same position: rings touching at a corner (or a pinched obstacle ring).
+  const std::vector<Vec2>& v = impl->vertices;
+  std::vector<int> order(v.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+  std::sort(order.begin(), order.end(), [&](int a, int b) {
+    return v[a].x() < v[b].x() || (v[a].x() == v[b].x() && v[a].y() < v[b].y());
   });
-  impl->has_touching_vertices = std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end();
+  impl->shared_vertex.assign(v.size(), 0);
+  for (std::size_t k = 1; k < order.size(); ++k)
+    if (v[order[k]] == v[order[k - 1]]) impl->shared_vertex[order[k]] = impl->shared_vertex[order[k - 1]] = 1;
   impl->polygons = std::move(polygons);
   impl->index.Build(impl->vertices, impl->edges, impl->next, impl->core_bounds);
   return impl;

@@ -20,8 +20,9 @@ struct Shape::Impl {
   double radius = 0.0;
   bool degenerate_core = false;   // a single point or segment
   bool convex = false;
-  // Two or more rings share a vertex position (only in internally built obstacles).
-  bool has_touching_vertices = false;
+  // Per vertex: another ring has a vertex at the same position (rings touching at a corner, as
+  // in exact footprints and Minkowski obstacles); the side there is decided by parity.
+  std::vector<char> shared_vertex;
 
   // Flattened vertices of all rings; edge i runs from vertex i to vertex next[i]. For a segment
   // core there is one edge (0 -> 1); for a point core none.
