@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the build tree into a temporary prefix outside the source tree, then configures,
-# builds and runs examples/consumer against it: proof that find_package(pushgraph) works.
+# builds and runs examples/consumer and the examples (examples/, as their CTest tests, reading
+# the installed data) against it: proof that find_package(pushgraph) works.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build}
@@ -12,4 +13,8 @@ cmake -S examples/consumer -B "$work" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUIL
 cmake --build "$work" -j"$(nproc)" >/dev/null
 "$work/consumer"
 (cd "$work" && "$prefix/bin/pushgraph" demo --svg "$work/demo.svg" >/dev/null)  # finds $prefix/share/pushgraph
-echo "check-install: consumer project and installed tool passed (prefix $prefix)"
+cmake -S examples -B "$work/examples" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release \
+  -DPUSHGRAPH_EXAMPLES_DATA_DIR="$prefix/share/pushgraph" >/dev/null
+cmake --build "$work/examples" -j"$(nproc)" >/dev/null
+ctest --test-dir "$work/examples" --output-on-failure
+echo "check-install: consumer project, examples and installed tool passed (prefix $prefix)"

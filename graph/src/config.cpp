@@ -3,6 +3,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -32,6 +33,7 @@ std::map<std::string, double EstimatorConfig::*> DoubleFields() {
       {"eps_force", &EstimatorConfig::eps_force},
       {"c", &EstimatorConfig::c},
       {"c_scale", &EstimatorConfig::c_scale},
+      {"c_prior_sigma", &EstimatorConfig::c_prior_sigma},
       {"force_prior_sigma", &EstimatorConfig::force_prior_sigma},
       {"force_random_walk", &EstimatorConfig::force_random_walk},
       {"limit_surface_sigma", &EstimatorConfig::limit_surface_sigma},
@@ -95,7 +97,8 @@ void CheckPositive(double v, const std::string& key) {
 
 }  // namespace
 
-EstimatorConfig ParseEstimatorConfig(const std::string& json_text, const std::string& source) {
+EstimatorConfig ParseEstimatorConfig(const std::string& json_text, const std::string& source,
+                                     const EstimatorConfig& base) {
   Json j;
   try {
     j = Json::parse(json_text);
@@ -103,7 +106,7 @@ EstimatorConfig ParseEstimatorConfig(const std::string& json_text, const std::st
     throw GraphError(source + ": invalid JSON: " + e.what());
   }
   if (!j.is_object()) throw GraphError(source + ": the configuration must be a JSON object");
-  EstimatorConfig cfg;
+  EstimatorConfig cfg = base;
   const auto doubles = DoubleFields();
   const auto ints = IntFields();
   const auto losses = LossFields();
@@ -115,9 +118,20 @@ EstimatorConfig ParseEstimatorConfig(const std::string& json_text, const std::st
     } else if (auto i = ints.find(key); i != ints.end()) {
       if (!it->is_number_integer()) Fail(source, key, "expected an integer");
       cfg.*(i->second) = it->get<int>();
-    } else if (key == "covariance") {
+    } else if (key == "contact_finger") {
+      const std::string v = it->is_string() ? it->get<std::string>() : "";
+      if (v == "witness") cfg.contact_finger = EstimatorConfig::ContactFinger::kWitness;
+      else if (v == "boundary") cfg.contact_finger = EstimatorConfig::ContactFinger::kBoundary;
+      else Fail(source, key, "expected \"witness\" or \"boundary\", got " + it->dump());
+    } else if (key == "limit_surface_load") {
+      const std::string v = it->is_string() ? it->get<std::string>() : "";
+      if (v == "auto") cfg.limit_surface_load = EstimatorConfig::LimitSurfaceLoad::kAuto;
+      else if (v == "on") cfg.limit_surface_load = EstimatorConfig::LimitSurfaceLoad::kOn;
+      else if (v == "off") cfg.limit_surface_load = EstimatorConfig::LimitSurfaceLoad::kOff;
+      else Fail(source, key, "expected \"auto\", \"on\" or \"off\", got " + it->dump());
+    } else if (key == "covariance" || key == "estimate_c") {
       if (!it->is_boolean()) Fail(source, key, "expected true or false");
-      cfg.covariance = it->get<bool>();
+      (key == "covariance" ? cfg.covariance : cfg.estimate_c) = it->get<bool>();
     } else if (key == "losses") {
       if (!it->is_object()) Fail(source, key, "expected an object");
       for (auto l = it->begin(); l != it->end(); ++l) {
@@ -139,12 +153,28 @@ EstimatorConfig ParseEstimatorConfig(const std::string& json_text, const std::st
   return cfg;
 }
 
-EstimatorConfig LoadEstimatorConfig(const std::string& path) {
+EstimatorConfig LoadEstimatorConfig(const std::string& path, const EstimatorConfig& base) {
   std::ifstream in(path);
   if (!in) throw GraphError("cannot open config file '" + path + "'");
   std::stringstream ss;
   ss << in.rdbuf();
-  return ParseEstimatorConfig(ss.str(), path);
+  return ParseEstimatorConfig(ss.str(), path, base);
+}
+
+EstimatorConfig ApplyMeasurementSigmas(EstimatorConfig cfg, const limit_surface::MeasurementSigmas& s) {
+  auto floor_at = [](double sigma, double least, const char* what) {
+    if (!std::isfinite(sigma) || sigma < 0.0) {
+      throw GraphError(std::string("measurement_sigmas.") + what + " must be finite and >= 0");
+    }
+    return std::max(sigma, least);
+  };
+  cfg.object_pose_sigma_trans = floor_at(s.object_trans, 1e-4, "object_pose (translation)");
+  cfg.object_pose_sigma_rot = floor_at(s.object_rot, 1e-3, "object_pose (rotation)");
+  cfg.finger_pose_sigma_trans = floor_at(s.finger_trans, 1e-4, "finger_pose (translation)");
+  cfg.finger_pose_sigma_rot = floor_at(s.finger_rot, 1e-3, "finger_pose (rotation)");
+  cfg.contact_sigma = floor_at(s.contact, 1e-4, "contact_point");
+  cfg.force_sigma = floor_at(s.force, 1e-3, "force");
+  return cfg;
 }
 
 void ValidateConfig(const EstimatorConfig& cfg) {

@@ -1,5 +1,7 @@
 #include "graph_builder.h"
 
+#include <ceres/normal_prior.h>
+
 #include <pushgraph/geometry/point_query.h>
 #include <pushgraph/graph/incremental.h>
 #include <pushgraph/limit_surface/limit_surface.h>
@@ -10,6 +12,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <iostream>
 #include <tuple>
 
 namespace pushgraph::graph {
@@ -200,6 +204,15 @@ GraphBuilder::GraphBuilder(const limit_surface::Trajectory& trajectory, Model mo
   if (traj_.object.mass > 0.0 && traj_.object.mu_surface > 0.0) {
     f_max_ = traj_.object.mu_surface * traj_.object.mass * limit_surface::kStandardGravity;
   }
+  using Load = EstimatorConfig::LimitSurfaceLoad;
+  use_load_factor_ = f_max_ > 0.0 && (cfg_.limit_surface_load == Load::kOn ||
+                                      (cfg_.limit_surface_load == Load::kAuto && m.force.empty()));
+}
+
+void GraphBuilder::EnableCEstimation() {
+  if (model_ != Model::kQs) return;
+  estimate_c_ = true;
+  c_var_[0] = qs_.c;
 }
 
 void GraphBuilder::Initialize(int i, double limit) {
@@ -298,7 +311,11 @@ void GraphBuilder::AddKinematicFactors(ceres::Problem& problem, int i) {
     }
     // C: contact point on both boundaries, finger touching the object.
     problem.AddResidualBlock(new BoundaryPointFactor(traj_.object.shape, cfg_.contact_object_sigma), nullptr, v.x, v.p);
-    problem.AddResidualBlock(new BoundaryPointFactor(traj_.finger.shape, cfg_.contact_finger_sigma), nullptr, v.e, v.p);
+    if (cfg_.contact_finger == EstimatorConfig::ContactFinger::kWitness) {
+      problem.AddResidualBlock(new ContactWitnessFactor(querier_, cfg_.contact_finger_sigma), nullptr, v.x, v.e, v.p);
+    } else {
+      problem.AddResidualBlock(new BoundaryPointFactor(traj_.finger.shape, cfg_.contact_finger_sigma), nullptr, v.e, v.p);
+    }
     // The finger touches the object (signed separation 0): in QS and the baseline (Yu and
     // Rodriguez's contact factor). CP and SDF link finger and object through p only (Fig. 2a-b).
     if (model_ == Model::kQs || model_ == Model::kYu) {
@@ -347,10 +364,28 @@ void GraphBuilder::AddDynamicFactors(ceres::Problem& problem, int i) {
       g.dt = s.t - steps_[i - 1].t;
       const double rate_scale = std::sqrt(0.01 / g.dt);  // per-10-ms sigmas (config.h)
       if (model_ == Model::kQs) {
-        problem.AddResidualBlock(new QuasiStaticFactor(g, cfg_.eps_velocity, cfg_.eps_force,
-                                                       cfg_.quasi_static_sigma * rate_scale),
-                                 nullptr, vars_[i - 1].x, v.x, v.p, v.f);
-        if (f_max_ > 0.0) {
+        if (estimate_c_) {
+          problem.AddResidualBlock(new QuasiStaticFactorWithC(g, cfg_.eps_velocity, cfg_.eps_force,
+                                                              cfg_.quasi_static_sigma * rate_scale),
+                                   nullptr, vars_[i - 1].x, v.x, v.p, v.f, c_var_);
+          if (!c_in_problem_) {
+            // Prior around the geometric value; bounds keep c physical (tau / c in D).
+            const double c0 = qs_.c;
+            ceres::Matrix A(1, 1);
+            ceres::Vector b(1);
+            A(0, 0) = 1.0 / (cfg_.c_prior_sigma * c0);
+            b(0) = c0;
+            problem.AddResidualBlock(new ceres::NormalPrior(A, b), nullptr, c_var_);
+            problem.SetParameterLowerBound(c_var_, 0, 0.2 * c0);
+            problem.SetParameterUpperBound(c_var_, 0, 5.0 * c0);
+            c_in_problem_ = true;
+          }
+        } else {
+          problem.AddResidualBlock(new QuasiStaticFactor(g, cfg_.eps_velocity, cfg_.eps_force,
+                                                         cfg_.quasi_static_sigma * rate_scale),
+                                   nullptr, vars_[i - 1].x, v.x, v.p, v.f);
+        }
+        if (use_load_factor_) {
           problem.AddResidualBlock(new LimitSurfaceLoadFactor(g, f_max_, cfg_.eps_velocity, cfg_.eps_force,
                                                               cfg_.limit_surface_sigma * rate_scale),
                                    nullptr, vars_[i - 1].x, v.x, v.p, v.f);
@@ -414,6 +449,15 @@ std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder, c
   return "ok";
 }
 
+// PUSHGRAPH_SOLVER_LOG=1 prints every solve's Ceres report (iterations, time per stage) to stderr.
+void LogSummary(const char* what, const ceres::Solver::Summary& summary) {
+  static const bool enabled = [] {
+    const char* v = std::getenv("PUSHGRAPH_SOLVER_LOG");
+    return v != nullptr && *v != '\0' && *v != '0';
+  }();
+  if (enabled) std::cerr << "pushgraph " << what << ":\n" << summary.FullReport() << "\n";
+}
+
 ceres::Solver::Options SolverOptions(int max_iterations, double function_tolerance) {
   ceres::Solver::Options o;
   o.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
@@ -424,6 +468,10 @@ ceres::Solver::Options SolverOptions(int max_iterations, double function_toleran
   o.parameter_tolerance = 1e-10;
   o.num_threads = 1;
   o.logging_type = ceres::SILENT;
+  if (const char* v = std::getenv("PUSHGRAPH_SOLVER_LOG"); v != nullptr && std::string(v) == "2") {
+    o.logging_type = ceres::PER_MINIMIZER_ITERATION;  // per-iteration trace, for tuning
+    o.minimizer_progress_to_stdout = true;
+  }
   return o;
 }
 
@@ -433,6 +481,7 @@ namespace {
 
 EstimationResult EstimateBatch(const limit_surface::Trajectory& traj, Model model, const EstimatorConfig& cfg) {
   internal::GraphBuilder builder(traj, model, cfg);
+  if (cfg.estimate_c) builder.EnableCEstimation();
   const int n = static_cast<int>(builder.steps().size());
   const auto start = std::chrono::steady_clock::now();
   ceres::Problem problem;
@@ -447,6 +496,7 @@ EstimationResult EstimateBatch(const limit_surface::Trajectory& traj, Model mode
     for (int i = 0; i < n; ++i) kinematic.AddFactors(pre, i);
     ceres::Solver::Summary pre_summary;
     ceres::Solve(internal::SolverOptions(cfg.max_iterations, cfg.function_tolerance), &pre, &pre_summary);
+    internal::LogSummary("batch warm start (sdf)", pre_summary);
     stage_iterations = pre_summary.num_successful_steps + pre_summary.num_unsuccessful_steps;
     for (int i = 0; i < n; ++i) {
       auto& dst = builder.vars()[i];
@@ -459,6 +509,7 @@ EstimationResult EstimateBatch(const limit_surface::Trajectory& traj, Model mode
   for (int i = 0; i < n; ++i) builder.AddFactors(problem, i);
   ceres::Solver::Summary summary;
   ceres::Solve(internal::SolverOptions(cfg.max_iterations, cfg.function_tolerance), &problem, &summary);
+  internal::LogSummary("batch", summary);
   if (summary.termination_type == ceres::FAILURE) {
     throw GraphError("batch solve failed: " + summary.message);
   }
@@ -471,6 +522,20 @@ EstimationResult EstimateBatch(const limit_surface::Trajectory& traj, Model mode
     r.states.push_back(builder.State(i));
   }
   if (cfg.covariance) r.solver.covariance_status = internal::ComputeCovariances(problem, builder, idx, r.states);
+  if (ModelHasForce(model)) r.c = builder.c();
+  if (double* c = builder.c_block()) {
+    r.c_estimated = true;
+    if (cfg.covariance) {
+      ceres::Covariance::Options options;
+      options.algorithm_type = ceres::SPARSE_QR;
+      ceres::Covariance covariance(options);
+      const std::vector<std::pair<const double*, const double*>> pair{{c, c}};
+      double var = 0.0;
+      if (covariance.Compute(pair, &problem) && covariance.GetCovarianceBlock(c, c, &var)) {
+        r.c_sigma = std::sqrt(var);
+      }
+    }
+  }
   r.solver.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   r.solver.iterations = stage_iterations + summary.num_successful_steps + summary.num_unsuccessful_steps;
   r.solver.final_cost = summary.final_cost;

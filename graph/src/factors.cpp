@@ -123,6 +123,33 @@ bool TouchingFactor::Evaluate(double const* const* parameters, double* residuals
   return true;
 }
 
+// ------------------------------------------------------------------------- C, witness form
+ContactWitnessFactor::ContactWitnessFactor(std::shared_ptr<const geometry::ShapePairQuerier> querier,
+                                           double sigma)
+    : querier_(std::move(querier)), w_(CheckedWeight(sigma, "contact witness")) {
+  if (!querier_) throw GraphError("ContactWitnessFactor: null shape-pair querier");
+}
+
+bool ContactWitnessFactor::Evaluate(double const* const* parameters, double* residuals,
+                                    double** jacobians) const {
+  geometry::ShapePairJacobians J;
+  geometry::ShapePairResult r;
+  if (!QueryPair(*querier_, parameters, &r, &J)) return false;
+  const Vec2 mid = 0.5 * (r.object_point + r.finger_point);
+  Eigen::Map<Eigen::Vector2d>{residuals} = w_ * (Vec2(parameters[2][0], parameters[2][1]) - mid);
+  if (jacobians != nullptr) {
+    const double h = -0.5 * w_;
+    if (jacobians[0] != nullptr) {
+      Eigen::Map<RowMat23>{jacobians[0]} = h * (J.J_object_point_object_pose + J.J_finger_point_object_pose);
+    }
+    if (jacobians[1] != nullptr) {
+      Eigen::Map<RowMat23>{jacobians[1]} = h * (J.J_object_point_finger_pose + J.J_finger_point_finger_pose);
+    }
+    if (jacobians[2] != nullptr) Eigen::Map<RowMat22>{jacobians[2]} = w_ * Eigen::Matrix2d::Identity();
+  }
+  return true;
+}
+
 // ---------------------------------------------------------------------------------------- S
 IntersectionFactor::IntersectionFactor(std::shared_ptr<const geometry::ShapePairQuerier> querier,
                                        double sigma)
@@ -296,26 +323,65 @@ QuasiStaticFactor::QuasiStaticFactor(const QuasiStaticGeometry& geometry, double
   }
 }
 
-bool QuasiStaticFactor::Evaluate(double const* const* parameters, double* residuals,
-                                 double** jacobians) const {
-  const QuasiStaticTerms t = ComputeQuasiStaticTerms(
-      geometry_, PoseFrom(parameters[0]), PoseFrom(parameters[1]),
-      Vec2(parameters[2][0], parameters[2][1]), Vec2(parameters[3][0], parameters[3][1]));
+// r = w u / (a b), u = V' x g', a = sqrt(|V'|^2 + eps_v^2), b = sqrt(|g'|^2 + eps_f^2):
+//   dr/dV = w (-[g]x / (a b) - u V^T / (a^3 b)),  dr/dg = w ([V]x / (a b) - u g^T / (a b^3)).
+static Eigen::Vector3d NormalizedCross(const QuasiStaticTerms& t, double eps_v, double eps_f, double w,
+                                       Eigen::Matrix3d* J_r_V, Eigen::Matrix3d* J_r_g) {
   const Eigen::Vector3d u = t.V.cross(t.g);
-  const double a = std::sqrt(t.V.squaredNorm() + eps_v_ * eps_v_);
-  const double b = std::sqrt(t.g.squaredNorm() + eps_f_ * eps_f_);
-  const double s = w_ / (a * b);
-  Eigen::Map<Eigen::Vector3d>{residuals} = s * u;
-  if (jacobians == nullptr) return true;
-  // r = w u / (a b):  dr/dV = w (-[g]x / (a b) - u V^T / (a^3 b)),
-  //                   dr/dg = w ( [V]x / (a b) - u g^T / (a b^3)).
-  const Eigen::Matrix3d J_r_V = s * (-Skew(t.g) - u * t.V.transpose() / (a * a));
-  const Eigen::Matrix3d J_r_g = s * (Skew(t.V) - u * t.g.transpose() / (b * b));
+  const double a = std::sqrt(t.V.squaredNorm() + eps_v * eps_v);
+  const double b = std::sqrt(t.g.squaredNorm() + eps_f * eps_f);
+  const double s = w / (a * b);
+  if (J_r_V != nullptr) *J_r_V = s * (-Skew(t.g) - u * t.V.transpose() / (a * a));
+  if (J_r_g != nullptr) *J_r_g = s * (Skew(t.V) - u * t.g.transpose() / (b * b));
+  return s * u;
+}
+
+// D at c = geometry.c, or at c = parameters[4][0] when with_c (then also d r / d c).
+static bool EvaluateQuasiStatic(QuasiStaticGeometry geometry, double eps_v, double eps_f, double w,
+                                bool with_c, double const* const* parameters, double* residuals,
+                                double** jacobians) {
+  if (with_c) {
+    geometry.c = parameters[4][0];
+    if (!(geometry.c > 0.0) || !std::isfinite(geometry.c)) return false;  // Ceres shortens the step
+  }
+  const QuasiStaticTerms t = ComputeQuasiStaticTerms(
+      geometry, PoseFrom(parameters[0]), PoseFrom(parameters[1]),
+      Vec2(parameters[2][0], parameters[2][1]), Vec2(parameters[3][0], parameters[3][1]));
+  Eigen::Matrix3d J_r_V, J_r_g;
+  const bool jac = jacobians != nullptr;
+  Eigen::Map<Eigen::Vector3d>{residuals} =
+      NormalizedCross(t, eps_v, eps_f, w, jac ? &J_r_V : nullptr, jac ? &J_r_g : nullptr);
+  if (!jac) return true;
   if (jacobians[0] != nullptr) Eigen::Map<RowMat33>{jacobians[0]} = J_r_V * t.J_V_xprev;
   if (jacobians[1] != nullptr) Eigen::Map<RowMat33>{jacobians[1]} = J_r_V * t.J_V_x + J_r_g * t.J_g_x;
   if (jacobians[2] != nullptr) Eigen::Map<RowMat32>{jacobians[2]} = J_r_g * t.J_g_p;
   if (jacobians[3] != nullptr) Eigen::Map<RowMat32>{jacobians[3]} = J_r_g * t.J_g_f;
+  if (with_c && jacobians[4] != nullptr) {
+    // V'_z = c omega and g'_z = tau / c: dV'/dc = (0, 0, V'_z / c), dg'/dc = (0, 0, -g'_z / c).
+    const double c = geometry.c;
+    Eigen::Map<Eigen::Vector3d>{jacobians[4]} = J_r_V.col(2) * (t.V.z() / c) - J_r_g.col(2) * (t.g.z() / c);
+  }
   return true;
+}
+
+bool QuasiStaticFactor::Evaluate(double const* const* parameters, double* residuals,
+                                 double** jacobians) const {
+  return EvaluateQuasiStatic(geometry_, eps_v_, eps_f_, w_, false, parameters, residuals, jacobians);
+}
+
+QuasiStaticFactorWithC::QuasiStaticFactorWithC(const QuasiStaticGeometry& geometry, double eps_velocity,
+                                               double eps_force, double sigma)
+    : geometry_(geometry), eps_v_(eps_velocity), eps_f_(eps_force),
+      w_(CheckedWeight(sigma, "quasi-static")) {
+  CheckGeometry(geometry_);
+  if (!(eps_v_ > 0.0) || !(eps_f_ > 0.0)) {
+    throw GraphError("quasi-static factor: eps_velocity and eps_force must be > 0");
+  }
+}
+
+bool QuasiStaticFactorWithC::Evaluate(double const* const* parameters, double* residuals,
+                                      double** jacobians) const {
+  return EvaluateQuasiStatic(geometry_, eps_v_, eps_f_, w_, true, parameters, residuals, jacobians);
 }
 
 LimitSurfaceLoadFactor::LimitSurfaceLoadFactor(const QuasiStaticGeometry& geometry, double f_max,

@@ -46,6 +46,12 @@ class GraphBuilder {
   void AddFactors(ceres::Problem& problem, int i, int parts = kAll);
   /// Parameter blocks of step i present in the problem.
   std::vector<double*> Blocks(int i);
+  /// Makes c a shared variable of every D factor (QS only; the batch solver calls this when
+  /// config.estimate_c). c_block() is then non-null once a D factor was added.
+  void EnableCEstimation();
+  double* c_block() { return c_in_problem_ ? c_var_ : nullptr; }
+  double c() const { return estimate_c_ ? c_var_[0] : qs_.c; }
+  double c_initial() const { return qs_.c; }
   /// The estimate of step i (no covariances).
   StateEstimate State(int i) const;
 
@@ -61,7 +67,11 @@ class GraphBuilder {
   std::vector<StepVars> vars_;
   std::shared_ptr<const geometry::ShapePairQuerier> querier_;
   QuasiStaticGeometry qs_;
+  bool estimate_c_ = false;
+  bool c_in_problem_ = false;
+  double c_var_[1] = {0.0};
   double f_max_ = 0.0;  ///< mu m g; 0 when the trajectory lacks mass or friction
+  bool use_load_factor_ = false;  ///< LimitSurfaceLoadFactor on (config + force stream)
 };
 
 /// Fills the covariances of `states` (indices `steps` into builder steps) with ceres::Covariance
@@ -70,5 +80,7 @@ std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder,
                                const std::vector<int>& steps, std::vector<StateEstimate>& states);
 
 ceres::Solver::Options SolverOptions(int max_iterations, double function_tolerance);
+/// Prints the solver's full report to stderr when the environment sets PUSHGRAPH_SOLVER_LOG=1.
+void LogSummary(const char* what, const ceres::Solver::Summary& summary);
 
 }  // namespace pushgraph::graph::internal

@@ -52,6 +52,11 @@ std::string ResultToJson(const graph::EstimationResult& r, int indent) {
                  {"max_update_time_s", r.solver.max_update_time_s},
                  {"mean_update_time_s", r.solver.mean_update_time_s},
                  {"covariance", r.solver.covariance_status}};
+  if (r.c) {
+    nlohmann::json c = {{"c", *r.c}, {"estimated", r.c_estimated}};
+    if (r.c_sigma) c["c_sigma"] = *r.c_sigma;
+    j["parameters"] = std::move(c);
+  }
   if (!r.metrics.empty()) {
     Json m = Json::object();
     for (const auto& [k, v] : r.metrics) m[k] = v;

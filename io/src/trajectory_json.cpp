@@ -97,11 +97,37 @@ class Reader {
     return s;
   }
 
+  // {"object_pose": [trans, rot], "finger_pose": [trans, rot], "contact_point": s, "force": s}
+  limit_surface::MeasurementSigmas SigmasOf(const json& value, const std::string& path) const {
+    CheckKeys(value, {"object_pose", "finger_pose", "contact_point", "force"}, path);
+    limit_surface::MeasurementSigmas s;
+    auto pair = [&](const char* key, double* trans, double* rot) {
+      if (!value.contains(key)) return;
+      const json& v = value[key];
+      const std::string p = path + "." + key;
+      if (!v.is_array() || v.size() != 2) Fail(p, "must be [sigma_trans, sigma_rot], got " + v.dump());
+      *trans = NonNegative(v[0], p + "[0]");
+      *rot = NonNegative(v[1], p + "[1]");
+    };
+    pair("object_pose", &s.object_trans, &s.object_rot);
+    pair("finger_pose", &s.finger_trans, &s.finger_rot);
+    if (value.contains("contact_point")) s.contact = NonNegative(value["contact_point"], path + ".contact_point");
+    if (value.contains("force")) s.force = NonNegative(value["force"], path + ".force");
+    return s;
+  }
+
  private:
   std::string source_;
 };
 
 json ShapeJson(const geometry::Shape& shape) { return json::parse(geometry::ShapeToJson(shape, -1)); }
+
+json SigmasJson(const limit_surface::MeasurementSigmas& s) {
+  return {{"object_pose", {s.object_trans, s.object_rot}},
+          {"finger_pose", {s.finger_trans, s.finger_rot}},
+          {"contact_point", s.contact},
+          {"force", s.force}};
+}
 
 json StreamsJson(const Streams& s) {
   json out = json::object();
@@ -127,7 +153,7 @@ Trajectory ParseTrajectoryJson(const std::string& text, const std::string& sourc
     throw IoError(source + ": malformed JSON: " + e.what());
   }
   const Reader r(source);
-  r.CheckKeys(doc, {"format", "object", "finger", "streams", "ground_truth"}, "top level");
+  r.CheckKeys(doc, {"format", "object", "finger", "streams", "ground_truth", "measurement_sigmas"}, "top level");
   const json& format = r.Require(doc, "format", "top level");
   if (!format.is_string() || format.get<std::string>() != kTrajectoryFormat)
     r.Fail("format", std::string("expected \"") + kTrajectoryFormat + "\", got " + format.dump());
@@ -149,6 +175,8 @@ Trajectory ParseTrajectoryJson(const std::string& text, const std::string& sourc
   t.finger.mu_contact = r.NonNegative(r.Require(finger, "mu_contact", "finger"), "finger.mu_contact");
   if (doc.contains("streams")) t.measured = r.StreamsOf(doc["streams"], "streams");
   if (doc.contains("ground_truth")) t.ground_truth = r.StreamsOf(doc["ground_truth"], "ground_truth");
+  if (doc.contains("measurement_sigmas"))
+    t.measurement_sigmas = r.SigmasOf(doc["measurement_sigmas"], "measurement_sigmas");
   return t;
 }
 
@@ -170,6 +198,7 @@ std::string TrajectoryToJson(const Trajectory& t, int indent) {
   if (indent < 0) {
     json doc = {{"format", kTrajectoryFormat}, {"object", object}, {"finger", finger}, {"streams", StreamsJson(t.measured)}};
     if (t.ground_truth) doc["ground_truth"] = StreamsJson(*t.ground_truth);
+    if (t.measurement_sigmas) doc["measurement_sigmas"] = SigmasJson(*t.measurement_sigmas);
     return doc.dump();
   }
   auto streams = [](const Streams& s) {
@@ -188,6 +217,7 @@ std::string TrajectoryToJson(const Trajectory& t, int indent) {
   std::string out = "{\"format\": \"" + std::string(kTrajectoryFormat) + "\",\n \"object\": " + object.dump() +
                     ",\n \"finger\": " + finger.dump() + ",\n \"streams\": " + streams(t.measured);
   if (t.ground_truth) out += ",\n \"ground_truth\": " + streams(*t.ground_truth);
+  if (t.measurement_sigmas) out += ",\n \"measurement_sigmas\": " + SigmasJson(*t.measurement_sigmas).dump();
   return out + "}";
 }
 

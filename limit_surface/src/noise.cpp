@@ -190,4 +190,16 @@ Streams ApplyNoise(const Streams& truth, const NoiseModel& model, std::uint64_t 
   return out;
 }
 
+MeasurementSigmas SigmasOf(const NoiseModel& model) {
+  auto sigma = [](const ScalarNoise& n) { return n.kind == NoiseKind::kNone ? 0.0 : n.sigma; };
+  MeasurementSigmas s;
+  s.object_trans = sigma(model.object_pose.position);
+  s.object_rot = sigma(model.object_pose.angle);
+  s.finger_trans = sigma(model.finger_pose.position);
+  s.finger_rot = sigma(model.finger_pose.angle);
+  s.contact = sigma(model.contact_point.position);
+  s.force = sigma(model.force.position);
+  return s;
+}
+
 }  // namespace pushgraph::limit_surface

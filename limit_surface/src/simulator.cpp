@@ -223,6 +223,7 @@ SimulationResult Simulate(const PushPlan& plan) {
     stats.max_torque_residual = std::max(stats.max_torque_residual, s.response.torque_residual);
 
   traj.measured = ApplyNoise(truth, plan.noise, plan.seed);
+  traj.measurement_sigmas = SigmasOf(plan.noise);
   traj.ground_truth = std::move(truth);
   return result;
 }

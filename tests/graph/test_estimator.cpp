@@ -54,6 +54,64 @@ TEST(Estimator, ConfigParsingNamesBadKeys) {
   EXPECT_NE(message(R"({"losses": {"force": {"type": "tukey"}}})").find("tukey"), std::string::npos);
   EXPECT_NE(message(R"({"max_iterations": 2.5})").find("max_iterations"), std::string::npos);
   EXPECT_NE(message("{").find("cfg.json"), std::string::npos);
+  EXPECT_NE(message(R"({"contact_finger": "nearest"})").find("contact_finger"), std::string::npos);
+  EXPECT_NE(message(R"({"limit_surface_load": true})").find("limit_surface_load"), std::string::npos);
+  const EstimatorConfig d = ParseEstimatorConfig(R"({"contact_finger": "boundary", "limit_surface_load": "on"})");
+  EXPECT_EQ(d.contact_finger, EstimatorConfig::ContactFinger::kBoundary);
+  EXPECT_EQ(d.limit_surface_load, EstimatorConfig::LimitSurfaceLoad::kOn);
+  // A config file overrides a base (the trajectory's measurement sigmas) by name only.
+  EstimatorConfig base;
+  base.force_sigma = 0.123;
+  base.object_pose_sigma_trans = 0.007;
+  const EstimatorConfig over = ParseEstimatorConfig(R"({"force_sigma": 0.5})", "cfg.json", base);
+  EXPECT_EQ(over.force_sigma, 0.5);
+  EXPECT_EQ(over.object_pose_sigma_trans, 0.007);
+}
+
+// Joint estimation of c: started 40% too high, the estimate moves towards the value of the
+// simulated object and reports a sigma.
+TEST(Estimator, JointEstimationOfCMovesTowardsTheTruth) {
+  PushSpec spec = OffsetPush(7);
+  spec.contact_offset = 0.03;  // off-centre: rotation makes c observable
+  const limit_surface::Trajectory t = GeneratePush(spec);
+  EstimatorConfig cfg;
+  const double c_true = QuasiStaticGeometryFor(t, cfg).c;
+  cfg.c_scale = 1.4;
+  cfg.estimate_c = true;
+  cfg.c_prior_sigma = 1.0;  // weak: the data decide
+  const EstimationResult r = Estimate(t, Model::kQs, Mode::kBatch, cfg);
+  ASSERT_TRUE(r.c.has_value());
+  EXPECT_TRUE(r.c_estimated);
+  std::printf("[c] true %.5f, start %.5f, estimate %.5f (sigma %.5f)\n", c_true, 1.4 * c_true, *r.c,
+              r.c_sigma.value_or(-1.0));
+  EXPECT_LT(std::abs(*r.c - c_true), 0.5 * std::abs(1.4 * c_true - c_true));
+  ASSERT_TRUE(r.c_sigma.has_value());
+  EXPECT_GT(*r.c_sigma, 0.0);
+  // Off by default: c is reported but fixed.
+  cfg.estimate_c = false;
+  const EstimationResult fixed = Estimate(t, Model::kQs, Mode::kBatch, cfg);
+  EXPECT_FALSE(fixed.c_estimated);
+  EXPECT_DOUBLE_EQ(*fixed.c, 1.4 * c_true);
+}
+
+TEST(Estimator, MeasurementSigmasSetTheMeasurementFactors) {
+  limit_surface::MeasurementSigmas s;
+  s.object_trans = 0.002;
+  s.object_rot = 0.02;
+  s.finger_trans = 0.0005;
+  s.finger_rot = 0.0;  // noise-free: floored
+  s.contact = 0.001;
+  s.force = 0.05;
+  const EstimatorConfig c = ApplyMeasurementSigmas(EstimatorConfig{}, s);
+  EXPECT_EQ(c.object_pose_sigma_trans, 0.002);
+  EXPECT_EQ(c.object_pose_sigma_rot, 0.02);
+  EXPECT_EQ(c.finger_pose_sigma_trans, 0.0005);
+  EXPECT_EQ(c.finger_pose_sigma_rot, 1e-3);
+  EXPECT_EQ(c.contact_sigma, 0.001);
+  EXPECT_EQ(c.force_sigma, 0.05);
+  EXPECT_NO_THROW(ValidateConfig(c));
+  s.force = NAN;
+  EXPECT_THROW(ApplyMeasurementSigmas(EstimatorConfig{}, s), GraphError);
 }
 
 TEST(Estimator, BadTrajectoriesGetClearErrors) {

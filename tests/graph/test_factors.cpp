@@ -264,6 +264,49 @@ std::vector<QsCase> QuasiStaticCases(Rng& rng, const QuasiStaticGeometry& g) {
   return cases;
 }
 
+// C in its witness form: p against the midpoint of the exact witnesses, for disk and polygonal
+// fingers, apart and overlapping, at edges and at vertices of the object.
+TEST(FactorJacobians, ContactWitness) {
+  Rng rng;
+  JacobianTally tally("C witness");
+  WorstError worst{"C witness (contact point)"};
+  int checked = 0;
+  for (const Shape& obj : {Shape::Box(0.09, 0.09), Shape::RegularPolygon(5, 0.06)}) {
+    for (const Shape& fin : {Shape::Disk(0.005), Shape::Box(0.01, 0.004)}) {
+      auto querier = std::make_shared<const geometry::ShapePairQuerier>(obj, fin);
+      ContactWitnessFactor factor(querier, 5e-4);
+      for (int i = 0; i < 80; ++i) {
+        const Pose2 x = rng.P(0.1);
+        const auto& ring = obj.polygons()[0].outer;
+        const int k = i % static_cast<int>(ring.size());
+        const Vec2 a = ring[k], b = ring[(k + 1) % ring.size()];
+        const double s = i % 4 == 0 ? 0.0 : rng.U(0.1, 0.9);
+        const Vec2 on = a + s * (b - a);
+        const Vec2 n_out = s == 0.0 ? on.normalized() : Vec2((b - a).y(), -(b - a).x()).normalized();
+        const Vec2 c = on + n_out * (0.005 + rng.U(-0.003, 0.003));
+        const Pose2 e = geometry::Compose(x, Pose2{c.x(), c.y(), rng.U(-0.3, 0.3)});
+        const Vec2 p = geometry::Act(x, on) + Vec2(rng.U(-1e-3, 1e-3), rng.U(-1e-3, 1e-3));
+        CheckCost(factor, {V(x), V(e), V(p)}, tally, worst, "witness " + std::to_string(i));
+        ++checked;
+        // Where the shapes touch, p at the touching point has zero residual.
+        if (i % 10 == 0) {
+          const auto r = querier->Query(x, e);
+          const Vec2 mid = 0.5 * (r.object_point + r.finger_point);
+          Eigen::Vector3d xv = x.vector(), ev = e.vector();
+          Eigen::Vector2d pv = mid;
+          const double* ps[3] = {xv.data(), ev.data(), pv.data()};
+          double res[2];
+          ASSERT_TRUE(factor.Evaluate(ps, res, nullptr));
+          EXPECT_EQ(res[0], 0.0);
+          EXPECT_EQ(res[1], 0.0);
+        }
+      }
+    }
+  }
+  EXPECT_EQ(checked, 320);
+  EXPECT_TRUE(tally.MostlyChecked(0.8));
+}
+
 TEST(FactorJacobians, QuasiStaticBothForms) {
   Rng rng;
   QuasiStaticGeometry g;
@@ -275,13 +318,18 @@ TEST(FactorJacobians, QuasiStaticBothForms) {
   QuasiStaticFactor d(g, 1e-3, 0.05, 0.1);
   LimitSurfaceLoadFactor l(g, 2.0, 1e-3, 0.05, 0.1);
   CrossMultipliedQuasiStaticFactor y(g, 1e-3);
+  QuasiStaticFactorWithC dc(g, 1e-3, 0.05, 0.1);
+  JacobianTally tc("D with c");
+  WorstError wc{"D with c as a variable"};
   int n = 0;
   for (const QsCase& c : QuasiStaticCases(rng, g)) {
     const std::string ctx = "case " + std::to_string(n++);
     CheckCost(d, {V(c.x_prev), V(c.x), V(c.p), V(c.f)}, td, wd, ctx);
     CheckCost(y, {V(c.x_prev), V(c.x), V(c.p), V(c.f)}, ty, wy, ctx);
     CheckCost(l, {V(c.x_prev), V(c.x), V(c.p), V(c.f)}, tl, wl, ctx);
+    CheckCost(dc, {V(c.x_prev), V(c.x), V(c.p), V(c.f), V({g.c * rng.U(0.5, 2.0)})}, tc, wc, ctx);
   }
+  EXPECT_TRUE(tc.MostlyChecked(0.95));
   EXPECT_TRUE(tl.MostlyChecked(0.95));
   EXPECT_TRUE(td.MostlyChecked(0.95));
   EXPECT_TRUE(ty.MostlyChecked(0.95));
@@ -331,6 +379,55 @@ TEST(FactorSemantics, QuasiStaticVanishesExactlyOnTheEllipsoidAndIsInformativeIn
       EXPECT_LT(Residual(y, bad).norm(), 1e-12);
     }
   }
+}
+
+// Rotation-dominated pushes (far off-centre contact: about 97% of |V'| is c omega) and pure
+// rotation: D stays finite, vanishes on the ellipsoid's motion and sees a wrong one, where the
+// paper's Eq. 8 (v / omega - c^2 f / tau) would be ill-conditioned only in translation and
+// the baseline's form loses its third component.
+TEST(FactorSemantics, QuasiStaticIsInformativeInRotation) {
+  QuasiStaticGeometry g;
+  g.c = 0.0344;
+  g.dt = 0.004;
+  QuasiStaticFactor d(g, 1e-3, 0.05, 0.1);
+  for (double offset : {0.2, 1.0, -1.0}) {
+    const Vec2 q(-0.045, offset);
+    const Vec2 fb(1.5, 0.0);
+    const double tau = q.x() * fb.y() - q.y() * fb.x();
+    const double k = 0.05 / fb.norm();
+    const Eigen::Vector3d xi(k * fb.x(), k * fb.y(), k * tau / (g.c * g.c));
+    ASSERT_GT(std::abs(g.c * xi.z()), 5.0 * xi.head<2>().norm()) << offset;  // rotation-dominated
+    QsCase c;
+    c.x_prev = Pose2{0.1, 0.2, 0.3};
+    c.x = geometry::Compose(c.x_prev, geometry::Exp(xi * g.dt));
+    c.p = geometry::Act(c.x, q);
+    c.f = c.x.rotation() * fb;
+    EXPECT_LT(Residual(d, c).norm(), 1e-9) << offset;
+    // Tilt the twist 20 degrees in the (v_x, c omega) plane: D sees it.
+    const double cw = g.c * xi.z();
+    Eigen::Vector3d bad = xi;
+    bad.x() = xi.x() * std::cos(0.35) - cw * std::sin(0.35);
+    bad.z() = (xi.x() * std::sin(0.35) + cw * std::cos(0.35)) / g.c;
+    QsCase b = c;
+    b.x = geometry::Compose(c.x_prev, geometry::Exp(bad * g.dt));
+    b.p = geometry::Act(b.x, q);
+    b.f = b.x.rotation() * fb;
+    EXPECT_GT(Residual(d, b).norm() * 0.1, 0.2) << offset;
+  }
+  // Pure rotation about the centre of pressure while pushed off-centre: not what the ellipsoid
+  // predicts for a point force, so D is non-zero, finite, with finite Jacobians.
+  QsCase c;
+  c.x_prev = Pose2{0.0, 0.0, 0.0};
+  c.x = Pose2{0.0, 0.0, 0.01};
+  c.p = geometry::Act(c.x, Vec2(-0.045, 0.03));
+  c.f = Vec2(1.0, 0.0);
+  const Eigen::VectorXd r = Residual(d, c);
+  EXPECT_TRUE(r.allFinite());
+  EXPECT_GT(r.norm() * 0.1, 0.1);
+  Rng rng;
+  JacobianTally tally("D pure rotation");
+  WorstError worst{"D pure rotation"};
+  CheckCost(d, {V(c.x_prev), V(c.x), V(c.p), V(c.f)}, tally, worst, "pure rotation");
 }
 
 TEST(FactorSemantics, BadSigmasAndStepsAreRejected) {

@@ -63,6 +63,25 @@ void ExpectError(const std::string& text, const std::string& needle) {
   }
 }
 
+TEST(TrajectoryJson, MeasurementSigmasRoundTripAndAreChecked) {
+  const auto t = ParseTrajectoryJson(Doc(
+      "{}", R"(, "measurement_sigmas": {"object_pose": [0.002, 0.02], "finger_pose": [0.0005, 0], "contact_point": 0.001, "force": 0.05})"));
+  ASSERT_TRUE(t.measurement_sigmas.has_value());
+  EXPECT_EQ(t.measurement_sigmas->object_rot, 0.02);
+  EXPECT_EQ(t.measurement_sigmas->finger_trans, 0.0005);
+  EXPECT_EQ(t.measurement_sigmas->force, 0.05);
+  for (int indent : {-1, 1}) {
+    const auto u = ParseTrajectoryJson(TrajectoryToJson(t, indent));
+    ASSERT_TRUE(u.measurement_sigmas.has_value());
+    EXPECT_EQ(u.measurement_sigmas->contact, 0.001);
+    EXPECT_EQ(u.measurement_sigmas->object_trans, 0.002);
+  }
+  EXPECT_FALSE(ParseTrajectoryJson(Doc("{}")).measurement_sigmas.has_value());
+  ExpectError(Doc("{}", R"(, "measurement_sigmas": {"force": -1})"), "measurement_sigmas.force");
+  ExpectError(Doc("{}", R"(, "measurement_sigmas": {"object_pose": 0.1})"), "measurement_sigmas.object_pose");
+  ExpectError(Doc("{}", R"(, "measurement_sigmas": {"gps": 1})"), "unknown field \"gps\"");
+}
+
 TEST(TrajectoryJson, BadInputNamesFileAndPath) {
   ExpectError("{", "malformed JSON");
   ExpectError(Doc("{}", R"(, "extra": 1)"), "unknown field \"extra\"");

@@ -131,7 +131,7 @@ TEST_F(CliTest, PenetrationBadPoseIsOneClearLine) {
 
 TEST_F(CliTest, DemoRunsOnShippedShapesAndWritesSvg) {
   const std::string svg = (dir_ / "demo.svg").string();
-  const ToolRun r = Exec("demo --data " PUSHGRAPH_SOURCE_DIR "/data --svg " + svg);
+  const ToolRun r = Exec("demo --geometry --data " PUSHGRAPH_SOURCE_DIR "/data --svg " + svg);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("0 of 20000 random points differ from brute force"), std::string::npos) << r.out;
   EXPECT_TRUE(fs::exists(svg));

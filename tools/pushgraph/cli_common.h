@@ -24,6 +24,7 @@ void RegisterLimitSurface(CLI::App& app);
 void RegisterSimulate(CLI::App& app);
 void RegisterDemo(CLI::App& app);
 void RegisterEstimate(CLI::App& app);
+void RegisterEvaluate(CLI::App& app);
 void RegisterFootprint(CLI::App& app);
 void RegisterMitImport(CLI::App& app);
 

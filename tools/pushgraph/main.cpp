@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   RegisterDemo(app);
 #ifdef PUSHGRAPH_WITH_GRAPH
   RegisterEstimate(app);
+  RegisterEvaluate(app);
 #endif
   RegisterFootprint(app);
   RegisterMitImport(app);

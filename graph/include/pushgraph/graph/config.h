@@ -10,6 +10,8 @@
 //   graph::EstimatorConfig cfg = graph::LoadEstimatorConfig("config.json");
 //
 // Unknown keys, wrong types, non-positive sigmas and NaN are errors (GraphError naming the key).
+#include <pushgraph/limit_surface/trajectory.h>
+
 #include <string>
 
 namespace pushgraph::graph {
@@ -31,7 +33,13 @@ struct EstimatorConfig {
   double force_sigma = 0.5;                ///< N
   // C and S: geometric consistency (stiff).
   double contact_object_sigma = 5e-4;  ///< m, contact point on the object boundary
-  double contact_finger_sigma = 5e-4;  ///< m, contact point on the finger boundary
+  double contact_finger_sigma = 5e-4;  ///< m, contact point on the finger (witness or boundary)
+  /// How C ties p to the finger: kWitness, p = the midpoint of the exact shape-pair witnesses
+  /// (well-posed, the default); kBoundary, p on the finger's boundary (the paper's literal
+  /// C(p, e); ill-conditioned near tangency, see ContactWitnessFactor). JSON "contact_finger":
+  /// "witness" | "boundary".
+  enum class ContactFinger { kWitness, kBoundary };
+  ContactFinger contact_finger = ContactFinger::kWitness;
   double touching_sigma = 5e-4;        ///< m, signed separation of finger and object
   double intersection_sigma = 5e-4;    ///< m, S
   // V: white-noise-acceleration spectral densities; sigma = q sqrt((dt1 + dt2) / 2).
@@ -40,14 +48,30 @@ struct EstimatorConfig {
   // D: the normalized cross-product quasi-static factor (dimensionless, about sin(angle)).
   // Sigmas of D and of the limit-surface load are for a 10 ms step; a step of dt gets
   // sigma sqrt(0.01 / dt), so the information per second does not depend on the input rate.
-  double quasi_static_sigma = 0.1;
+  // 0.3 (about 17 degrees) covers the ellipsoid's error against the exact limit surface (mean 5,
+  // max 10-20 degrees, docs/limit_surface.md) and per-step velocity noise; 0.1 made the
+  // covariances overconfident (object-pose NEES 9-27 for dimension 3 on simulated pushes).
+  double quasi_static_sigma = 0.3;
   double eps_velocity = 1e-3;  ///< m/s, regularizes |V'| in D
   double eps_force = 0.05;     ///< N, regularizes |g'| in D
   double c = 0.0;              ///< m; 0: from the object's limit surface (uniform pressure)
   double c_scale = 1.0;        ///< multiplies c (published fits are about 1.11 on real data)
+  /// Estimate c jointly with the trajectory (QS, batch): one shared variable, started at the
+  /// c above, with a Gaussian prior of relative sigma c_prior_sigma around it and bounded to
+  /// [0.2, 5] times it. The estimate and its sigma are in EstimationResult::c.
+  bool estimate_c = false;
+  double c_prior_sigma = 0.3;  ///< relative
+  /// When the limit-surface load factor is used: kAuto (the default) only without a force
+  /// stream, where it is the sole information on the force magnitude; with force measurements
+  /// it adds little and its rest/sliding gate (|V'| against eps_velocity) slows convergence
+  /// 2-4x. JSON "limit_surface_load": "auto" | "on" | "off".
+  enum class LimitSurfaceLoad { kAuto, kOn, kOff };
+  LimitSurfaceLoad limit_surface_load = LimitSurfaceLoad::kAuto;
   double limit_surface_sigma = 0.1;  ///< relative, |load| = f_max while sliding (0.875-1.03 exact/ellipsoid)
-  double force_prior_sigma = 100.0;
-  double force_random_walk = 10.0;  ///< N/sqrt(s), force continuity between consecutive steps  ///< N, weak prior f ~ N(0, s^2) keeping |f| observable
+  double force_prior_sigma = 100.0;  ///< N, weak prior f ~ N(0, s^2) keeping |f| observable
+  /// N/sqrt(s): force continuity between consecutive steps (a random walk). 3 halves the force
+  /// error of 10 under the paper's 0.5 N noise on simulated pushes (0.25 vs 0.39 N RMS).
+  double force_random_walk = 3.0;
   // The Yu-Rodriguez 2018 baseline.
   double yu_quasi_static_sigma = 2e-4;  ///< m^2 N / s, cross-multiplied residual
   double random_walk_trans = 0.05;      ///< m/sqrt(s), zero-velocity prior
@@ -69,10 +93,21 @@ struct EstimatorConfig {
   int incremental_max_iterations = 50;
 };
 
-/// Parses a JSON object overriding fields of the defaults; `source` names the input in errors.
+/// Parses a JSON object overriding fields of `base` (the defaults unless given); `source` names
+/// the input in errors.
 EstimatorConfig ParseEstimatorConfig(const std::string& json_text,
-                                     const std::string& source = "<config>");
-EstimatorConfig LoadEstimatorConfig(const std::string& path);
+                                     const std::string& source = "<config>",
+                                     const EstimatorConfig& base = {});
+EstimatorConfig LoadEstimatorConfig(const std::string& path, const EstimatorConfig& base = {});
+
+/// `config` with its measurement sigmas (M factors) set to the known noise of the data
+/// (limit_surface::Trajectory::measurement_sigmas), so covariances are consistent. Zero
+/// (noise-free) sigmas are floored at 1e-4 m, 1e-3 rad and 1e-3 N: an exact measurement would
+/// make the problem infinitely stiff.
+///
+///   cfg = graph::ApplyMeasurementSigmas(cfg, *traj.measurement_sigmas);
+EstimatorConfig ApplyMeasurementSigmas(EstimatorConfig config,
+                                       const limit_surface::MeasurementSigmas& sigmas);
 /// Checks every field (positive sigmas, finite values, window >= update_every >= 1).
 void ValidateConfig(const EstimatorConfig& config);
 

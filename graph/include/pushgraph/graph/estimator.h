@@ -65,6 +65,10 @@ struct EstimationResult {
   Mode mode = Mode::kBatch;
   std::vector<StateEstimate> states;
   SolverStats solver;
+  /// The limit-surface ratio c used by D (m); estimated when config.estimate_c (QS batch),
+  /// with its marginal sigma (c_sigma, when covariances were computed).
+  std::optional<double> c, c_sigma;
+  bool c_estimated = false;
   /// RMS errors against the trajectory's ground truth (empty without it): object_position_rms
   /// (m), object_rotation_rms (rad), finger_position_rms, finger_rotation_rms, contact_rms (m),
   /// force_rms (N); the same of the raw measurements as measured_*; and the mean normalized

@@ -95,6 +95,26 @@ class TouchingFactor : public ceres::SizedCostFunction<1, 3, 3> {
   double w_;
 };
 
+/// C(p_t, x_t, e_t), well-posed form: the contact point is where the shapes meet,
+///   r = (p - (object_point + finger_point) / 2) / sigma,
+/// the midpoint of the exact shape-pair witnesses (closest pair when apart, deepest finger point
+/// delta and its projection G_delta when overlapping; they coincide when touching). "p on the
+/// finger boundary" (BoundaryPointFactor on the finger) pins p to the intersection of two
+/// boundaries, which near tangency (a rounded finger touching an edge) moves like
+/// sqrt(overlap): 0.1 mm of overlap lets p slide 1 mm along the edge, and Levenberg-Marquardt
+/// crawls. The witness is a smooth function of both poses. Parameters: object pose (3), finger
+/// pose (3), contact point (2).
+class ContactWitnessFactor : public ceres::SizedCostFunction<2, 3, 3, 2> {
+ public:
+  ContactWitnessFactor(std::shared_ptr<const geometry::ShapePairQuerier> querier, double sigma);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  std::shared_ptr<const geometry::ShapePairQuerier> querier_;
+  double w_;
+};
+
 /// S: one-sided intersection penalty r = (G_delta - delta) / sigma when the finger and the
 /// object overlap (delta the deepest finger point, G_delta its projection onto the object
 /// boundary), r = 0 when apart. Parameters: object pose (3), finger pose (3).
@@ -189,6 +209,21 @@ class QuasiStaticFactor : public ceres::SizedCostFunction<3, 3, 3, 2, 2> {
  public:
   QuasiStaticFactor(const QuasiStaticGeometry& geometry, double eps_velocity, double eps_force,
                     double sigma);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  QuasiStaticGeometry geometry_;
+  double eps_v_, eps_f_, w_;
+};
+
+/// D with the limit-surface ratio c as a fifth parameter block (1), shared by every step, to
+/// estimate c jointly with the trajectory (EstimatorConfig::estimate_c). Same residual as
+/// QuasiStaticFactor; Evaluate fails (Ceres shortens the step) for c <= 0.
+class QuasiStaticFactorWithC : public ceres::SizedCostFunction<3, 3, 3, 2, 2, 1> {
+ public:
+  QuasiStaticFactorWithC(const QuasiStaticGeometry& geometry, double eps_velocity, double eps_force,
+                         double sigma);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 

@@ -18,6 +18,8 @@
 
 #include <ceres/cost_function.h>
 
+#include <Eigen/Core>
+
 #include <memory>
 #include <vector>
 

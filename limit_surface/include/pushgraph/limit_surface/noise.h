@@ -90,4 +90,7 @@ void ValidateNoise(const NoiseModel& model);
 /// The measured streams: ground truth plus noise, occlusion, outliers and frozen force.
 Streams ApplyNoise(const Streams& truth, const NoiseModel& model, std::uint64_t seed);
 
+/// The per-axis standard deviations of a noise model (outliers and occlusion windows aside).
+MeasurementSigmas SigmasOf(const NoiseModel& model);
+
 }  // namespace pushgraph::limit_surface

@@ -54,11 +54,24 @@ struct FingerDescription {
   double mu_contact = 0.0;  ///< finger-object friction coefficient
 };
 
+/// Standard deviations of the measurement noise (per axis), when known: simulated pushes and
+/// recordings with added noise carry them so an estimator can weight its measurement factors
+/// to match (graph::ApplyMeasurementSigmas). 0 means noise-free.
+struct MeasurementSigmas {
+  double object_trans = 0.0;  ///< m
+  double object_rot = 0.0;    ///< rad
+  double finger_trans = 0.0;  ///< m
+  double finger_rot = 0.0;    ///< rad
+  double contact = 0.0;       ///< m
+  double force = 0.0;         ///< N
+};
+
 struct Trajectory {
   ObjectDescription object;
   FingerDescription finger;
   Streams measured;
   std::optional<Streams> ground_truth;
+  std::optional<MeasurementSigmas> measurement_sigmas;
 };
 
 }  // namespace pushgraph::limit_surface

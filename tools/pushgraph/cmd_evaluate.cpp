@@ -1,0 +1,296 @@
+// pushgraph evaluate [INPUTS...] [--simulate N] [--protocol LIST] [-j N] [--shard K/N] --out DIR
+// pushgraph evaluate merge DIR... --out DIR
+// The paper's evaluation protocols (Tables I, II, Fig. 5, occlusion, consistency, runtime) over
+// MIT recordings, trajectory files and simulated pushes, in parallel, sharded for job arrays
+// (docs/evaluation.md). The logic is io/evaluation.h; this file parses options, shows progress
+// and writes files.
+#include "cli_common.h"
+
+#include <pushgraph/io/evaluation.h>
+#include <pushgraph/io/footprint.h>
+#include <pushgraph/io/trajectory_json.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include <unistd.h>
+
+namespace pushgraph::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct EvaluateOptions {
+  std::vector<std::string> inputs;
+  int simulate = 0;
+  std::string sim_object = DefaultDataDir() + "/shapes/notched_block.json";
+  std::string sim_finger = DefaultDataDir() + "/shapes/disk_finger_5mm.json";
+  double sim_mass = 0.5, sim_mu = 0.3, sim_mu_contact = 0.4;
+  std::string protocols = "all";
+  std::string object, finger;
+  double mass = 0.0, mu = -1.0, mu_contact = 0.25;
+  std::string mesh_dir;
+  std::string config;
+  std::string estimator_config;
+  std::uint64_t seed = 1;
+  double mit_rate = 100.0;
+  double occlusion_fraction = 0.4;
+  std::string occlusion_mode = "batch";
+  int jobs = 0;
+  std::string shard;
+  std::string out;
+  std::vector<std::string> merge;
+  bool quiet = false;
+};
+
+geometry::Shape LoadShape(const std::string& path, const std::string& what) {
+  try {
+    return geometry::LoadShapeJson(path);
+  } catch (const std::exception& e) {
+    throw CliError(what + " " + path + ": " + e.what());
+  }
+}
+
+// A shape in the evaluation config: "shape.json", or {"mesh": "x.obj", "up": "z", "scale": 1}.
+geometry::Shape ConfigShape(const nlohmann::json& j, const fs::path& base, const std::string& where) {
+  auto resolve = [&](const std::string& p) { return fs::path(p).is_absolute() ? p : (base / p).string(); };
+  if (j.is_string()) return LoadShape(resolve(j.get<std::string>()), where);
+  if (j.is_object() && j.contains("mesh")) {
+    io::FootprintOptions o;
+    for (const auto& [k, v] : j.items()) {
+      if (k != "mesh" && k != "up" && k != "scale") throw CliError(where + ": unknown key '" + k + "' (mesh, up, scale)");
+    }
+    if (j.contains("up")) o.up = io::ParseUpAxis(j["up"].get<std::string>());
+    if (j.contains("scale")) o.scale = j["scale"].get<double>();
+    return io::MeshFootprint(resolve(j["mesh"].get<std::string>()), o);
+  }
+  throw CliError(where + ": expected a shape file name or {\"mesh\": FILE.obj, \"up\": \"z\", \"scale\": 1}");
+}
+
+// {"mesh_dir": DIR, "estimator": {...EstimatorConfig keys...},
+//  "objects": {"ellip1": {"shape": ..., "finger": ..., "mass": kg, "mu_surface": mu, "mu_contact": mu}}}
+void LoadEvaluationConfig(const std::string& path, io::EvaluationOptions* options) {
+  std::ifstream in(path);
+  if (!in) throw CliError("--config " + path + ": cannot open file");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw CliError("--config " + path + ": malformed JSON: " + e.what());
+  }
+  if (!j.is_object()) throw CliError("--config " + path + ": expected a JSON object");
+  const fs::path base = fs::path(path).parent_path();
+  try {
+    for (const auto& [key, value] : j.items()) {
+      if (key == "mesh_dir") {
+        const std::string d = value.get<std::string>();
+        options->mesh_dir = fs::path(d).is_absolute() ? d : (base / d).string();
+      } else if (key == "estimator") {
+        options->estimator = graph::ParseEstimatorConfig(value.dump(), path + " (estimator)");
+      } else if (key == "objects") {
+        for (const auto& [name, o] : value.items()) {
+          const std::string where = path + ": objects." + name;
+          io::ObjectModel m;
+          for (const auto& [k, v] : o.items()) {
+            if (k == "shape") m.shape = ConfigShape(v, base, where + ".shape");
+            else if (k == "finger") m.finger = ConfigShape(v, base, where + ".finger");
+            else if (k == "mass") m.mass = v.get<double>();
+            else if (k == "mu_surface") m.mu_surface = v.get<double>();
+            else if (k == "mu_contact") m.mu_contact = v.get<double>();
+            else throw CliError(where + ": unknown key '" + k + "' (shape, finger, mass, mu_surface, mu_contact)");
+          }
+          if (m.shape.empty() || m.finger.empty()) throw CliError(where + ": needs both 'shape' and 'finger'");
+          if (!(m.mass > 0.0) || !std::isfinite(m.mass)) throw CliError(where + ".mass must be a number > 0");
+          if (!(m.mu_surface >= 0.0) || !(m.mu_contact >= 0.0)) throw CliError(where + ": friction must be >= 0");
+          options->objects[name] = m;
+        }
+      } else {
+        throw CliError(path + ": unknown key '" + key + "' (mesh_dir, estimator, objects)");
+      }
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw CliError(path + ": " + e.what());
+  }
+}
+
+// Progress on stderr: one updating line on a terminal, else a plain line every ~10% or 30 s.
+class Progress {
+ public:
+  explicit Progress(bool quiet) : quiet_(quiet), tty_(::isatty(2) == 1), start_(Clock::now()), last_(start_) {}
+  void Update(int done, int total, int failed, const io::EvaluationRow& row) {
+    if (!row.error.empty()) {
+      if (tty_) std::cerr << "\r\033[K";
+      std::cerr << "evaluate: error: " << row.error << "\n";
+    }
+    if (quiet_) return;
+    const double elapsed = Seconds(start_);
+    const double eta = done > 0 ? elapsed / done * (total - done) : 0.0;
+    char line[200];
+    std::snprintf(line, sizeof line, "evaluate: %d/%d trajectories (%d%%), %d failed, %.0f s elapsed, ~%.0f s left, last %s",
+                  done, total, total > 0 ? 100 * done / total : 100, failed, elapsed, eta, row.name.c_str());
+    if (tty_) {
+      std::cerr << "\r\033[K" << line << (done == total ? "\n" : "") << std::flush;
+    } else if (done == total || done % std::max(1, total / 10) == 0 || Seconds(last_) > 30.0) {
+      std::cerr << line << "\n";
+      last_ = Clock::now();
+    }
+  }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  static double Seconds(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+  bool quiet_, tty_;
+  Clock::time_point start_, last_;
+};
+
+void PrintTables(const std::string& out_dir, const std::vector<io::EvaluationRow>& rows, const std::string& settings) {
+  const std::vector<io::Table> tables = io::MakeTables(rows, settings);
+  std::cout << io::WriteTables(out_dir, tables, rows);
+  std::cerr << "evaluate: tables written to " << out_dir << " (results.md, TABLE.md, TABLE.csv, rows.jsonl)\n";
+}
+
+void RunMerge(const std::vector<std::string>& dirs, const std::string& out) {
+  if (out.empty()) throw CliError("evaluate merge: --out DIR is required");
+  io::RowsHeader header;
+  const std::vector<io::EvaluationRow> rows = io::MergeRows(dirs, &header);
+  fs::create_directories(out);
+  io::RowsHeader merged = header;
+  merged.shard = 0;
+  merged.shards = 1;
+  io::WriteRows((fs::path(out) / "rows.jsonl").string(), merged, rows);
+  PrintTables(out, rows, header.settings_json);
+}
+
+void RunEvaluate(const EvaluateOptions& o) {
+  if (!o.merge.empty()) return RunMerge(o.merge, o.out);
+  io::EvaluationOptions options;
+  options.protocols = io::ParseProtocols(o.protocols);
+  options.seed = o.seed;
+  if (!std::isfinite(o.mit_rate) || o.mit_rate < 0.0) throw CliError("--mit-rate must be >= 0 (0 keeps every sample)");
+  options.mit_rate = o.mit_rate;
+  if (!(o.occlusion_fraction > 0.0 && o.occlusion_fraction < 1.0)) throw CliError("--occlusion-fraction must be in (0, 1)");
+  options.occlusion_fraction = o.occlusion_fraction;
+  options.occlusion_mode = graph::ParseMode(o.occlusion_mode);
+  options.mesh_dir = o.mesh_dir;
+  if (!o.config.empty()) LoadEvaluationConfig(o.config, &options);
+  if (!o.estimator_config.empty()) options.estimator = graph::LoadEstimatorConfig(o.estimator_config);
+  const bool any_override = !o.object.empty() || !o.finger.empty() || o.mass > 0.0 || o.mu >= 0.0;
+  if (any_override) {
+    if (o.object.empty() || o.finger.empty() || !(o.mass > 0.0) || !(o.mu >= 0.0))
+      throw CliError("--object, --finger, --mass and --mu go together (they describe every MIT recording)");
+    io::ObjectModel m;
+    m.shape = LoadShape(o.object, "--object");
+    m.finger = LoadShape(o.finger, "--finger");
+    m.mass = o.mass;
+    m.mu_surface = o.mu;
+    m.mu_contact = o.mu_contact;
+    options.object_override = m;
+  }
+  if (o.simulate < 0) throw CliError("--simulate must be >= 0");
+  options.simulation.count = o.simulate;
+  if (o.simulate > 0) {
+    options.simulation.object.shape = LoadShape(o.sim_object, "--sim-object");
+    options.simulation.object.finger = LoadShape(o.sim_finger, "--sim-finger");
+    if (!(o.sim_mass > 0.0) || !(o.sim_mu > 0.0) || !(o.sim_mu_contact >= 0.0))
+      throw CliError("--sim-mass and --sim-mu must be > 0, --sim-mu-contact >= 0");
+    options.simulation.object.mass = o.sim_mass;
+    options.simulation.object.mu_surface = o.sim_mu;
+    options.simulation.object.mu_contact = o.sim_mu_contact;
+    options.simulation.name = "sim:" + fs::path(o.sim_object).stem().string();
+  }
+  if (o.out.empty()) throw CliError("--out DIR is required");
+
+  const std::vector<std::string> files = o.inputs.empty() ? std::vector<std::string>{} : io::ExpandInputs(o.inputs);
+  const std::vector<io::EvaluationItem> all = io::PlanEvaluation(files, options);
+  if (all.empty()) throw CliError("nothing to evaluate: give recordings/trajectories or --simulate N");
+  int shard = 0, shards = 1;
+  if (!o.shard.empty()) std::tie(shard, shards) = io::ParseShard(o.shard);
+  const std::vector<io::EvaluationItem> items = io::ShardItems(all, shard, shards);
+  const std::string settings = options.SettingsJson();
+
+  std::cerr << "evaluate: " << items.size() << " of " << all.size() << " trajectories";
+  if (shards > 1) std::cerr << " (shard " << shard << "/" << shards << ")";
+  std::cerr << ", protocols " << o.protocols << "\n";
+  Progress progress(o.quiet);
+  const std::vector<io::EvaluationRow> rows =
+      io::RunEvaluation(items, options, o.jobs, [&](int done, int total, int failed, const io::EvaluationRow& row) {
+        progress.Update(done, total, failed, row);
+      });
+  int failed = 0;
+  for (const io::EvaluationRow& r : rows) failed += r.error.empty() ? 0 : 1;
+
+  std::error_code ec;
+  fs::create_directories(o.out, ec);
+  if (ec) throw CliError("--out " + o.out + ": cannot create folder (" + ec.message() + ")");
+  io::RowsHeader header{shard, shards, static_cast<int>(all.size()), settings};
+  if (shards > 1) {
+    const std::string path =
+        (fs::path(o.out) / ("rows-" + std::to_string(shard) + "-of-" + std::to_string(shards) + ".jsonl")).string();
+    io::WriteRows(path, header, rows);
+    std::cerr << "evaluate: shard rows written to " << path << "; combine with `pushgraph evaluate merge DIR...`\n";
+  } else {
+    io::WriteRows((fs::path(o.out) / "rows.jsonl").string(), header, rows);
+    PrintTables(o.out, rows, settings);
+  }
+  if (failed > 0) std::cerr << "evaluate: " << failed << " of " << rows.size() << " trajectories failed (listed above)\n";
+  if (!rows.empty() && failed == static_cast<int>(rows.size())) throw CliError("every trajectory failed");
+}
+
+}  // namespace
+
+void RegisterEvaluate(CLI::App& app) {
+  auto o = std::make_shared<EvaluateOptions>();
+  CLI::App* cmd = app.add_subcommand("evaluate", "Run the paper's evaluation protocols over many pushes (tables as Markdown/CSV)");
+  cmd->add_option("inputs", o->inputs, "MIT recordings (.h5/.json) or trajectory files: files, folders (recursive) or globs");
+  cmd->add_option("--simulate", o->simulate, "Also evaluate N seeded simulated pushes (varied direction and offset)")
+      ->capture_default_str();
+  cmd->add_option("--sim-object", o->sim_object, "Shape of the simulated pushes' object")->capture_default_str();
+  cmd->add_option("--sim-finger", o->sim_finger, "Finger of the simulated pushes")->capture_default_str();
+  cmd->add_option("--sim-mass", o->sim_mass, "Simulated object's mass (kg)")->capture_default_str();
+  cmd->add_option("--sim-mu", o->sim_mu, "Simulated object-table friction")->capture_default_str();
+  cmd->add_option("--sim-mu-contact", o->sim_mu_contact, "Simulated finger-object friction")->capture_default_str();
+  cmd->add_option("--protocol", o->protocols, "table1,table2,fig5,occlusion,consistency,runtime or all")
+      ->capture_default_str();
+  cmd->add_option("--object", o->object, "Object shape JSON for every MIT recording (with --finger --mass --mu)");
+  cmd->add_option("--finger", o->finger, "Probe shape JSON for every MIT recording");
+  cmd->add_option("--mass", o->mass, "Object mass (kg) for every MIT recording");
+  cmd->add_option("--mu", o->mu, "Object-table friction for every MIT recording");
+  cmd->add_option("--mu-contact", o->mu_contact, "Finger-object friction with --object")->capture_default_str();
+  cmd->add_option("--mesh-dir", o->mesh_dir,
+                  "Folder with the dataset's NAME.obj and tip.obj (default: an obj/ folder beside or above each recording)");
+  cmd->add_option("--config", o->config, "Evaluation config JSON: objects, mesh_dir, estimator (docs/evaluation.md)");
+  cmd->add_option("--estimator-config", o->estimator_config, "Estimator configuration JSON (docs/estimation.md)");
+  cmd->add_option("--seed", o->seed, "Base seed of the added noise and the simulated pushes")->capture_default_str();
+  cmd->add_option("--mit-rate", o->mit_rate, "MIT streams thinned to at most this rate (Hz, the paper's 100; 0: all)")
+      ->capture_default_str();
+  cmd->add_option("--occlusion-fraction", o->occlusion_fraction, "Occluded middle fraction of each push")
+      ->capture_default_str();
+  cmd->add_option("--occlusion-mode", o->occlusion_mode, "Solver of the occlusion protocol: batch or incremental")
+      ->check(CLI::IsMember({"batch", "incremental"}))
+      ->capture_default_str();
+  cmd->add_option("-j,--jobs", o->jobs, "Worker threads (default: all cores)");
+  cmd->add_option("--shard", o->shard, "Evaluate only items with index % N == K and write their rows (K/N)");
+  cmd->add_option("--out", o->out, "Output folder (tables, rows)");
+  cmd->add_option("--merge", o->merge, "Merge the rows of shard folders/files instead of evaluating")
+      ->expected(1, -1);
+  cmd->add_flag("-q,--quiet", o->quiet, "No progress display");
+  cmd->footer("Tables: results.md, TABLE.md and TABLE.csv in --out; see docs/evaluation.md.");
+  cmd->callback([o, cmd] {
+    if (cmd->got_subcommand("merge")) return;
+    RunEvaluate(*o);
+  });
+
+  auto m = std::make_shared<std::pair<std::vector<std::string>, std::string>>();
+  CLI::App* merge = cmd->add_subcommand("merge", "Combine the rows of shards (folders or rows files) into the tables");
+  merge->add_option("shards", m->first, "Shard output folders or rows-K-of-N.jsonl files")->required();
+  merge->add_option("--out", m->second, "Output folder")->required();
+  merge->callback([m] { RunMerge(m->first, m->second); });
+}
+
+}  // namespace pushgraph::cli
