@@ -131,10 +131,13 @@ struct ShapePairQuerier::Impl {
   mutable std::deque<double> order;
   mutable int built = 0;
 
-  Shape Obstacle(double phi) const {
+  // The obstacle at relative angle phi, or at phi rounded to angle_cache_resolution: *used is
+  // the angle it was built for (the touching pairs must be searched at that angle).
+  Shape Obstacle(double phi, double* used) const {
     double key = WrapAngle(phi);
     if (options.angle_cache_resolution > 0.0)
       key = WrapAngle(std::round(key / options.angle_cache_resolution) * options.angle_cache_resolution);
+    *used = key;
     std::lock_guard<std::mutex> lock(mutex);
     auto it = obstacles.find(key);
     if (it != obstacles.end()) return it->second;
@@ -169,8 +172,8 @@ ShapePairResult ShapePairQuerier::Impl::QueryExact(const Pose2& object_pose, con
   const double ro = object.radius(), rf = finger.radius();
   Mat23 J_c_obj;
   const Vec2 c = InverseAct(object_pose, finger_pose.translation(), &J_c_obj);
-  const double phi = finger_pose.theta - object_pose.theta;
-  const Shape C = Obstacle(phi);
+  double phi = 0.0;  // the relative angle the obstacle was built for (rounded when cached)
+  const Shape C = Obstacle(finger_pose.theta - object_pose.theta, &phi);
   const PointQuery qc = QueryPoint(C, c);
   const Vec2 n_o = qc.normal;
   const double sd = qc.signed_distance;

@@ -34,6 +34,7 @@ std::map<std::string, double EstimatorConfig::*> DoubleFields() {
       {"c", &EstimatorConfig::c},
       {"c_scale", &EstimatorConfig::c_scale},
       {"c_prior_sigma", &EstimatorConfig::c_prior_sigma},
+      {"finger_angle_resolution", &EstimatorConfig::finger_angle_resolution},
       {"force_prior_sigma", &EstimatorConfig::force_prior_sigma},
       {"force_random_walk", &EstimatorConfig::force_random_walk},
       {"limit_surface_sigma", &EstimatorConfig::limit_surface_sigma},
@@ -180,9 +181,9 @@ EstimatorConfig ApplyMeasurementSigmas(EstimatorConfig cfg, const limit_surface:
 void ValidateConfig(const EstimatorConfig& cfg) {
   for (const auto& [key, member] : DoubleFields()) {
     const double v = cfg.*member;
-    if (key == "c") {
+    if (key == "c" || key == "finger_angle_resolution") {
       if (!(v >= 0.0) || !std::isfinite(v)) {
-        throw GraphError("config key 'c' must be finite and >= 0 (0: from the limit surface)");
+        throw GraphError("config key '" + key + "' must be finite and >= 0");
       }
     } else {
       CheckPositive(v, key);

@@ -199,7 +199,10 @@ GraphBuilder::GraphBuilder(const limit_surface::Trajectory& trajectory, Model mo
     }
   }
   vars_.resize(steps_.size());
-  querier_ = std::make_shared<geometry::ShapePairQuerier>(traj_.object.shape, traj_.finger.shape);
+  geometry::ShapePairQuerier::Options pair_options;
+  pair_options.angle_cache_resolution = cfg_.finger_angle_resolution;
+  pair_options.max_cached_angles = 4096;
+  querier_ = std::make_shared<geometry::ShapePairQuerier>(traj_.object.shape, traj_.finger.shape, pair_options);
   if (ModelHasForce(model_)) qs_ = QuasiStaticGeometryFor(traj_, cfg_);
   if (traj_.object.mass > 0.0 && traj_.object.mu_surface > 0.0) {
     f_max_ = traj_.object.mu_surface * traj_.object.mass * limit_surface::kStandardGravity;

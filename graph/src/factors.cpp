@@ -5,6 +5,8 @@
 #include <Eigen/Geometry>
 
 #include <cmath>
+#include <cstdlib>
+#include <iostream>
 #include <exception>
 #include <utility>
 
@@ -98,7 +100,11 @@ static bool QueryPair(const geometry::ShapePairQuerier& querier, double const* c
                geometry::ShapePairResult* r, geometry::ShapePairJacobians* J) {
   try {
     *r = querier.Query(PoseFrom(parameters[0]), PoseFrom(parameters[1]), J);
-  } catch (const std::exception&) {
+  } catch (const std::exception& e) {
+    // Ceres treats a failed evaluation as an infeasible step; say why when asked to.
+    if (const char* log = std::getenv("PUSHGRAPH_SOLVER_LOG"); log != nullptr && *log != '0') {
+      std::cerr << "pushgraph: shape-pair query failed: " << e.what() << "\n";
+    }
     return false;
   }
   return true;

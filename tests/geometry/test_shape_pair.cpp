@@ -290,6 +290,34 @@ TEST(ShapePairPolygon, ExactMatchesMinkowskiOracle) {
   EXPECT_GT(overlap, 0);
 }
 
+// With angles cached at a resolution, the query is the exact answer at the rounded relative
+// angle: never an error (the touching pairs are searched at that angle), and within
+// resolution x finger size of the exact separation.
+TEST(ShapePairPolygon, AngleCacheIsCloseAndNeverFails) {
+  std::mt19937_64 rng(712);
+  for (int c = 0; c < Scaled(3, 1); ++c) {
+    const Shape object = RandomObject(rng, 12);
+    const Shape finger = RandomFinger(rng, c % 2 == 0 ? 0.0 : 0.005);
+    ShapePairQuerier::Options options;
+    options.angle_cache_resolution = 2e-3;
+    const ShapePairQuerier cached(object, finger, options);
+    const ShapePairQuerier exact(object, finger);
+    const Box2 fb = finger.bounds();
+    const double size = (fb.max - fb.min).norm() + finger.radius();
+    for (int i = 0; i < Scaled(12, 4); ++i) {
+      const Pose2 op = RandomPose(rng);
+      const Pose2 fp = FingerPoseNear(rng, object, op, std::uniform_real_distribution<double>(-0.01, 0.02)(rng));
+      ShapePairJacobians J;
+      ShapePairResult rc;
+      ASSERT_NO_THROW(rc = cached.Query(op, fp, &J)) << "case " << c << "/" << i;
+      const ShapePairResult re = exact.Query(op, fp);
+      EXPECT_NEAR(rc.signed_distance, re.signed_distance, 2e-3 * size) << "case " << c << "/" << i;
+      EXPECT_TRUE(J.J_sd_object_pose.allFinite());
+    }
+    EXPECT_LE(cached.obstacles_built(), exact.obstacles_built());
+  }
+}
+
 TEST(ShapePairPolygon, RoundedConvexFingerIsExact) {
   std::mt19937_64 rng(703);
   const Shape object = RandomObject(rng, 16);
