@@ -268,6 +268,51 @@ void GraphBuilder::Initialize(int i, double limit) {
   }
 }
 
+int GraphBuilder::SmoothInitialMotion(int max_iterations, double function_tolerance) {
+  const auto& m = traj_.measured;
+  ceres::Problem problem;
+  const int n = static_cast<int>(steps_.size());
+  for (int i = 0; i < n; ++i) {
+    const Step& s = steps_[i];
+    StepVars& v = vars_[i];
+    if (s.object >= 0) {
+      problem.AddResidualBlock(new PoseMeasurementFactor(m.object_pose[s.object].pose, cfg_.object_pose_sigma_trans,
+                                                         cfg_.object_pose_sigma_rot),
+                               MakeLoss(cfg_.object_pose_loss), v.x);
+    }
+    if (s.finger >= 0) {
+      problem.AddResidualBlock(new PoseMeasurementFactor(m.finger_pose[s.finger].pose, cfg_.finger_pose_sigma_trans,
+                                                         cfg_.finger_pose_sigma_rot),
+                               MakeLoss(cfg_.finger_pose_loss), v.e);
+    }
+    if (i >= 2) {
+      const double dt1 = steps_[i - 1].t - steps_[i - 2].t, dt2 = s.t - steps_[i - 1].t;
+      const double st = ConstantVelocitySigma(cfg_.accel_trans, dt1, dt2);
+      const double sr = ConstantVelocitySigma(cfg_.accel_rot, dt1, dt2);
+      problem.AddResidualBlock(new ConstantVelocityFactor(dt1, dt2, st, sr), nullptr, vars_[i - 2].x, vars_[i - 1].x, v.x);
+      problem.AddResidualBlock(new ConstantVelocityFactor(dt1, dt2, st, sr), nullptr, vars_[i - 2].e, vars_[i - 1].e, v.e);
+    }
+  }
+  // A pose with neither measurement nor neighbours (a one- or two-step input) keeps its value.
+  for (int i = 0; i < n; ++i) {
+    if (!problem.HasParameterBlock(vars_[i].x)) problem.AddParameterBlock(vars_[i].x, 3);
+    if (!problem.HasParameterBlock(vars_[i].e)) problem.AddParameterBlock(vars_[i].e, 3);
+  }
+  ceres::Solver::Summary summary;
+  ceres::Solve(SolverOptions(max_iterations, function_tolerance), &problem, &summary);
+  LogSummary("motion-only initialization", summary);
+  if (m.contact_point.empty()) {
+    for (int i = 0; i < n; ++i) {
+      if (!steps_[i].in_contact) continue;
+      StepVars& v = vars_[i];
+      const auto q = geometry::QueryPoint(traj_.object.shape, Pose2{v.x[0], v.x[1], v.x[2]}, Vec2(v.e[0], v.e[1]));
+      v.p[0] = q.closest_point.x();
+      v.p[1] = q.closest_point.y();
+    }
+  }
+  return summary.num_successful_steps + summary.num_unsuccessful_steps;
+}
+
 ceres::LossFunction* GraphBuilder::MakeLoss(const LossConfig& loss) const {
   switch (loss.type) {
     case LossConfig::Type::kNone: return nullptr;
@@ -496,11 +541,12 @@ EstimationResult EstimateBatch(const limit_surface::Trajectory& traj, Model mode
     internal::GraphBuilder kinematic(traj, Model::kSdf, cfg);
     ceres::Problem pre;
     for (int i = 0; i < n; ++i) kinematic.Initialize(i, INFINITY);
+    stage_iterations += kinematic.SmoothInitialMotion(cfg.max_iterations, cfg.function_tolerance);
     for (int i = 0; i < n; ++i) kinematic.AddFactors(pre, i);
     ceres::Solver::Summary pre_summary;
     ceres::Solve(internal::SolverOptions(cfg.max_iterations, cfg.function_tolerance), &pre, &pre_summary);
     internal::LogSummary("batch warm start (sdf)", pre_summary);
-    stage_iterations = pre_summary.num_successful_steps + pre_summary.num_unsuccessful_steps;
+    stage_iterations += pre_summary.num_successful_steps + pre_summary.num_unsuccessful_steps;
     for (int i = 0; i < n; ++i) {
       auto& dst = builder.vars()[i];
       const auto& src = kinematic.vars()[i];
@@ -509,6 +555,7 @@ EstimationResult EstimateBatch(const limit_surface::Trajectory& traj, Model mode
       std::copy(src.p, src.p + 2, dst.p);
     }
   }
+  if (!ModelHasForce(model)) stage_iterations += builder.SmoothInitialMotion(cfg.max_iterations, cfg.function_tolerance);
   for (int i = 0; i < n; ++i) builder.AddFactors(problem, i);
   ceres::Solver::Summary summary;
   ceres::Solve(internal::SolverOptions(cfg.max_iterations, cfg.function_tolerance), &problem, &summary);
