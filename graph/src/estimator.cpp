@@ -268,11 +268,11 @@ void GraphBuilder::Initialize(int i, double limit) {
   }
 }
 
-int GraphBuilder::SmoothInitialMotion(int max_iterations, double function_tolerance) {
+int GraphBuilder::SmoothInitialMotion(int max_iterations, double function_tolerance, int first, int last) {
   const auto& m = traj_.measured;
   ceres::Problem problem;
-  const int n = static_cast<int>(steps_.size());
-  for (int i = 0; i < n; ++i) {
+  const int n = last < 0 ? static_cast<int>(steps_.size()) : last;
+  for (int i = first; i < n; ++i) {
     const Step& s = steps_[i];
     StepVars& v = vars_[i];
     if (s.object >= 0) {
@@ -293,16 +293,21 @@ int GraphBuilder::SmoothInitialMotion(int max_iterations, double function_tolera
       problem.AddResidualBlock(new ConstantVelocityFactor(dt1, dt2, st, sr), nullptr, vars_[i - 2].e, vars_[i - 1].e, v.e);
     }
   }
-  // A pose with neither measurement nor neighbours (a one- or two-step input) keeps its value.
-  for (int i = 0; i < n; ++i) {
+  // A pose with neither measurement nor neighbours (a one- or two-step input) keeps its value;
+  // steps before `first` (already estimated, incremental mode) are held fixed.
+  for (int i = std::max(0, first - 2); i < n; ++i) {
     if (!problem.HasParameterBlock(vars_[i].x)) problem.AddParameterBlock(vars_[i].x, 3);
     if (!problem.HasParameterBlock(vars_[i].e)) problem.AddParameterBlock(vars_[i].e, 3);
+    if (i < first) {
+      problem.SetParameterBlockConstant(vars_[i].x);
+      problem.SetParameterBlockConstant(vars_[i].e);
+    }
   }
   ceres::Solver::Summary summary;
   ceres::Solve(SolverOptions(max_iterations, function_tolerance), &problem, &summary);
   LogSummary("motion-only initialization", summary);
   if (m.contact_point.empty()) {
-    for (int i = 0; i < n; ++i) {
+    for (int i = first; i < n; ++i) {
       if (!steps_[i].in_contact) continue;
       StepVars& v = vars_[i];
       const auto q = geometry::QueryPoint(traj_.object.shape, Pose2{v.x[0], v.x[1], v.x[2]}, Vec2(v.e[0], v.e[1]));
@@ -541,7 +546,7 @@ EstimationResult EstimateBatch(const limit_surface::Trajectory& traj, Model mode
     internal::GraphBuilder kinematic(traj, Model::kSdf, cfg);
     ceres::Problem pre;
     for (int i = 0; i < n; ++i) kinematic.Initialize(i, INFINITY);
-    stage_iterations += kinematic.SmoothInitialMotion(cfg.max_iterations, cfg.function_tolerance);
+    stage_iterations += kinematic.SmoothInitialMotion(10, 1e-3);
     for (int i = 0; i < n; ++i) kinematic.AddFactors(pre, i);
     ceres::Solver::Summary pre_summary;
     ceres::Solve(internal::SolverOptions(cfg.max_iterations, cfg.function_tolerance), &pre, &pre_summary);
@@ -555,7 +560,7 @@ EstimationResult EstimateBatch(const limit_surface::Trajectory& traj, Model mode
       std::copy(src.p, src.p + 2, dst.p);
     }
   }
-  if (!ModelHasForce(model)) stage_iterations += builder.SmoothInitialMotion(cfg.max_iterations, cfg.function_tolerance);
+  if (!ModelHasForce(model)) stage_iterations += builder.SmoothInitialMotion(10, 1e-3);
   for (int i = 0; i < n; ++i) builder.AddFactors(problem, i);
   ceres::Solver::Summary summary;
   ceres::Solve(internal::SolverOptions(cfg.max_iterations, cfg.function_tolerance), &problem, &summary);

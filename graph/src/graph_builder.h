@@ -41,10 +41,13 @@ class GraphBuilder {
   void Initialize(int i, double limit);
   /// Replaces the initial poses (all steps already Initialize()d) by a motion-only smoother's:
   /// pose measurements and the constant-velocity prior alone (nearly linear: 2 to 5 LM
-  /// iterations), then re-derives geometric contact points. Interpolated raw poses at 250 Hz
+  /// iterations; it is only a starting point, so the batch solver caps it at 10 iterations and a
+  /// relative cost change of 1e-3), then re-derives geometric contact points. Interpolated raw poses at 250 Hz
   /// make V's initial cost huge (1e8 on a noisy MIT recording) and cost the full graph tens of
   /// iterations. Returns the iterations used.
-  int SmoothInitialMotion(int max_iterations, double function_tolerance);
+  /// Only steps [first, last) are smoothed (last < 0: to the end); the two steps before `first`
+  /// enter the V factors as constants (incremental mode: causal, the window's older estimates kept).
+  int SmoothInitialMotion(int max_iterations, double function_tolerance, int first = 0, int last = -1);
   /// Parts of a step's factors: kinematic (M of poses and contact, C, S, V, random walk) and
   /// dynamic (force variable, its M and prior, D, the limit-surface load).
   static constexpr int kKinematic = 1, kDynamic = 2, kAll = 3;

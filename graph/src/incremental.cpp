@@ -208,9 +208,11 @@ struct IncrementalEstimator::Impl {
     const int first_new = next_step;
     while (next_step < n && (builder.steps()[next_step].t <= target + 1e-12 || next_trigger == triggers.size())) {
       builder.Initialize(next_step, target);
-      builder.AddFactors(*problem, next_step, internal::GraphBuilder::kKinematic);
       ++next_step;
     }
+    // The new steps start from a causal motion-only smoother (as the batch solver's start).
+    stats.iterations += builder.SmoothInitialMotion(10, 1e-3, first_new, next_step);
+    for (int i = first_new; i < next_step; ++i) builder.AddFactors(*problem, i, internal::GraphBuilder::kKinematic);
     ceres::Solver::Summary summary;
     const auto options = internal::SolverOptions(cfg.incremental_max_iterations, cfg.function_tolerance);
     if (ModelHasForce(builder.model())) {
