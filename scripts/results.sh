@@ -45,5 +45,17 @@ seconds=$(( $(date +%s) - start ))
   echo "  commit $(git rev-parse --short HEAD 2>/dev/null || echo unknown)$(git diff --quiet 2>/dev/null || echo ' + local changes')."
   echo
   sed 's/^### /## /' "$OUT/results.md"
+  echo
+  echo "## Pictures"
+  echo
+  echo "The first push of each object (\`--plots 1\`, all in \`$OUT/plots\`); two are copied here."
+  echo
+  for f in "$OUT"/plots/ellip1-*-occlusion.svg "$OUT"/plots/sim_notched_block-*-fig3.svg; do
+    [ -f "$f" ] || continue
+    name="results-$(basename "$f")"
+    cp "$f" "docs/images/$name"
+    echo "![$(basename "$f" .svg)](images/$name)"
+    echo
+  done
 } > docs/results.md
 echo "results.sh: wrote docs/results.md (tables and CSV in $OUT)" >&2

@@ -1,6 +1,7 @@
 // The evaluation workflow (evaluation.h): inputs, noise, per-trajectory statistics, tables,
 // shards.
 #include <pushgraph/io/evaluation.h>
+#include <pushgraph/io/plot_svg.h>
 
 #include <pushgraph/io/footprint.h>
 #include <pushgraph/io/mit_push.h>
@@ -11,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -631,6 +633,8 @@ std::vector<EvaluationItem> PlanEvaluation(const std::vector<std::string>& files
     it.sim_index = i;
     items.push_back(it);
   }
+  std::map<std::string, int> plotted;
+  for (EvaluationItem& it : items) it.plot = plotted[it.group]++ < options.plots_per_group;
   return items;
 }
 
@@ -650,6 +654,51 @@ std::vector<EvaluationItem> ShardItems(const std::vector<EvaluationItem>& items,
   }
   return out;
 }
+
+namespace {
+
+// The paper's Fig. 3 / Fig. 5 (and Fig. 6 for the occluded push) for one item: the QS trajectory
+// above the object error over time of raw and every model that ran in batch.
+void WriteItemPlots(const EvaluationItem& item, const std::string& dir, const std::map<std::string, ls::Trajectory>& noisy,
+                    const std::map<std::string, graph::EstimationResult>& results, const Window& window) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw IoError(dir + ": cannot create the plot folder (" + ec.message() + ")");
+  std::string group = item.group;
+  for (char& c : group) {
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
+  }
+  for (const auto& [noise, suffix] : {std::pair<std::string, std::string>{"gauss", "fig3"}, {"occluded", "occlusion"}}) {
+    const auto qs = results.find(noise + ".qs.batch");
+    if (qs == results.end()) continue;
+    const ls::Trajectory& traj = noisy.at(noise);
+    std::vector<std::pair<std::string, const graph::EstimationResult*>> models;
+    for (const auto& [model, label] : {std::pair<const char*, const char*>{"cp", "CP"}, {"sdf", "SDF"}, {"qs", "QS"},
+                                        {"yu", "Yu-Rodriguez"}}) {
+      const auto it = results.find(noise + "." + model + ".batch");
+      if (it != results.end()) models.emplace_back(label, &it->second);
+    }
+    TrajectoryPlotOptions options;
+    options.error_panel = false;
+    options.title = item.group + " push " + std::to_string(item.index) + ": QS batch" +
+                    (noise == "occluded" ? ", object stream occluded" : "");
+    // Time from the push's first step: MIT recordings carry unix time stamps.
+    const double t0 = qs->second.states.empty() ? 0.0 : qs->second.states.front().t;
+    std::vector<TimeSeries> errors = ObjectPositionErrorSeries(traj, models);
+    for (TimeSeries& e : errors) {
+      for (double& t : e.t) t -= t0;
+    }
+    std::vector<std::pair<double, double>> shaded;
+    if (noise == "occluded") shaded.emplace_back(window.t0 - t0, window.t1 - t0);
+    const std::string svg = StackSvgVertically(
+        {TrajectorySvg(traj, qs->second, options),
+         TimeSeriesSvg(errors, "object position error over time (s from the first step)", "error [mm]", shaded)});
+    const std::string name = group + "-" + std::to_string(item.index) + "-" + suffix + ".svg";
+    WriteSvgFile((fs::path(dir) / name).string(), svg);
+  }
+}
+
+}  // namespace
 
 EvaluationRow EvaluateItem(const EvaluationItem& item, const EvaluationOptions& o) {
   EvaluationRow row;
@@ -680,14 +729,21 @@ EvaluationRow EvaluateItem(const EvaluationItem& item, const EvaluationOptions& 
       }
       AccumulateRaw(noisy[run.noise], run.noise + ".raw", sink);
     }
+    const bool plot = item.plot && !o.plot_dir.empty();
+    std::map<std::string, graph::EstimationResult> kept;  // batch results, for the pictures
     for (const RunSpec& run : runs) {
       stage = run.Prefix();
       const ls::Trajectory& t = noisy.at(run.noise);
       graph::EstimatorConfig cfg = graph::ApplyMeasurementSigmas(o.estimator, *t.measurement_sigmas);
       cfg.covariance = run.covariance;
-      const graph::EstimationResult r = graph::Estimate(t, run.model, run.mode, cfg);
+      graph::EstimationResult r = graph::Estimate(t, run.model, run.mode, cfg);
       AccumulateRun(t, r, run.Prefix(), run.noise == "occluded" ? window : Window{}, sink);
       if (row.steps == 0) row.steps = static_cast<int>(r.states.size());
+      if (plot && run.mode == graph::Mode::kBatch) kept.emplace(run.Prefix(), std::move(r));
+    }
+    if (plot) {
+      stage = "plots";
+      WriteItemPlots(item, o.plot_dir, noisy, kept, window);
     }
   } catch (const std::exception& e) {
     row.stats.clear();

@@ -126,6 +126,31 @@ TEST_F(Evaluation, AddedNoiseKeepsTheCleanStreamsAsGroundTruth) {
             clean.ground_truth->finger_pose.back().pose.x);
 }
 
+// Pictures: the first plots_per_group items of each group get a Fig. 3/5 and an occlusion SVG
+// with every model's error curve; the others none.
+TEST_F(Evaluation, PicturesOfTheFirstPushOfEachGroup) {
+  EvaluationOptions o = SmallSimulatedSet(2, "fig5,occlusion");
+  o.plot_dir = (dir_ / "plots").string();
+  const std::vector<EvaluationItem> items = PlanEvaluation({}, o);
+  ASSERT_EQ(items.size(), 2u);
+  EXPECT_TRUE(items[0].plot);
+  EXPECT_FALSE(items[1].plot);
+  for (const EvaluationItem& item : items) {
+    const EvaluationRow row = EvaluateItem(item, o);
+    EXPECT_TRUE(row.error.empty()) << row.error;
+  }
+  for (const char* name : {"sim_notched_block-0-fig3.svg", "sim_notched_block-0-occlusion.svg"}) {
+    std::ifstream in(dir_ / "plots" / name);
+    ASSERT_TRUE(in) << name;
+    const std::string svg((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(svg.find("<svg"), std::string::npos) << name;
+    for (const char* label : {"raw", "CP", "SDF", "QS", "Yu-Rodriguez"}) {
+      EXPECT_NE(svg.find(std::string(">") + label + "<"), std::string::npos) << name << " lacks " << label;
+    }
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "plots" / "sim_notched_block-1-fig3.svg"));
+}
+
 // One evaluation of three short simulated pushes and a broken file: the tables have the
 // expected rows, estimates beat the raw measurements, the broken file is counted, and the rows
 // of two shards merge into exactly the same tables.

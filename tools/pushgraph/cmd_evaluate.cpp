@@ -33,6 +33,7 @@ struct EvaluateOptions {
   std::string sim_finger = DefaultDataDir() + "/shapes/disk_finger_5mm.json";
   double sim_mass = 0.5, sim_mu = 0.3, sim_mu_contact = 0.4;
   std::string protocols = "all";
+  int plots = 1;  // pictures of the first N pushes of every object
   std::string object, finger;
   double mass = 0.0, mu = -1.0, mu_contact = 0.25;
   std::string mesh_dir;
@@ -205,6 +206,9 @@ void RunEvaluate(const EvaluateOptions& o) {
     options.simulation.name = "sim:" + fs::path(o.sim_object).stem().string();
   }
   if (o.out.empty()) throw CliError("--out DIR is required");
+  if (o.plots < 0) throw CliError("--plots must be >= 0");
+  options.plots_per_group = o.plots;
+  if (o.plots > 0) options.plot_dir = (fs::path(o.out) / "plots").string();
 
   const std::vector<std::string> files = o.inputs.empty() ? std::vector<std::string>{} : io::ExpandInputs(o.inputs);
   const std::vector<io::EvaluationItem> all = io::PlanEvaluation(files, options);
@@ -256,6 +260,9 @@ void RegisterEvaluate(CLI::App& app) {
   cmd->add_option("--sim-mu", o->sim_mu, "Simulated object-table friction")->capture_default_str();
   cmd->add_option("--sim-mu-contact", o->sim_mu_contact, "Simulated finger-object friction")->capture_default_str();
   cmd->add_option("--protocol", o->protocols, "table1,table2,fig5,occlusion,consistency,runtime or all")
+      ->capture_default_str();
+  cmd->add_option("--plots", o->plots,
+                  "Pictures of the first N pushes of every object in OUT/plots (Fig. 3, 5, 6 style SVG; 0: none)")
       ->capture_default_str();
   cmd->add_option("--object", o->object, "Object shape JSON for every MIT recording (with --finger --mass --mu)");
   cmd->add_option("--finger", o->finger, "Probe shape JSON for every MIT recording");

@@ -125,6 +125,13 @@ struct EvaluationOptions {
   std::string mesh_dir;
   SimulationSpec simulation;
   graph::EstimatorConfig estimator;  ///< measurement sigmas are replaced by the added noise's
+  /// Pictures (plot_svg.h) of the first `plots_per_group` items of every group are written into
+  /// plot_dir (when set): GROUP-INDEX-fig3.svg, the QS batch trajectory over the footprint with
+  /// two-sigma ellipses and forces (the paper's Fig. 3) above the object error over time of raw,
+  /// CP, SDF, QS and the baseline (Fig. 5); GROUP-INDEX-occlusion.svg, the same for the occluded
+  /// push with the window shaded (Fig. 6).
+  std::string plot_dir;
+  int plots_per_group = 1;
 
   /// The settings that must agree between shards (JSON text, for the rows' header).
   std::string SettingsJson() const;
@@ -137,6 +144,7 @@ struct EvaluationItem {
   std::string group;     ///< object name: one table row group
   enum class Source { kFile, kSimulated } source = Source::kSimulated;  ///< kFile: kind by DetectInputKind
   int sim_index = -1;
+  bool plot = false;  ///< among the first plots_per_group items of its group (PlanEvaluation)
 };
 
 /// Files from paths, folders (recursively: *.h5, *.hdf5, *.json) and glob patterns, sorted and
