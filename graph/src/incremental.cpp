@@ -216,8 +216,19 @@ struct IncrementalEstimator::Impl {
     ceres::Solver::Summary summary;
     const auto options = internal::SolverOptions(cfg.incremental_max_iterations, cfg.function_tolerance);
     if (ModelHasForce(builder.model())) {
-      // Staged like the batch solver: the new steps' kinematics first, then their dynamics.
+      // Staged like the batch solver: the new steps' kinematics first (the window's older
+      // steps held fixed: only the new ones need a start), then everything with the dynamics.
+      std::vector<double*> held;
+      for (int i = lo; i < first_new; ++i) {
+        for (double* b : builder.Blocks(i)) {
+          if (problem->HasParameterBlock(b) && !problem->IsParameterBlockConstant(b)) {
+            problem->SetParameterBlockConstant(b);
+            held.push_back(b);
+          }
+        }
+      }
       ceres::Solve(options, problem.get(), &summary);
+      for (double* b : held) problem->SetParameterBlockVariable(b);
       stats.iterations += summary.num_successful_steps + summary.num_unsuccessful_steps;
       for (int i = first_new; i < next_step; ++i) builder.AddFactors(*problem, i, internal::GraphBuilder::kDynamic);
     }

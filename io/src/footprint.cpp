@@ -118,7 +118,9 @@ std::vector<double> ReadVertexCoordinates(const std::string& path, std::size_t e
   std::ifstream in(path);
   std::vector<double> out;
   std::string line;
+  int line_number = 0;
   while (std::getline(in, line)) {
+    ++line_number;
     const char* c = line.c_str();
     while (*c == ' ' || *c == '\t') ++c;
     if (c[0] != 'v' || (c[1] != ' ' && c[1] != '\t')) continue;
@@ -126,9 +128,22 @@ std::vector<double> ReadVertexCoordinates(const std::string& path, std::size_t e
     for (int k = 0; k < 3; ++k) {
       char* end = nullptr;
       const double v = std::strtod(c, &end);
-      if (end == c) return {};
+      // tinyobjloader reads a bad number as 0 and NaN as NaN: both would be silent wrong answers.
+      const std::string where = path + ":" + std::to_string(line_number) + ": vertex coordinate " + std::to_string(k + 1);
+      if (end == c) throw IoError(where + " is missing or not a number: '" + line + "'");
+      if (!std::isfinite(v)) throw IoError(where + " is not finite: '" + line + "'");
       out.push_back(v);
       c = end;
+    }
+    while (*c == ' ' || *c == '\t' || *c == '\r') ++c;
+    if (*c != '\0' && *c != '#') {
+      // An optional fourth (weight) or vertex colours may follow; they must be numbers too.
+      char* end = nullptr;
+      std::strtod(c, &end);
+      if (end == c) {
+        throw IoError(path + ":" + std::to_string(line_number) + ": unexpected text after the vertex coordinates: '" +
+                      line + "'");
+      }
     }
   }
   if (out.size() != expected) return {};

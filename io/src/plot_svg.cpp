@@ -318,6 +318,19 @@ std::string TimeSeriesPanel(const std::vector<TimeSeries>& series, const std::st
   }
   if (!(tmax >= tmin)) tmin = 0.0, tmax = 1.0;
   if (tmax == tmin) tmax = tmin + 1.0;
+  // Unix time stamps (MIT recordings): at 1.46e9 s every tick would read the same; plot the time
+  // since the first sample and say so in the title.
+  if (std::abs(tmin) > 1e3 && std::abs(tmin) > 1e4 * (tmax - tmin)) {
+    std::vector<TimeSeries> shifted = series;
+    for (TimeSeries& s : shifted) {
+      for (double& t : s.t) t -= tmin;
+    }
+    std::vector<std::pair<double, double>> windows = shaded;
+    for (auto& w : windows) w = {w.first - tmin, w.second - tmin};
+    char origin[64];
+    std::snprintf(origin, sizeof origin, " (time from t0 = %.3f s)", tmin);
+    return TimeSeriesPanel(shifted, title + origin, y_label, windows, x, y, width, height);
+  }
   double vmin = 0.0;
   for (const TimeSeries& s : series)
     for (double v : s.value)

@@ -138,6 +138,14 @@ TEST_F(Footprint, ClearErrors) {
   bad_scale.scale = -1;
   expect_error(Write("ok.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), bad_scale, "scale");
   EXPECT_THROW(io::ParseUpAxis("w"), io::IoError);
+  // Bad vertex coordinates name the line (tinyobjloader alone reads "abc" as 0 and keeps NaN).
+  expect_error(Write("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n"), {}, "nan.obj:2: vertex coordinate 1 is not finite");
+  expect_error(Write("inf.obj", "v 0 0 0\nv 1 0 0\nv 0 inf 0\nf 1 2 3\n"), {}, "inf.obj:3: vertex coordinate 2 is not finite");
+  expect_error(Write("abc.obj", "v 0 0 0\nv 1 0 abc\nv 0 1 0\nf 1 2 3\n"), {}, "abc.obj:2: vertex coordinate 3 is missing or not a number");
+  expect_error(Write("short.obj", "v 0 0 0\nv 1 0\nv 0 1 0\nf 1 2 3\n"), {}, "short.obj:2: vertex coordinate 3");
+  expect_error(Write("tail.obj", "v 0 0 0 x\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), {}, "tail.obj:1: unexpected text");
+  // Comments, a weight and vertex colours after the coordinates are fine.
+  EXPECT_NO_THROW(io::MeshFootprint(Write("colours.obj", "v 0 0 0 1 0 0 # red\nv 1 0 0 1.0\nv 0 1 0\nf 1 2 3\n"), {}));
 }
 
 }  // namespace

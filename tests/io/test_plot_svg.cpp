@@ -344,4 +344,16 @@ TEST(PlotSvg, TimeSeriesBreaksLinesAtGapsAndShadesWindows) {
   EXPECT_THROW(io::StackSvgVertically({"not svg"}), io::IoError);
 }
 
+// Unix time stamps (MIT recordings) are plotted from the first sample, so the ticks differ.
+TEST(PlotSvg, UnixTimeStampsArePlottedFromTheFirstSample) {
+  io::TimeSeries a{"raw", {}, {}};
+  for (int k = 0; k < 50; ++k) a.t.push_back(1461860553.5 + 0.02 * k), a.value.push_back(1.0 + 0.1 * k);
+  const std::string svg = io::TimeSeriesSvg({a}, "error", "mm", {{1461860553.9, 1461860554.1}});
+  EXPECT_EQ(XmlProblem(svg), "");
+  EXPECT_NE(svg.find("time from t0 = 1461860553.500 s"), std::string::npos);
+  EXPECT_EQ(svg.find("1.46186e+09"), std::string::npos);
+  EXPECT_NE(svg.find(">0.4<"), std::string::npos);  // a tick in seconds from t0
+  EXPECT_EQ(Count(svg, "class='shaded'"), 1);
+}
+
 }  // namespace

@@ -63,7 +63,12 @@ limit_surface::Trajectory LoadInput(const EstimateOptions& o, std::string* sourc
   read.trim_to_contact = true;
   const io::MitRecording rec = io::ReadMitPush(o.input, read);
   for (const std::string& note : rec.notes) std::cerr << "estimate: " << note << "\n";
-  if (!rec.contact_found) std::cerr << "estimate: no contact phase found; the whole recording is used\n";
+  if (!rec.contact_found) {
+    // Nothing was pushed: the contact, force and quasi-static factors would be fitted to a
+    // push that never happened (a finger far from a resting object).
+    throw CliError(o.input + ": no contact phase found (no force above the contact threshold and no object motion): "
+                   "nothing was pushed, nothing to estimate");
+  }
   limit_surface::ObjectDescription object{LoadShape(o.object, "--object"), o.mass, o.mu, "uniform"};
   limit_surface::FingerDescription finger{LoadShape(o.finger, "--finger"), o.mu_contact};
   // Time stamps stay the recording's own (unix seconds): ReadMitPush keeps them.
