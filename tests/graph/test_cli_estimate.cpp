@@ -6,6 +6,10 @@
 #include "graph/push_generator.h"
 
 #include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -24,7 +28,13 @@ struct ToolRun {
   std::string err;
 };
 
-const std::string kDir = ::testing::TempDir();
+// One folder per test process: ctest runs the tests of this file in parallel processes, and a
+// shared folder let one test read another's stderr.
+const std::string kDir = [] {
+  const std::string dir = ::testing::TempDir() + "/pushgraph_estimate_cli_" + std::to_string(::getpid());
+  std::filesystem::create_directories(dir);
+  return dir;
+}();
 
 ToolRun Tool(const std::string& args) {
   const std::string err_path = kDir + "/estimate_stderr.txt";

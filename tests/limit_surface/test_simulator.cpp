@@ -5,6 +5,10 @@
 #include <pushgraph/limit_surface/simulator.h>
 
 #include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <filesystem>
 #include <sys/wait.h>
 
 #include <algorithm>
@@ -20,6 +24,18 @@
 
 namespace pushgraph::limit_surface {
 namespace {
+
+// One folder per test process: ctest runs these tests in parallel processes, which must not
+// share output or stderr files.
+std::string ProcessTempDir() {
+  static const std::string dir = [] {
+    const std::string d = ::testing::TempDir() + "/pushgraph_simulator_" + std::to_string(::getpid());
+    std::filesystem::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
+
 
 using geometry::Pose2;
 using geometry::Shape;
@@ -223,7 +239,7 @@ TEST(Simulator, WritesAndReadsBackTheTrajectoryFile) {
   PushPlan plan = SquarePlan(0.3, 0.01);
   plan.noise = DefaultNoise(NoiseKind::kGaussian);
   const SimulationResult r = Simulate(plan);
-  const std::string path = ::testing::TempDir() + "/sim_roundtrip.json";
+  const std::string path = ProcessTempDir() + "/sim_roundtrip.json";
   io::SaveTrajectoryJson(r.trajectory, path);
   const Trajectory back = io::LoadTrajectoryJson(path);
   ASSERT_TRUE(back.ground_truth.has_value());
@@ -452,7 +468,7 @@ struct ToolRun {
   std::string err;
 };
 ToolRun RunTool(const std::string& args) {
-  const std::string err_path = ::testing::TempDir() + "/simulate_stderr.txt";
+  const std::string err_path = ProcessTempDir() + "/simulate_stderr.txt";
   const std::string command = std::string(PUSHGRAPH_TOOL) + " simulate " + args + " > /dev/null 2> " + err_path;
   ToolRun r;
   const int raw = std::system(command.c_str());
@@ -465,7 +481,7 @@ ToolRun RunTool(const std::string& args) {
 }
 
 TEST(SimulateCli, DefaultsWriteAValidTrajectory) {
-  const std::string out = ::testing::TempDir() + "/cli_sim.json";
+  const std::string out = ProcessTempDir() + "/cli_sim.json";
   const ToolRun r = RunTool("-o " + out + " --seed 3 --noise bimodal --occlusion 0.5,0.8 --outliers 0.02");
   ASSERT_EQ(r.status, 0) << r.err;
   const Trajectory t = io::LoadTrajectoryJson(out);
@@ -477,7 +493,7 @@ TEST(SimulateCli, DefaultsWriteAValidTrajectory) {
   const Pose2 a = t.ground_truth->object_pose.front().pose, b = t.ground_truth->object_pose.back().pose;
   EXPECT_GT(std::hypot(b.x - a.x, b.y - a.y), 0.01);
   // Same seed -> identical file.
-  const std::string out2 = ::testing::TempDir() + "/cli_sim2.json";
+  const std::string out2 = ProcessTempDir() + "/cli_sim2.json";
   ASSERT_EQ(RunTool("-o " + out2 + " --seed 3 --noise bimodal --occlusion 0.5,0.8 --outliers 0.02").status, 0);
   std::ifstream f1(out), f2(out2);
   std::stringstream s1, s2;
@@ -489,7 +505,7 @@ TEST(SimulateCli, DefaultsWriteAValidTrajectory) {
 }
 
 TEST(SimulateCli, BadInputIsOneLineError) {
-  const std::string out = ::testing::TempDir() + "/cli_bad.json";
+  const std::string out = ProcessTempDir() + "/cli_bad.json";
   for (const std::string& args : {std::string("-o " + out + " --mass -1"), std::string("-o " + out + " --noise pink"),
                                   std::string("-o " + out + " --occlusion 2,1"),
                                   std::string("-o " + out + " --object /nonexistent/shape.json"),
@@ -502,7 +518,7 @@ TEST(SimulateCli, BadInputIsOneLineError) {
 }
 
 TEST(SimulateCli, EveryFlagInHelpIsDocumented) {
-  const std::string help_path = ::testing::TempDir() + "/simulate_help.txt";
+  const std::string help_path = ProcessTempDir() + "/simulate_help.txt";
   ASSERT_EQ(std::system((std::string(PUSHGRAPH_TOOL) + " simulate --help > " + help_path).c_str()), 0);
   std::ifstream help_in(help_path), doc_in(std::string(PUSHGRAPH_SOURCE_DIR) + "/docs/simulator.md");
   std::stringstream help, doc;
