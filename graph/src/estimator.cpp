@@ -273,25 +273,8 @@ int GraphBuilder::SmoothInitialMotion(int max_iterations, double function_tolera
   ceres::Problem problem;
   const int n = last < 0 ? static_cast<int>(steps_.size()) : last;
   for (int i = first; i < n; ++i) {
-    const Step& s = steps_[i];
-    StepVars& v = vars_[i];
-    if (s.object >= 0) {
-      problem.AddResidualBlock(new PoseMeasurementFactor(m.object_pose[s.object].pose, cfg_.object_pose_sigma_trans,
-                                                         cfg_.object_pose_sigma_rot),
-                               MakeLoss(cfg_.object_pose_loss), v.x);
-    }
-    if (s.finger >= 0) {
-      problem.AddResidualBlock(new PoseMeasurementFactor(m.finger_pose[s.finger].pose, cfg_.finger_pose_sigma_trans,
-                                                         cfg_.finger_pose_sigma_rot),
-                               MakeLoss(cfg_.finger_pose_loss), v.e);
-    }
-    if (i >= 2) {
-      const double dt1 = steps_[i - 1].t - steps_[i - 2].t, dt2 = s.t - steps_[i - 1].t;
-      const double st = ConstantVelocitySigma(cfg_.accel_trans, dt1, dt2);
-      const double sr = ConstantVelocitySigma(cfg_.accel_rot, dt1, dt2);
-      problem.AddResidualBlock(new ConstantVelocityFactor(dt1, dt2, st, sr), nullptr, vars_[i - 2].x, vars_[i - 1].x, v.x);
-      problem.AddResidualBlock(new ConstantVelocityFactor(dt1, dt2, st, sr), nullptr, vars_[i - 2].e, vars_[i - 1].e, v.e);
-    }
+    AddPoseMeasurementFactors(problem, i);
+    AddConstantVelocityFactors(problem, i);
   }
   // A pose with neither measurement nor neighbours (a one- or two-step input) keeps its value;
   // steps before `first` (already estimated, incremental mode) are held fixed.
@@ -346,17 +329,7 @@ void GraphBuilder::AddKinematicFactors(ceres::Problem& problem, int i) {
   const auto& m = traj_.measured;
   const Step& s = steps_[i];
   StepVars& v = vars_[i];
-  // M
-  if (s.object >= 0) {
-    problem.AddResidualBlock(new PoseMeasurementFactor(m.object_pose[s.object].pose, cfg_.object_pose_sigma_trans,
-                                                       cfg_.object_pose_sigma_rot),
-                             MakeLoss(cfg_.object_pose_loss), v.x);
-  }
-  if (s.finger >= 0) {
-    problem.AddResidualBlock(new PoseMeasurementFactor(m.finger_pose[s.finger].pose, cfg_.finger_pose_sigma_trans,
-                                                       cfg_.finger_pose_sigma_rot),
-                             MakeLoss(cfg_.finger_pose_loss), v.e);
-  }
+  AddPoseMeasurementFactors(problem, i);  // M
   if (s.in_contact) {
     if (s.contact >= 0) {
       problem.AddResidualBlock(new VectorMeasurementFactor(m.contact_point[s.contact].point, cfg_.contact_sigma),
@@ -388,13 +361,36 @@ void GraphBuilder::AddKinematicFactors(ceres::Problem& problem, int i) {
       problem.AddResidualBlock(new RandomWalkFactor(dt, cfg_.random_walk_trans, cfg_.random_walk_rot), nullptr,
                                vars_[i - 1].e, v.e);
     }
-  } else if (i >= 2) {
-    const double dt1 = steps_[i - 1].t - steps_[i - 2].t, dt2 = s.t - steps_[i - 1].t;
-    const double st = ConstantVelocitySigma(cfg_.accel_trans, dt1, dt2);
-    const double sr = ConstantVelocitySigma(cfg_.accel_rot, dt1, dt2);
-    problem.AddResidualBlock(new ConstantVelocityFactor(dt1, dt2, st, sr), nullptr, vars_[i - 2].x, vars_[i - 1].x, v.x);
-    problem.AddResidualBlock(new ConstantVelocityFactor(dt1, dt2, st, sr), nullptr, vars_[i - 2].e, vars_[i - 1].e, v.e);
+  } else {
+    AddConstantVelocityFactors(problem, i);
   }
+}
+
+void GraphBuilder::AddPoseMeasurementFactors(ceres::Problem& problem, int i) {
+  const auto& m = traj_.measured;
+  const Step& s = steps_[i];
+  StepVars& v = vars_[i];
+  if (s.object >= 0) {
+    problem.AddResidualBlock(new PoseMeasurementFactor(m.object_pose[s.object].pose, cfg_.object_pose_sigma_trans,
+                                                       cfg_.object_pose_sigma_rot),
+                             MakeLoss(cfg_.object_pose_loss), v.x);
+  }
+  if (s.finger >= 0) {
+    problem.AddResidualBlock(new PoseMeasurementFactor(m.finger_pose[s.finger].pose, cfg_.finger_pose_sigma_trans,
+                                                       cfg_.finger_pose_sigma_rot),
+                             MakeLoss(cfg_.finger_pose_loss), v.e);
+  }
+}
+
+void GraphBuilder::AddConstantVelocityFactors(ceres::Problem& problem, int i) {
+  if (i < 2) return;
+  const double dt1 = steps_[i - 1].t - steps_[i - 2].t, dt2 = steps_[i].t - steps_[i - 1].t;
+  const double st = ConstantVelocitySigma(cfg_.accel_trans, dt1, dt2);
+  const double sr = ConstantVelocitySigma(cfg_.accel_rot, dt1, dt2);
+  problem.AddResidualBlock(new ConstantVelocityFactor(dt1, dt2, st, sr), nullptr, vars_[i - 2].x, vars_[i - 1].x,
+                           vars_[i].x);
+  problem.AddResidualBlock(new ConstantVelocityFactor(dt1, dt2, st, sr), nullptr, vars_[i - 2].e, vars_[i - 1].e,
+                           vars_[i].e);
 }
 
 void GraphBuilder::AddDynamicFactors(ceres::Problem& problem, int i) {

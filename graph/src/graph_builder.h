@@ -67,6 +67,8 @@ class GraphBuilder {
  private:
   ceres::LossFunction* MakeLoss(const LossConfig& loss) const;
   void AddKinematicFactors(ceres::Problem& problem, int i);
+  void AddPoseMeasurementFactors(ceres::Problem& problem, int i);   ///< M of both poses
+  void AddConstantVelocityFactors(ceres::Problem& problem, int i);  ///< V on steps i-2, i-1, i
   void AddDynamicFactors(ceres::Problem& problem, int i);
 
   const limit_surface::Trajectory& traj_;
