@@ -5,11 +5,9 @@
 
 #include "graph/push_generator.h"
 
+#include "tool_runner.h"
+
 #include <gtest/gtest.h>
-
-#include <unistd.h>
-
-#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -23,49 +21,32 @@
 namespace pushgraph::graph {
 namespace {
 
-struct ToolRun {
-  int status;
-  std::string err;
-};
-
-// One folder per test process: ctest runs the tests of this file in parallel processes, and a
-// shared folder let one test read another's stderr.
-const std::string kDir = [] {
-  const std::string dir = ::testing::TempDir() + "/pushgraph_estimate_cli_" + std::to_string(::getpid());
-  std::filesystem::create_directories(dir);
-  return dir;
-}();
-
-ToolRun Tool(const std::string& args) {
-  const std::string err_path = kDir + "/estimate_stderr.txt";
-  const std::string cmd = std::string(PUSHGRAPH_TOOL) + " " + args + " > /dev/null 2> " + err_path;
-  const int rc = std::system(cmd.c_str());
-  std::ifstream in(err_path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, ss.str()};
-}
-
 nlohmann::json Load(const std::string& path) {
   std::ifstream in(path);
   return nlohmann::json::parse(in);
 }
 
-std::string WritePush() {
-  testing::PushSpec s;
-  s.contact_offset = 0.015;
-  s.duration = 0.6;
-  const std::string path = kDir + "/estimate_push.json";
-  io::SaveTrajectoryJson(testing::GeneratePush(s), path);
-  return path;
-}
+// The tool runs with ToolTest's private folder per test (ctest runs tests in parallel processes).
+class EstimateCli : public pushgraph::testing::ToolTest {
+ protected:
+  std::string dir() const { return dir_.string(); }
+  pushgraph::testing::ToolRun Tool(const std::string& args) { return Exec(args); }
+  std::string WritePush() {
+    testing::PushSpec s;
+    s.contact_offset = 0.015;
+    s.duration = 0.6;
+    const std::string path = dir() + "/estimate_push.json";
+    io::SaveTrajectoryJson(testing::GeneratePush(s), path);
+    return path;
+  }
+};
 
-TEST(EstimateCli, WritesTheResultFormatForEveryModelAndMode) {
+TEST_F(EstimateCli, WritesTheResultFormatForEveryModelAndMode) {
   const std::string in = WritePush();
   for (const std::string model : {"cp", "sdf", "qs", "yu"}) {
     for (const std::string mode : {"batch", "incremental"}) {
-      const std::string out = kDir + "/result_" + model + "_" + mode + ".json";
-      const ToolRun r = Tool("estimate " + in + " --model " + model + " --mode " + mode + " -o " + out);
+      const std::string out = dir() + "/result_" + model + "_" + mode + ".json";
+      const pushgraph::testing::ToolRun r = Tool("estimate " + in + " --model " + model + " --mode " + mode + " -o " + out);
       ASSERT_EQ(r.status, 0) << r.err;
       const nlohmann::json j = Load(out);
       EXPECT_EQ(j["model"], model);
@@ -90,19 +71,19 @@ TEST(EstimateCli, WritesTheResultFormatForEveryModelAndMode) {
   }
 }
 
-TEST(EstimateCli, ConfigFileIsApplied) {
+TEST_F(EstimateCli, ConfigFileIsApplied) {
   const std::string in = WritePush();
-  const std::string cfg = kDir + "/estimate_cfg.json";
+  const std::string cfg = dir() + "/estimate_cfg.json";
   std::ofstream(cfg) << R"({"covariance": false, "losses": {"force": {"type": "cauchy", "scale": 2}}})";
-  const std::string out = kDir + "/result_cfg.json";
+  const std::string out = dir() + "/result_cfg.json";
   ASSERT_EQ(Tool("estimate " + in + " --model qs -o " + out + " --config " + cfg).status, 0);
   EXPECT_FALSE(Load(out)["states"][10].contains("object_pose_cov"));
 }
 
-TEST(EstimateCli, BadInputGetsOneLineErrors) {
+TEST_F(EstimateCli, BadInputGetsOneLineErrors) {
   const std::string in = WritePush();
-  const std::string out = kDir + "/result_bad.json";
-  ToolRun r = Tool("estimate " + in + " --model qs3 -o " + out);
+  const std::string out = dir() + "/result_bad.json";
+  pushgraph::testing::ToolRun r = Tool("estimate " + in + " --model qs3 -o " + out);
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find("unknown model 'qs3'"), std::string::npos) << r.err;
   r = Tool("estimate " + in + " --mode online -o " + out);
@@ -113,13 +94,13 @@ TEST(EstimateCli, BadInputGetsOneLineErrors) {
   // No object measurements at all.
   limit_surface::Trajectory t = io::LoadTrajectoryJson(in);
   t.measured.object_pose.clear();
-  const std::string empty = kDir + "/estimate_no_object.json";
+  const std::string empty = dir() + "/estimate_no_object.json";
   io::SaveTrajectoryJson(t, empty);
   r = Tool("estimate " + empty + " -o " + out);
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("no object pose measurements"), std::string::npos) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-  const std::string cfg = kDir + "/estimate_bad_cfg.json";
+  const std::string cfg = dir() + "/estimate_bad_cfg.json";
   std::ofstream(cfg) << R"({"window": 3})";
   r = Tool("estimate " + in + " -o " + out + " --config " + cfg);
   EXPECT_NE(r.err.find("'window'"), std::string::npos) << r.err;
@@ -127,18 +108,18 @@ TEST(EstimateCli, BadInputGetsOneLineErrors) {
 
 // An MIT recording (HDF5) read directly: trimmed to contact, time stamps kept (unix seconds),
 // the paper's noise added with the clean recording as ground truth, and a picture.
-TEST(EstimateCli, MitRecordingWithAddedNoise) {
+TEST_F(EstimateCli, MitRecordingWithAddedNoise) {
   const std::string shared = std::string(PUSHGRAPH_SHARED_DIR) + "/data/mit-push/";
   const std::string h5 = shared + "abs/rect1/motion_surface=abs_shape=rect1_a=0_v=75_i=2.000_s=0.800_t=0.349.h5";
   if (!std::ifstream(h5)) GTEST_SKIP() << "no MIT data at " << shared;
-  const std::string square = kDir + "/square.json", tip = kDir + "/tip.json";
+  const std::string square = dir() + "/square.json", tip = dir() + "/tip.json";
   std::ofstream(square) << R"({"polygons": [{"outer": [[-0.045, -0.045], [0.045, -0.045], [0.045, 0.045], [-0.045, 0.045]]}]})";
   std::ofstream(tip) << R"({"polygons": [{"outer": [[0, 0]]}], "radius": 0.0047})";
-  const std::string cfg = kDir + "/mit_cfg.json";
+  const std::string cfg = dir() + "/mit_cfg.json";
   std::ofstream(cfg) << R"({"covariance": false})";
-  const std::string out = kDir + "/mit_result.json", svg = kDir + "/mit.svg";
+  const std::string out = dir() + "/mit_result.json", svg = dir() + "/mit.svg";
   const std::string common = "estimate '" + h5 + "' --object " + square + " --finger " + tip + " --mass 0.8374 --mu 0.35 --model cp --config " + cfg;
-  const ToolRun r = Tool(common + " --add-noise gaussian --seed 4 -o " + out + " --svg " + svg);
+  const pushgraph::testing::ToolRun r = Tool(common + " --add-noise gaussian --seed 4 -o " + out + " --svg " + svg);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("force sensor frozen"), std::string::npos) << r.err;  // the reader's repair notes
   const nlohmann::json j = Load(out);
@@ -157,10 +138,10 @@ TEST(EstimateCli, MitRecordingWithAddedNoise) {
   ASSERT_EQ(Tool(common + " -o " + out).status, 0);
   EXPECT_EQ(Load(out)["metrics"]["measured_object_position_rms"].get<double>(), 0.0);
   // MIT input needs the object's description; unknown content is named.
-  ToolRun bad = Tool("estimate '" + h5 + "' -o " + out);
+  pushgraph::testing::ToolRun bad = Tool("estimate '" + h5 + "' -o " + out);
   EXPECT_EQ(bad.status, 1);
   EXPECT_NE(bad.err.find("is an MIT recording"), std::string::npos) << bad.err;
-  const std::string junk = kDir + "/junk.json";
+  const std::string junk = dir() + "/junk.json";
   std::ofstream(junk) << R"({"hello": 1})";
   bad = Tool("estimate " + junk + " -o " + out);
   EXPECT_NE(bad.err.find("neither a pushgraph trajectory"), std::string::npos) << bad.err;

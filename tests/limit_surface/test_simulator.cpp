@@ -4,12 +4,9 @@
 #include <pushgraph/io/trajectory_json.h>
 #include <pushgraph/limit_surface/simulator.h>
 
+#include "tool_runner.h"
+
 #include <gtest/gtest.h>
-
-#include <unistd.h>
-
-#include <filesystem>
-#include <sys/wait.h>
 
 #include <algorithm>
 #include <cctype>
@@ -24,17 +21,6 @@
 
 namespace pushgraph::limit_surface {
 namespace {
-
-// One folder per test process: ctest runs these tests in parallel processes, which must not
-// share output or stderr files.
-std::string ProcessTempDir() {
-  static const std::string dir = [] {
-    const std::string d = ::testing::TempDir() + "/pushgraph_simulator_" + std::to_string(::getpid());
-    std::filesystem::create_directories(d);
-    return d;
-  }();
-  return dir;
-}
 
 
 using geometry::Pose2;
@@ -235,11 +221,14 @@ TEST(Simulator, SameSeedSameOutputDifferentSeedDifferentNoise) {
   EXPECT_NE(a, c);
 }
 
-TEST(Simulator, WritesAndReadsBackTheTrajectoryFile) {
+// ToolTest for its private temporary folder (ctest runs tests in parallel processes).
+class SimulatorFiles : public pushgraph::testing::ToolTest {};
+
+TEST_F(SimulatorFiles, WritesAndReadsBackTheTrajectoryFile) {
   PushPlan plan = SquarePlan(0.3, 0.01);
   plan.noise = DefaultNoise(NoiseKind::kGaussian);
   const SimulationResult r = Simulate(plan);
-  const std::string path = ProcessTempDir() + "/sim_roundtrip.json";
+  const std::string path = (dir_ / "sim_roundtrip.json").string();
   io::SaveTrajectoryJson(r.trajectory, path);
   const Trajectory back = io::LoadTrajectoryJson(path);
   ASSERT_TRUE(back.ground_truth.has_value());
@@ -463,26 +452,14 @@ TEST(Noise, BadModelsNameTheField) {
 
 // ---- pushgraph simulate ------------------------------------------------------------------------
 
-struct ToolRun {
-  int status = 0;
-  std::string err;
+class SimulateCli : public pushgraph::testing::ToolTest {
+ protected:
+  pushgraph::testing::ToolRun RunTool(const std::string& args) { return Exec("simulate " + args); }
 };
-ToolRun RunTool(const std::string& args) {
-  const std::string err_path = ProcessTempDir() + "/simulate_stderr.txt";
-  const std::string command = std::string(PUSHGRAPH_TOOL) + " simulate " + args + " > /dev/null 2> " + err_path;
-  ToolRun r;
-  const int raw = std::system(command.c_str());
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  std::ifstream in(err_path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  r.err = ss.str();
-  return r;
-}
 
-TEST(SimulateCli, DefaultsWriteAValidTrajectory) {
-  const std::string out = ProcessTempDir() + "/cli_sim.json";
-  const ToolRun r = RunTool("-o " + out + " --seed 3 --noise bimodal --occlusion 0.5,0.8 --outliers 0.02");
+TEST_F(SimulateCli, DefaultsWriteAValidTrajectory) {
+  const std::string out = (dir_ / "cli_sim.json").string();
+  const pushgraph::testing::ToolRun r = RunTool("-o " + out + " --seed 3 --noise bimodal --occlusion 0.5,0.8 --outliers 0.02");
   ASSERT_EQ(r.status, 0) << r.err;
   const Trajectory t = io::LoadTrajectoryJson(out);
   ASSERT_TRUE(t.ground_truth.has_value());
@@ -493,7 +470,7 @@ TEST(SimulateCli, DefaultsWriteAValidTrajectory) {
   const Pose2 a = t.ground_truth->object_pose.front().pose, b = t.ground_truth->object_pose.back().pose;
   EXPECT_GT(std::hypot(b.x - a.x, b.y - a.y), 0.01);
   // Same seed -> identical file.
-  const std::string out2 = ProcessTempDir() + "/cli_sim2.json";
+  const std::string out2 = (dir_ / "cli_sim2.json").string();
   ASSERT_EQ(RunTool("-o " + out2 + " --seed 3 --noise bimodal --occlusion 0.5,0.8 --outliers 0.02").status, 0);
   std::ifstream f1(out), f2(out2);
   std::stringstream s1, s2;
@@ -504,27 +481,26 @@ TEST(SimulateCli, DefaultsWriteAValidTrajectory) {
   std::remove(out2.c_str());
 }
 
-TEST(SimulateCli, BadInputIsOneLineError) {
-  const std::string out = ProcessTempDir() + "/cli_bad.json";
+TEST_F(SimulateCli, BadInputIsOneLineError) {
+  const std::string out = (dir_ / "cli_bad.json").string();
   for (const std::string& args : {std::string("-o " + out + " --mass -1"), std::string("-o " + out + " --noise pink"),
                                   std::string("-o " + out + " --occlusion 2,1"),
                                   std::string("-o " + out + " --object /nonexistent/shape.json"),
                                   std::string("-o " + out + " --outliers 2")}) {
-    const ToolRun r = RunTool(args);
+    const pushgraph::testing::ToolRun r = RunTool(args);
     EXPECT_NE(r.status, 0) << args;
     EXPECT_FALSE(r.err.empty()) << args;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << ": " << r.err;
   }
 }
 
-TEST(SimulateCli, EveryFlagInHelpIsDocumented) {
-  const std::string help_path = ProcessTempDir() + "/simulate_help.txt";
-  ASSERT_EQ(std::system((std::string(PUSHGRAPH_TOOL) + " simulate --help > " + help_path).c_str()), 0);
-  std::ifstream help_in(help_path), doc_in(std::string(PUSHGRAPH_SOURCE_DIR) + "/docs/simulator.md");
-  std::stringstream help, doc;
-  help << help_in.rdbuf();
+TEST_F(SimulateCli, EveryFlagInHelpIsDocumented) {
+  const pushgraph::testing::ToolRun run = RunTool("--help");
+  ASSERT_EQ(run.status, 0) << run.err;
+  std::ifstream doc_in(std::string(PUSHGRAPH_SOURCE_DIR) + "/docs/simulator.md");
+  std::stringstream doc;
   doc << doc_in.rdbuf();
-  const std::string h = help.str(), d = doc.str();
+  const std::string h = run.out, d = doc.str();
   int flags = 0;
   for (std::size_t pos = h.find("--"); pos != std::string::npos; pos = h.find("--", pos + 2)) {
     std::size_t end = pos + 2;
