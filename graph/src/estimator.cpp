@@ -466,7 +466,7 @@ StateEstimate GraphBuilder::State(int i) const {
 }
 
 std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder, const std::vector<int>& steps,
-                               std::vector<StateEstimate>& states) {
+                               std::vector<StateEstimate>& states, std::optional<double>* c_sigma) {
   ceres::Covariance::Options options;
   options.algorithm_type = ceres::SPARSE_QR;
   options.num_threads = 1;
@@ -475,7 +475,10 @@ std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder, c
   for (int i : steps) {
     for (double* b : builder.Blocks(i)) pairs.emplace_back(b, b);
   }
+  double* c = c_sigma != nullptr ? builder.c_block() : nullptr;
+  if (c != nullptr) pairs.emplace_back(c, c);
   if (!covariance.Compute(pairs, &problem)) return "failed (rank-deficient Jacobian)";
+  if (double var = 0.0; c != nullptr && covariance.GetCovarianceBlock(c, c, &var)) *c_sigma = std::sqrt(var);
   for (std::size_t k = 0; k < steps.size(); ++k) {
     const int i = steps[k];
     StepVars& v = builder.vars()[i];
@@ -498,13 +501,16 @@ std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder, c
   return "ok";
 }
 
-// PUSHGRAPH_SOLVER_LOG=1 prints every solve's Ceres report (iterations, time per stage) to stderr.
-void LogSummary(const char* what, const ceres::Solver::Summary& summary) {
-  static const bool enabled = [] {
+int SolverLogLevel() {
+  static const int level = [] {
     const char* v = std::getenv("PUSHGRAPH_SOLVER_LOG");
-    return v != nullptr && *v != '\0' && *v != '0';
+    return v == nullptr || *v == '\0' ? 0 : std::atoi(v);
   }();
-  if (enabled) std::cerr << "pushgraph " << what << ":\n" << summary.FullReport() << "\n";
+  return level;
+}
+
+void LogSummary(const char* what, const ceres::Solver::Summary& summary) {
+  if (SolverLogLevel() >= 1) std::cerr << "pushgraph " << what << ":\n" << summary.FullReport() << "\n";
 }
 
 ceres::Solver::Options SolverOptions(int max_iterations, double function_tolerance) {
@@ -517,7 +523,7 @@ ceres::Solver::Options SolverOptions(int max_iterations, double function_toleran
   o.parameter_tolerance = 1e-10;
   o.num_threads = 1;
   o.logging_type = ceres::SILENT;
-  if (const char* v = std::getenv("PUSHGRAPH_SOLVER_LOG"); v != nullptr && std::string(v) == "2") {
+  if (SolverLogLevel() >= 2) {
     o.logging_type = ceres::PER_MINIMIZER_ITERATION;  // per-iteration trace, for tuning
     o.minimizer_progress_to_stdout = true;
   }
@@ -572,21 +578,11 @@ EstimationResult EstimateBatch(const limit_surface::Trajectory& traj, Model mode
     idx[i] = i;
     r.states.push_back(builder.State(i));
   }
-  if (cfg.covariance) r.solver.covariance_status = internal::ComputeCovariances(problem, builder, idx, r.states);
-  if (ModelHasForce(model)) r.c = builder.c();
-  if (double* c = builder.c_block()) {
-    r.c_estimated = true;
-    if (cfg.covariance) {
-      ceres::Covariance::Options options;
-      options.algorithm_type = ceres::SPARSE_QR;
-      ceres::Covariance covariance(options);
-      const std::vector<std::pair<const double*, const double*>> pair{{c, c}};
-      double var = 0.0;
-      if (covariance.Compute(pair, &problem) && covariance.GetCovarianceBlock(c, c, &var)) {
-        r.c_sigma = std::sqrt(var);
-      }
-    }
+  if (cfg.covariance) {
+    r.solver.covariance_status = internal::ComputeCovariances(problem, builder, idx, r.states, &r.c_sigma);
   }
+  if (ModelHasForce(model)) r.c = builder.c();
+  r.c_estimated = builder.c_block() != nullptr;
   r.solver.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   r.solver.iterations = stage_iterations + summary.num_successful_steps + summary.num_unsuccessful_steps;
   r.solver.final_cost = summary.final_cost;

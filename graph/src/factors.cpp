@@ -1,13 +1,14 @@
 #include <pushgraph/graph/factors.h>
 
+#include "graph_builder.h"
+
 #include <pushgraph/geometry/point_query.h>
 
 #include <Eigen/Geometry>
 
 #include <cmath>
-#include <cstdlib>
-#include <iostream>
 #include <exception>
+#include <iostream>
 #include <utility>
 
 namespace pushgraph::graph {
@@ -102,7 +103,7 @@ static bool QueryPair(const geometry::ShapePairQuerier& querier, double const* c
     *r = querier.Query(PoseFrom(parameters[0]), PoseFrom(parameters[1]), J);
   } catch (const std::exception& e) {
     // Ceres treats a failed evaluation as an infeasible step; say why when asked to.
-    if (const char* log = std::getenv("PUSHGRAPH_SOLVER_LOG"); log != nullptr && *log != '0') {
+    if (internal::SolverLogLevel() >= 1) {
       std::cerr << "pushgraph: shape-pair query failed: " << e.what() << "\n";
     }
     return false;

@@ -5,6 +5,7 @@
 #include <ceres/ceres.h>
 
 #include <memory>
+#include <optional>
 #include <vector>
 
 namespace pushgraph::graph::internal {
@@ -86,12 +87,17 @@ class GraphBuilder {
 };
 
 /// Fills the covariances of `states` (indices `steps` into builder steps) with ceres::Covariance
-/// over `problem`; returns a status string ("ok" or the reason of failure).
+/// over `problem`, and the sigma of the estimated c (builder.c_block()) in the same computation
+/// when `c_sigma` is given; returns a status string ("ok" or the reason of failure).
 std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder,
-                               const std::vector<int>& steps, std::vector<StateEstimate>& states);
+                               const std::vector<int>& steps, std::vector<StateEstimate>& states,
+                               std::optional<double>* c_sigma = nullptr);
 
 ceres::Solver::Options SolverOptions(int max_iterations, double function_tolerance);
-/// Prints the solver's full report to stderr when the environment sets PUSHGRAPH_SOLVER_LOG=1.
+/// Diagnostics level from the environment, read once: PUSHGRAPH_SOLVER_LOG=1 prints every solve's
+/// Ceres report and why a factor evaluation failed, =2 also the per-iteration trace; unset: 0.
+int SolverLogLevel();
+/// Prints the solver's full report to stderr when SolverLogLevel() >= 1.
 void LogSummary(const char* what, const ceres::Solver::Summary& summary);
 
 }  // namespace pushgraph::graph::internal

@@ -682,17 +682,13 @@ void WriteItemPlots(const EvaluationItem& item, const std::string& dir, const st
     options.error_panel = false;
     options.title = item.group + " push " + std::to_string(item.index) + ": QS batch" +
                     (noise == "occluded" ? ", object stream occluded" : "");
-    // Time from the push's first step: MIT recordings carry unix time stamps.
-    const double t0 = qs->second.states.empty() ? 0.0 : qs->second.states.front().t;
-    std::vector<TimeSeries> errors = ObjectPositionErrorSeries(traj, models);
-    for (TimeSeries& e : errors) {
-      for (double& t : e.t) t -= t0;
-    }
+    // Unix time stamps (MIT recordings) are plotted from the first sample by TimeSeriesSvg itself.
     std::vector<std::pair<double, double>> shaded;
-    if (noise == "occluded") shaded.emplace_back(window.t0 - t0, window.t1 - t0);
+    if (noise == "occluded") shaded.emplace_back(window.t0, window.t1);
     const std::string svg = StackSvgVertically(
         {TrajectorySvg(traj, qs->second, options),
-         TimeSeriesSvg(errors, "object position error over time (s from the first step)", "error [mm]", shaded)});
+         TimeSeriesSvg(ObjectPositionErrorSeries(traj, models), "object position error over time", "error [mm]",
+                       shaded)});
     const std::string name = group + "-" + std::to_string(item.index) + "-" + suffix + ".svg";
     WriteSvgFile((fs::path(dir) / name).string(), svg);
   }
