@@ -76,7 +76,7 @@ struct EstimatorConfig {
   double force_prior_sigma = 100.0;  ///< N, weak prior f ~ N(0, s^2) keeping |f| observable
   /// N/sqrt(s): force continuity between consecutive steps (a random walk). Under the paper's
   /// 0.5 N noise, force RMS / NEES: simulated pushes 0.24 / 1.2 (3), 0.28 / 1.1 (5), 0.37 / 1.1
-  /// (10); an MIT ellip1 recording, whose real forces vary faster, 0.56 / 10.9 (3), 0.40 / 2.2
+  /// (10); an MIT ellip1 recording, whose real forces vary faster, 0.56 / 10.9 (3), 0.40 / 2.8
   /// (5), 0.38 / 1.1 (10). 5 is the compromise.
   double force_random_walk = 5.0;
   // The Yu-Rodriguez 2018 baseline.
