@@ -27,10 +27,12 @@ const limit_surface::Trajectory& Push(int steps) {
   return it->second;
 }
 
-void Batch(benchmark::State& state, graph::Model model, bool covariance) {
+void Batch(benchmark::State& state, graph::Model model, bool covariance,
+           graph::EstimatorConfig::CovarianceMethod method = graph::EstimatorConfig::CovarianceMethod::kSelectedInversion) {
   const auto& traj = Push(static_cast<int>(state.range(0)));
   graph::EstimatorConfig cfg;
   cfg.covariance = covariance;
+  cfg.covariance_method = method;
   int iterations = 0;
   for (auto _ : state) {
     const graph::EstimationResult r = graph::Estimate(traj, model, graph::Mode::kBatch, cfg);
@@ -43,10 +45,15 @@ void Batch(benchmark::State& state, graph::Model model, bool covariance) {
 
 void BM_BatchQs(benchmark::State& s) { Batch(s, graph::Model::kQs, false); }
 void BM_BatchQsWithCovariance(benchmark::State& s) { Batch(s, graph::Model::kQs, true); }
+// The peer: the same solve with ceres::Covariance (SPARSE_QR) for the marginals.
+void BM_BatchQsWithCeresCovariance(benchmark::State& s) {
+  Batch(s, graph::Model::kQs, true, graph::EstimatorConfig::CovarianceMethod::kCeres);
+}
 void BM_BatchCp(benchmark::State& s) { Batch(s, graph::Model::kCp, false); }
 BENCHMARK(BM_BatchQs)->Arg(100)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_BatchCp)->Arg(100)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond)->Iterations(1);
-BENCHMARK(BM_BatchQsWithCovariance)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_BatchQsWithCovariance)->Arg(100)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_BatchQsWithCeresCovariance)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 // Runs the whole incremental estimation; reports the mean and max update time and the mean of
 // the last quarter of the updates (flat against length means bounded cost).

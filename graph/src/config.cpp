@@ -34,6 +34,7 @@ std::map<std::string, double EstimatorConfig::*> DoubleFields() {
       {"c", &EstimatorConfig::c},
       {"c_scale", &EstimatorConfig::c_scale},
       {"c_prior_sigma", &EstimatorConfig::c_prior_sigma},
+      {"mu_prior_sigma", &EstimatorConfig::mu_prior_sigma},
       {"finger_angle_resolution", &EstimatorConfig::finger_angle_resolution},
       {"force_prior_sigma", &EstimatorConfig::force_prior_sigma},
       {"force_random_walk", &EstimatorConfig::force_random_walk},
@@ -130,9 +131,14 @@ EstimatorConfig ParseEstimatorConfig(const std::string& json_text, const std::st
       else if (v == "on") cfg.limit_surface_load = EstimatorConfig::LimitSurfaceLoad::kOn;
       else if (v == "off") cfg.limit_surface_load = EstimatorConfig::LimitSurfaceLoad::kOff;
       else Fail(source, key, "expected \"auto\", \"on\" or \"off\", got " + it->dump());
-    } else if (key == "covariance" || key == "estimate_c") {
+    } else if (key == "covariance_method") {
+      const std::string v = it->is_string() ? it->get<std::string>() : "";
+      if (v == "selected_inversion") cfg.covariance_method = EstimatorConfig::CovarianceMethod::kSelectedInversion;
+      else if (v == "ceres") cfg.covariance_method = EstimatorConfig::CovarianceMethod::kCeres;
+      else Fail(source, key, "expected \"selected_inversion\" or \"ceres\", got " + it->dump());
+    } else if (key == "covariance" || key == "estimate_c" || key == "estimate_mu") {
       if (!it->is_boolean()) Fail(source, key, "expected true or false");
-      (key == "covariance" ? cfg.covariance : cfg.estimate_c) = it->get<bool>();
+      (key == "covariance" ? cfg.covariance : key == "estimate_c" ? cfg.estimate_c : cfg.estimate_mu) = it->get<bool>();
     } else if (key == "losses") {
       if (!it->is_object()) Fail(source, key, "expected an object");
       for (auto l = it->begin(); l != it->end(); ++l) {

@@ -4,6 +4,7 @@
 
 #include <pushgraph/geometry/point_query.h>
 #include <pushgraph/graph/incremental.h>
+#include <pushgraph/graph/marginals.h>
 #include <pushgraph/limit_surface/limit_surface.h>
 #include <pushgraph/limit_surface/support.h>
 
@@ -13,6 +14,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <functional>
 #include <iostream>
 #include <tuple>
 
@@ -205,7 +207,9 @@ GraphBuilder::GraphBuilder(const limit_surface::Trajectory& trajectory, Model mo
   querier_ = std::make_shared<geometry::ShapePairQuerier>(traj_.object.shape, traj_.finger.shape, pair_options);
   if (ModelHasForce(model_)) qs_ = QuasiStaticGeometryFor(traj_, cfg_);
   if (traj_.object.mass > 0.0 && traj_.object.mu_surface > 0.0) {
-    f_max_ = traj_.object.mu_surface * traj_.object.mass * limit_surface::kStandardGravity;
+    mu_surface_ = traj_.object.mu_surface;
+    normal_load_ = traj_.object.mass * limit_surface::kStandardGravity;
+    f_max_ = mu_surface_ * normal_load_;
   }
   using Load = EstimatorConfig::LimitSurfaceLoad;
   use_load_factor_ = f_max_ > 0.0 && (cfg_.limit_surface_load == Load::kOn ||
@@ -216,6 +220,30 @@ void GraphBuilder::EnableCEstimation() {
   if (model_ != Model::kQs) return;
   estimate_c_ = true;
   c_var_[0] = qs_.c;
+}
+
+namespace {
+// A shared scalar parameter (c, mu): a Gaussian prior of relative sigma around its nominal
+// value and bounds [0.2, 5] times it.
+void AddSharedParameterPrior(ceres::Problem& problem, double* parameter, double nominal, double relative_sigma) {
+  ceres::Matrix A(1, 1);
+  ceres::Vector b(1);
+  A(0, 0) = 1.0 / (relative_sigma * nominal);
+  b(0) = nominal;
+  problem.AddResidualBlock(new ceres::NormalPrior(A, b), nullptr, parameter);
+  problem.SetParameterLowerBound(parameter, 0, 0.2 * nominal);
+  problem.SetParameterUpperBound(parameter, 0, 5.0 * nominal);
+}
+}  // namespace
+
+void GraphBuilder::EnableMuEstimation() {
+  if (model_ != Model::kQs) return;
+  if (!(f_max_ > 0.0)) {
+    throw GraphError("estimate_mu needs the object's mass and mu_surface in the trajectory");
+  }
+  estimate_mu_ = true;
+  use_load_factor_ = true;
+  mu_var_[0] = mu_surface_;
 }
 
 void GraphBuilder::Initialize(int i, double limit) {
@@ -417,24 +445,22 @@ void GraphBuilder::AddDynamicFactors(ceres::Problem& problem, int i) {
           problem.AddResidualBlock(new QuasiStaticFactorWithC(g, cfg_.eps_velocity, cfg_.eps_force,
                                                               cfg_.quasi_static_sigma * rate_scale),
                                    nullptr, vars_[i - 1].x, v.x, v.p, v.f, c_var_);
-          if (!c_in_problem_) {
-            // Prior around the geometric value; bounds keep c physical (tau / c in D).
-            const double c0 = qs_.c;
-            ceres::Matrix A(1, 1);
-            ceres::Vector b(1);
-            A(0, 0) = 1.0 / (cfg_.c_prior_sigma * c0);
-            b(0) = c0;
-            problem.AddResidualBlock(new ceres::NormalPrior(A, b), nullptr, c_var_);
-            problem.SetParameterLowerBound(c_var_, 0, 0.2 * c0);
-            problem.SetParameterUpperBound(c_var_, 0, 5.0 * c0);
-            c_in_problem_ = true;
-          }
+          // Prior around the geometric value; bounds keep c physical (tau / c in D).
+          if (!c_in_problem_) AddSharedParameterPrior(problem, c_var_, qs_.c, cfg_.c_prior_sigma);
+          c_in_problem_ = true;
         } else {
           problem.AddResidualBlock(new QuasiStaticFactor(g, cfg_.eps_velocity, cfg_.eps_force,
                                                          cfg_.quasi_static_sigma * rate_scale),
                                    nullptr, vars_[i - 1].x, v.x, v.p, v.f);
         }
-        if (use_load_factor_) {
+        if (use_load_factor_ && estimate_mu_) {
+          problem.AddResidualBlock(new LimitSurfaceLoadFactorWithMu(g, normal_load_, cfg_.eps_velocity, cfg_.eps_force,
+                                                                    cfg_.limit_surface_sigma * rate_scale),
+                                   nullptr, vars_[i - 1].x, v.x, v.p, v.f, mu_var_);
+          // Prior around the trajectory's mu; bounds keep f_max physical.
+          if (!mu_in_problem_) AddSharedParameterPrior(problem, mu_var_, mu_surface_, cfg_.mu_prior_sigma);
+          mu_in_problem_ = true;
+        } else if (use_load_factor_) {
           problem.AddResidualBlock(new LimitSurfaceLoadFactor(g, f_max_, cfg_.eps_velocity, cfg_.eps_force,
                                                               cfg_.limit_surface_sigma * rate_scale),
                                    nullptr, vars_[i - 1].x, v.x, v.p, v.f);
@@ -466,35 +492,83 @@ StateEstimate GraphBuilder::State(int i) const {
 }
 
 std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder, const std::vector<int>& steps,
-                               std::vector<StateEstimate>& states, std::optional<double>* c_sigma) {
-  ceres::Covariance::Options options;
-  options.algorithm_type = ceres::SPARSE_QR;
-  options.num_threads = 1;
-  ceres::Covariance covariance(options);
-  std::vector<std::pair<const double*, const double*>> pairs;
-  for (int i : steps) {
-    for (double* b : builder.Blocks(i)) pairs.emplace_back(b, b);
+                               std::vector<StateEstimate>& states, EstimatorConfig::CovarianceMethod method,
+                               EstimationResult* parameters) {
+  // The shared parameters (c, mu) whose sigmas are wanted.
+  std::vector<std::pair<double*, std::optional<double>*>> shared;
+  if (parameters != nullptr) {
+    if (double* c = builder.c_block()) shared.emplace_back(c, &parameters->c_sigma);
+    if (double* mu = builder.mu_block()) shared.emplace_back(mu, &parameters->mu_sigma);
   }
-  double* c = c_sigma != nullptr ? builder.c_block() : nullptr;
-  if (c != nullptr) pairs.emplace_back(c, c);
-  if (!covariance.Compute(pairs, &problem)) return "failed (rank-deficient Jacobian)";
-  if (double var = 0.0; c != nullptr && covariance.GetCovarianceBlock(c, c, &var)) *c_sigma = std::sqrt(var);
+  // Either method answers "the covariance of block b" into a row-major buffer.
+  std::function<bool(double*, double*)> get;
+  SparseMarginals marginals;
+  std::unique_ptr<ceres::Covariance> covariance;
+  std::string marginals_error;
+  if (method == EstimatorConfig::CovarianceMethod::kSelectedInversion) {
+    const auto start = std::chrono::steady_clock::now();
+    if (marginals.Compute(problem)) {
+      if (SolverLogLevel() >= 1) {
+        std::cerr << "pushgraph marginals: " << marginals.num_unknowns() << " unknowns, "
+                  << marginals.num_factor_nonzeros() << " factor nonzeros, "
+                  << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() << " s\n";
+      }
+      get = [&](double* b, double* out) {
+        const Eigen::MatrixXd m = marginals.Covariance(b);
+        Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(out, m.rows(), m.cols()) = m;
+        return true;
+      };
+    } else {
+      // Name the state, then try the QR on J (it copes with worse conditioning than J^T J).
+      marginals_error = marginals.error();
+      const double* bad = marginals.failed_block();
+      const char* names[] = {"object pose", "finger pose", "contact point", "force"};
+      for (int i = 0; bad != nullptr && i < static_cast<int>(builder.steps().size()); ++i) {
+        const StepVars& v = builder.vars()[i];
+        const double* blocks[] = {v.x, v.e, v.p, v.f};
+        for (int q = 0; q < 4; ++q) {
+          if (blocks[q] == bad) marginals_error += " [step " + std::to_string(i) + ", t = " + std::to_string(builder.steps()[i].t) + ", " + names[q] + "]";
+        }
+      }
+      if (bad != nullptr && bad == builder.c_block()) marginals_error += " [c]";
+      if (bad != nullptr && bad == builder.mu_block()) marginals_error += " [mu]";
+      if (SolverLogLevel() >= 1) std::cerr << "pushgraph marginals: " << marginals_error << "; trying ceres::Covariance\n";
+    }
+  }
+  if (!get) {
+    ceres::Covariance::Options options;
+    options.algorithm_type = ceres::SPARSE_QR;
+    options.num_threads = 1;
+    covariance = std::make_unique<ceres::Covariance>(options);
+    std::vector<std::pair<const double*, const double*>> pairs;
+    for (int i : steps) {
+      for (double* b : builder.Blocks(i)) pairs.emplace_back(b, b);
+    }
+    for (const auto& sh : shared) pairs.emplace_back(sh.first, sh.first);
+    if (!covariance->Compute(pairs, &problem)) {
+      return "failed (" + (marginals_error.empty() ? std::string("rank-deficient Jacobian") : marginals_error) + ")";
+    }
+    get = [&](double* b, double* out) { return covariance->GetCovarianceBlock(b, b, out); };
+  }
+  for (const auto& [block, sigma] : shared) {
+    if (double var = 0.0; get(block, &var)) *sigma = std::sqrt(var);
+  }
   for (std::size_t k = 0; k < steps.size(); ++k) {
     const int i = steps[k];
     StepVars& v = builder.vars()[i];
     StateEstimate& s = states[k];
     Eigen::Matrix<double, 3, 3, Eigen::RowMajor> c3;
     Eigen::Matrix<double, 2, 2, Eigen::RowMajor> c2;
-    covariance.GetCovarianceBlock(v.x, v.x, c3.data());
+    get(v.x, c3.data());
     s.object_pose_cov = Eigen::Matrix3d(c3);
-    covariance.GetCovarianceBlock(v.e, v.e, c3.data());
+    get(v.e, c3.data());
     s.finger_pose_cov = Eigen::Matrix3d(c3);
     if (builder.HasContactVars(i)) {
-      covariance.GetCovarianceBlock(v.p, v.p, c2.data());
+      get(v.p, c2.data());
       s.contact_cov = Eigen::Matrix2d(c2);
     }
     if (builder.HasForceVars(i)) {
-      covariance.GetCovarianceBlock(v.f, v.f, c2.data());
+      get(v.f, c2.data());
       s.force_cov = Eigen::Matrix2d(c2);
     }
   }
@@ -537,6 +611,7 @@ namespace {
 EstimationResult EstimateBatch(const limit_surface::Trajectory& traj, Model model, const EstimatorConfig& cfg) {
   internal::GraphBuilder builder(traj, model, cfg);
   if (cfg.estimate_c) builder.EnableCEstimation();
+  if (cfg.estimate_mu) builder.EnableMuEstimation();
   const int n = static_cast<int>(builder.steps().size());
   const auto start = std::chrono::steady_clock::now();
   ceres::Problem problem;
@@ -579,10 +654,13 @@ EstimationResult EstimateBatch(const limit_surface::Trajectory& traj, Model mode
     r.states.push_back(builder.State(i));
   }
   if (cfg.covariance) {
-    r.solver.covariance_status = internal::ComputeCovariances(problem, builder, idx, r.states, &r.c_sigma);
+    r.solver.covariance_status =
+        internal::ComputeCovariances(problem, builder, idx, r.states, cfg.covariance_method, &r);
   }
   if (ModelHasForce(model)) r.c = builder.c();
   r.c_estimated = builder.c_block() != nullptr;
+  if (model == Model::kQs && builder.mu() > 0.0) r.mu = builder.mu();
+  r.mu_estimated = builder.mu_block() != nullptr;
   r.solver.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   r.solver.iterations = stage_iterations + summary.num_successful_steps + summary.num_unsuccessful_steps;
   r.solver.final_cost = summary.final_cost;

@@ -400,24 +400,60 @@ LimitSurfaceLoadFactor::LimitSurfaceLoadFactor(const QuasiStaticGeometry& geomet
   if (!(eps_v_ > 0.0) || !(eps_f_ > 0.0)) throw GraphError("limit-surface load factor: eps must be > 0");
 }
 
-bool LimitSurfaceLoadFactor::Evaluate(double const* const* parameters, double* residuals,
-                                      double** jacobians) const {
+namespace {
+
+// r = w s_v (b / f_max - 1), b = |g'|_eps; the Jacobian with respect to f_max into *J_fmax.
+bool EvaluateLoad(const QuasiStaticGeometry& geometry, double f_max, double eps_v, double eps_f, double w,
+                  double const* const* parameters, double* residuals, double** jacobians, double* J_fmax) {
+  if (!(f_max > 0.0)) return false;
   const QuasiStaticTerms t = ComputeQuasiStaticTerms(
-      geometry_, PoseFrom(parameters[0]), PoseFrom(parameters[1]),
+      geometry, PoseFrom(parameters[0]), PoseFrom(parameters[1]),
       Vec2(parameters[2][0], parameters[2][1]), Vec2(parameters[3][0], parameters[3][1]));
-  const double v2 = t.V.squaredNorm(), e2 = eps_v_ * eps_v_;
+  const double v2 = t.V.squaredNorm(), e2 = eps_v * eps_v;
   const double sv = v2 / (v2 + e2);
-  const double b = std::sqrt(t.g.squaredNorm() + eps_f_ * eps_f_);
-  const double k = w_ / f_max_;
-  residuals[0] = k * sv * (b - f_max_);
+  const double b = std::sqrt(t.g.squaredNorm() + eps_f * eps_f);
+  residuals[0] = w * sv * (b / f_max - 1.0);
   if (jacobians == nullptr) return true;
   // ds_v/dV' = 2 eps^2 V'^T / (|V'|^2 + eps^2)^2;  d b / d g' = g'^T / b.
-  const Eigen::RowVector3d J_r_V = k * (b - f_max_) * 2.0 * e2 * t.V.transpose() / ((v2 + e2) * (v2 + e2));
-  const Eigen::RowVector3d J_r_g = k * sv * t.g.transpose() / b;
+  const Eigen::RowVector3d J_r_V = w * (b / f_max - 1.0) * 2.0 * e2 * t.V.transpose() / ((v2 + e2) * (v2 + e2));
+  const Eigen::RowVector3d J_r_g = w * sv * t.g.transpose() / (b * f_max);
   if (jacobians[0] != nullptr) Eigen::Map<Eigen::RowVector3d>{jacobians[0]} = J_r_V * t.J_V_xprev;
   if (jacobians[1] != nullptr) Eigen::Map<Eigen::RowVector3d>{jacobians[1]} = J_r_V * t.J_V_x + J_r_g * t.J_g_x;
   if (jacobians[2] != nullptr) Eigen::Map<Eigen::RowVector2d>{jacobians[2]} = J_r_g * t.J_g_p;
   if (jacobians[3] != nullptr) Eigen::Map<Eigen::RowVector2d>{jacobians[3]} = J_r_g * t.J_g_f;
+  if (J_fmax != nullptr) *J_fmax = -w * sv * b / (f_max * f_max);
+  return true;
+}
+
+}  // namespace
+
+bool LimitSurfaceLoadFactor::Evaluate(double const* const* parameters, double* residuals,
+                                      double** jacobians) const {
+  return EvaluateLoad(geometry_, f_max_, eps_v_, eps_f_, w_, parameters, residuals, jacobians, nullptr);
+}
+
+LimitSurfaceLoadFactorWithMu::LimitSurfaceLoadFactorWithMu(const QuasiStaticGeometry& geometry, double normal_load,
+                                                           double eps_velocity, double eps_force, double sigma)
+    : geometry_(geometry), normal_load_(normal_load), eps_v_(eps_velocity), eps_f_(eps_force),
+      w_(CheckedWeight(sigma, "limit-surface load")) {
+  CheckGeometry(geometry_);
+  if (!(normal_load > 0.0) || !std::isfinite(normal_load)) {
+    throw GraphError("limit-surface load factor: the normal load m g must be > 0");
+  }
+  if (!(eps_v_ > 0.0) || !(eps_f_ > 0.0)) throw GraphError("limit-surface load factor: eps must be > 0");
+}
+
+bool LimitSurfaceLoadFactorWithMu::Evaluate(double const* const* parameters, double* residuals,
+                                            double** jacobians) const {
+  const double mu = parameters[4][0];
+  if (!(mu > 0.0) || !std::isfinite(mu)) return false;
+  double J_fmax = 0.0;
+  const bool want_mu = jacobians != nullptr && jacobians[4] != nullptr;
+  if (!EvaluateLoad(geometry_, mu * normal_load_, eps_v_, eps_f_, w_, parameters, residuals, jacobians,
+                    want_mu ? &J_fmax : nullptr)) {
+    return false;
+  }
+  if (want_mu) jacobians[4][0] = J_fmax * normal_load_;  // f_max = mu N
   return true;
 }
 

@@ -61,6 +61,12 @@ class GraphBuilder {
   void EnableCEstimation();
   double* c_block() { return c_in_problem_ ? c_var_ : nullptr; }
   double c() const { return estimate_c_ ? c_var_[0] : qs_.c; }
+  /// Makes the table friction mu a variable of the limit-surface load factor (QS only,
+  /// config.estimate_mu; turns that factor on). Throws GraphError without mass or mu_surface.
+  void EnableMuEstimation();
+  double* mu_block() { return mu_in_problem_ ? mu_var_ : nullptr; }
+  /// mu of the load factor: the estimate, or the trajectory's mu_surface (0 when unknown).
+  double mu() const { return estimate_mu_ ? mu_var_[0] : mu_surface_; }
   double c_initial() const { return qs_.c; }
   /// The estimate of step i (no covariances).
   StateEstimate State(int i) const;
@@ -83,15 +89,21 @@ class GraphBuilder {
   bool c_in_problem_ = false;
   double c_var_[1] = {0.0};
   double f_max_ = 0.0;  ///< mu m g; 0 when the trajectory lacks mass or friction
+  double mu_surface_ = 0.0, normal_load_ = 0.0;  ///< the trajectory's mu and m g
+  bool estimate_mu_ = false;
+  bool mu_in_problem_ = false;
+  double mu_var_[1] = {0.0};
   bool use_load_factor_ = false;  ///< LimitSurfaceLoadFactor on (config + force stream)
 };
 
-/// Fills the covariances of `states` (indices `steps` into builder steps) with ceres::Covariance
-/// over `problem`, and the sigma of the estimated c (builder.c_block()) in the same computation
-/// when `c_sigma` is given; returns a status string ("ok" or the reason of failure).
+/// Fills the covariances of `states` (indices `steps` into builder steps) by `method`
+/// over `problem`, and, when `parameters` is given, the sigmas of the estimated c and mu
+/// (builder.c_block(), mu_block()) in the same computation; returns a status string ("ok" or
+/// the reason of failure).
 std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder,
                                const std::vector<int>& steps, std::vector<StateEstimate>& states,
-                               std::optional<double>* c_sigma = nullptr);
+                               EstimatorConfig::CovarianceMethod method,
+                               EstimationResult* parameters = nullptr);
 
 ceres::Solver::Options SolverOptions(int max_iterations, double function_tolerance);
 /// Diagnostics level from the environment, read once: PUSHGRAPH_SOLVER_LOG=1 prints every solve's

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <iostream>
 #include <map>
 
 namespace pushgraph::graph {
@@ -99,7 +100,7 @@ struct IncrementalEstimator::Impl {
     std::vector<StateEstimate> out;
     for (int i : idx) out.push_back(builder.State(i));
     if (cfg.covariance && !idx.empty()) {
-      const std::string status = internal::ComputeCovariances(*problem, builder, idx, out);
+      const std::string status = internal::ComputeCovariances(*problem, builder, idx, out, cfg.covariance_method);
       if (status != "ok") stats.covariance_status = status;
       else if (stats.covariance_status == "not computed") stats.covariance_status = "ok";
     }
@@ -228,11 +229,13 @@ struct IncrementalEstimator::Impl {
         }
       }
       ceres::Solve(options, problem.get(), &summary);
+      internal::LogSummary("incremental update, new steps' kinematics", summary);
       for (double* b : held) problem->SetParameterBlockVariable(b);
       stats.iterations += summary.num_successful_steps + summary.num_unsuccessful_steps;
       for (int i = first_new; i < next_step; ++i) builder.AddFactors(*problem, i, internal::GraphBuilder::kDynamic);
     }
     ceres::Solve(options, problem.get(), &summary);
+    internal::LogSummary("incremental update, window", summary);
     stats.iterations += summary.num_successful_steps + summary.num_unsuccessful_steps;
     last_cost = summary.final_cost;
     // States leaving the window (keep at least three steps for the V factors).
@@ -240,8 +243,17 @@ struct IncrementalEstimator::Impl {
     const double t_now = builder.steps()[next_step - 1].t;
     int s = lo;
     while (s < next_step - 3 && builder.steps()[s].t < t_now - window_duration) leaving.push_back(s++);
+    const auto record_start = std::chrono::steady_clock::now();
     Record(leaving);
+    const auto marginalize_start = std::chrono::steady_clock::now();
     for (int i : leaving) Marginalize(i);
+    if (internal::SolverLogLevel() >= 1) {
+      const auto now = std::chrono::steady_clock::now();
+      std::cerr << "pushgraph incremental update: record " << leaving.size() << " steps "
+                << std::chrono::duration<double>(marginalize_start - record_start).count() << " s, marginalize "
+                << std::chrono::duration<double>(now - marginalize_start).count() << " s, whole update "
+                << std::chrono::duration<double>(now - start).count() << " s\n";
+    }
     lo = s;
     const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     ++stats.updates;

@@ -55,6 +55,11 @@ std::string ResultToJson(const graph::EstimationResult& r, int indent) {
   if (r.c) {
     nlohmann::json c = {{"c", *r.c}, {"estimated", r.c_estimated}};
     if (r.c_sigma) c["c_sigma"] = *r.c_sigma;
+    if (r.mu) {
+      c["mu"] = *r.mu;
+      c["mu_estimated"] = r.mu_estimated;
+      if (r.mu_sigma) c["mu_sigma"] = *r.mu_sigma;
+    }
     j["parameters"] = std::move(c);
   }
   if (!r.metrics.empty()) {

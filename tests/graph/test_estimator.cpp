@@ -58,6 +58,12 @@ TEST(Estimator, ConfigParsingNamesBadKeys) {
   EXPECT_NE(message(R"({"limit_surface_load": true})").find("limit_surface_load"), std::string::npos);
   const EstimatorConfig d = ParseEstimatorConfig(R"({"contact_finger": "boundary", "limit_surface_load": "on"})");
   EXPECT_EQ(d.contact_finger, EstimatorConfig::ContactFinger::kBoundary);
+  const EstimatorConfig e = ParseEstimatorConfig(R"({"estimate_mu": true, "mu_prior_sigma": 0.5, "covariance_method": "ceres"})");
+  EXPECT_TRUE(e.estimate_mu);
+  EXPECT_EQ(e.mu_prior_sigma, 0.5);
+  EXPECT_EQ(e.covariance_method, EstimatorConfig::CovarianceMethod::kCeres);
+  EXPECT_NE(message(R"({"covariance_method": "dense"})").find("covariance_method"), std::string::npos);
+  EXPECT_NE(message(R"({"estimate_mu": 1})").find("estimate_mu"), std::string::npos);
   EXPECT_EQ(d.limit_surface_load, EstimatorConfig::LimitSurfaceLoad::kOn);
   // A config file overrides a base (the trajectory's measurement sigmas) by name only.
   EstimatorConfig base;
@@ -92,6 +98,41 @@ TEST(Estimator, JointEstimationOfCMovesTowardsTheTruth) {
   const EstimationResult fixed = Estimate(t, Model::kQs, Mode::kBatch, cfg);
   EXPECT_FALSE(fixed.c_estimated);
   EXPECT_DOUBLE_EQ(*fixed.c, 1.4 * c_true);
+}
+
+// mu from the force stream: while the object slides, |g'| = mu m g (the push generator follows
+// the ellipsoidal limit surface exactly). Started 40% high, the estimate must come back.
+TEST(Estimator, JointEstimationOfMuMovesTowardsTheTruth) {
+  PushSpec spec = OffsetPush(11);
+  limit_surface::Trajectory t = GeneratePush(spec);
+  const double mu_true = spec.mu;
+  t.object.mu_surface = 1.4 * mu_true;
+  EstimatorConfig cfg;
+  cfg.estimate_mu = true;
+  cfg.mu_prior_sigma = 1.0;  // weak: the data decide
+  const EstimationResult r = Estimate(t, Model::kQs, Mode::kBatch, cfg);
+  ASSERT_TRUE(r.mu.has_value());
+  EXPECT_TRUE(r.mu_estimated);
+  ASSERT_TRUE(r.mu_sigma.has_value());
+  std::printf("[mu] true %.4f, start %.4f, estimate %.4f (sigma %.4f)\n", mu_true, 1.4 * mu_true, *r.mu, *r.mu_sigma);
+  EXPECT_LT(std::abs(*r.mu - mu_true), 0.25 * std::abs(1.4 * mu_true - mu_true));
+  EXPECT_GT(*r.mu_sigma, 0.0);
+  EXPECT_LT(std::abs(*r.mu - mu_true), 4.0 * *r.mu_sigma + 0.01 * mu_true);
+  // Off by default: mu is reported (the trajectory's) but fixed.
+  cfg.estimate_mu = false;
+  const EstimationResult fixed = Estimate(t, Model::kQs, Mode::kBatch, cfg);
+  EXPECT_FALSE(fixed.mu_estimated);
+  EXPECT_DOUBLE_EQ(*fixed.mu, 1.4 * mu_true);
+  // Without the object's friction there is nothing to start from: a clear error.
+  limit_surface::Trajectory no_mu = t;
+  no_mu.object.mu_surface = 0.0;
+  cfg.estimate_mu = true;
+  try {
+    Estimate(no_mu, Model::kQs, Mode::kBatch, cfg);
+    ADD_FAILURE() << "expected a GraphError";
+  } catch (const GraphError& e) {
+    EXPECT_NE(std::string(e.what()).find("mu_surface"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Estimator, MeasurementSigmasSetTheMeasurementFactors) {

@@ -319,6 +319,9 @@ TEST(FactorJacobians, QuasiStaticBothForms) {
   LimitSurfaceLoadFactor l(g, 2.0, 1e-3, 0.05, 0.1);
   CrossMultipliedQuasiStaticFactor y(g, 1e-3);
   QuasiStaticFactorWithC dc(g, 1e-3, 0.05, 0.1);
+  LimitSurfaceLoadFactorWithMu lm(g, 0.8 * 9.81, 1e-3, 0.05, 0.1);
+  JacobianTally tm("limit-surface load with mu");
+  WorstError wm{"D limit-surface load with mu as a variable"};
   JacobianTally tc("D with c");
   WorstError wc{"D with c as a variable"};
   int n = 0;
@@ -328,7 +331,9 @@ TEST(FactorJacobians, QuasiStaticBothForms) {
     CheckCost(y, {V(c.x_prev), V(c.x), V(c.p), V(c.f)}, ty, wy, ctx);
     CheckCost(l, {V(c.x_prev), V(c.x), V(c.p), V(c.f)}, tl, wl, ctx);
     CheckCost(dc, {V(c.x_prev), V(c.x), V(c.p), V(c.f), V({g.c * rng.U(0.5, 2.0)})}, tc, wc, ctx);
+    CheckCost(lm, {V(c.x_prev), V(c.x), V(c.p), V(c.f), V({rng.U(0.05, 1.0)})}, tm, wm, ctx);
   }
+  EXPECT_TRUE(tm.MostlyChecked(0.95));
   EXPECT_TRUE(tc.MostlyChecked(0.95));
   EXPECT_TRUE(tl.MostlyChecked(0.95));
   EXPECT_TRUE(td.MostlyChecked(0.95));

@@ -66,6 +66,14 @@ struct EstimatorConfig {
   /// [0.2, 5] times it. The estimate and its sigma are in EstimationResult::c.
   bool estimate_c = false;
   double c_prior_sigma = 0.3;  ///< relative
+  /// Estimate the table friction mu jointly (QS, batch): one shared variable in the
+  /// limit-surface load factor (|g'| = mu m g while sliding; the factor is then on whatever
+  /// limit_surface_load says), started at the trajectory's mu_surface, with a Gaussian prior of
+  /// relative sigma mu_prior_sigma and bounds [0.2, 5] times it. Needs the object's mass and
+  /// mu_surface. With a force stream mu is observed through |f| while sliding; without one only
+  /// the prior and D's force direction speak, so its sigma stays near the prior's.
+  bool estimate_mu = false;
+  double mu_prior_sigma = 0.3;  ///< relative
   /// When the limit-surface load factor is used: kAuto (the default) only without a force
   /// stream, where it is the sole information on the force magnitude; with force measurements
   /// it adds little and its rest/sliding gate (|V'| against eps_velocity) slows convergence
@@ -94,6 +102,13 @@ struct EstimatorConfig {
   int max_iterations = 100;
   double function_tolerance = 1e-6;
   bool covariance = true;  ///< marginal covariances of every state
+  /// How they are computed: kSelectedInversion (SparseMarginals: sparse Cholesky of J^T J and
+  /// Takahashi's recursion, linear in the trajectory length; the default, falling back to
+  /// ceres::Covariance when J^T J is too ill-conditioned) or kCeres (ceres::Covariance with
+  /// SPARSE_QR, quadratic in the length: 4 to 5 s for 1000 QS steps; the reference).
+  /// JSON "covariance_method": "selected_inversion" | "ceres".
+  enum class CovarianceMethod { kSelectedInversion, kCeres };
+  CovarianceMethod covariance_method = CovarianceMethod::kSelectedInversion;
   // Incremental (fixed-lag smoothing).
   int incremental_window = 20;        ///< object measurement periods kept in the window
   int incremental_update_every = 5;   ///< object measurements between updates (k)

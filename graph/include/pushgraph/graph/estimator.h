@@ -69,6 +69,10 @@ struct EstimationResult {
   /// with its marginal sigma (c_sigma, when covariances were computed).
   std::optional<double> c, c_sigma;
   bool c_estimated = false;
+  /// The table friction mu of the limit-surface load; estimated when config.estimate_mu (QS
+  /// batch), with its marginal sigma. Set for QS when the trajectory has mass and mu_surface.
+  std::optional<double> mu, mu_sigma;
+  bool mu_estimated = false;
   /// RMS errors against the trajectory's ground truth (empty without it): object_position_rms
   /// (m), object_rotation_rms (rad), finger_position_rms, finger_rotation_rms, contact_rms (m),
   /// force_rms (N); the same of the raw measurements as measured_*; and the mean normalized

@@ -249,6 +249,23 @@ class LimitSurfaceLoadFactor : public ceres::SizedCostFunction<1, 3, 3, 2, 2> {
   double f_max_, eps_v_, eps_f_, w_;
 };
 
+/// The limit-surface load with the table friction mu as a fifth parameter block (1), shared by
+/// every step, to estimate mu jointly with the trajectory (EstimatorConfig::estimate_mu):
+/// f_max = mu N with N = m g the normal load, the same residual as LimitSurfaceLoadFactor
+/// written r = s_v (|g'|_eps / f_max - 1) / sigma, and d r / d mu = -s_v |g'|_eps / (f_max mu
+/// sigma). Evaluate fails (Ceres shortens the step) for mu <= 0.
+class LimitSurfaceLoadFactorWithMu : public ceres::SizedCostFunction<1, 3, 3, 2, 2, 1> {
+ public:
+  LimitSurfaceLoadFactorWithMu(const QuasiStaticGeometry& geometry, double normal_load,
+                               double eps_velocity, double eps_force, double sigma);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  QuasiStaticGeometry geometry_;
+  double normal_load_, eps_v_, eps_f_, w_;
+};
+
 /// The Yu-Rodriguez 2018 cross-multiplied quasi-static factor (the baseline):
 ///   r = (v_x tau - c^2 f_x omega, v_y tau - c^2 f_y omega) / sigma
 /// in the object frame (centre-of-pressure twist). Vanishes for any pure translation: that is

@@ -1,0 +1,220 @@
+// Selected inversion of a sparse Cholesky factor (Takahashi, Fagan and Chen 1973; the form of
+// Kaess and Dellaert 2009, Sec. 4): with H = L L^T and Z = H^-1, L^T Z = L^-1 is lower
+// triangular with diagonal 1 / L_jj, so for each column j (from the last) and each row i > j of
+// L's pattern
+//   Z_ij = -(1 / L_jj) sum_{k > j, L_kj != 0} L_kj Z_ki,
+//   Z_jj = (1 / L_jj) (1 / L_jj - sum_{k > j, L_kj != 0} L_kj Z_kj).
+// Every Z_ki needed lies in L's pattern (the rows of a column of L form a clique of the filled
+// graph), so only that pattern is ever computed.
+#include <pushgraph/graph/marginals.h>
+
+#include <ceres/crs_matrix.h>
+
+#include <Eigen/OrderingMethods>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+#include <unordered_map>
+
+namespace pushgraph::graph {
+namespace {
+// A pivot keeping less than this fraction of its unknown's information (L_jj^2 / H_jj, that is
+// 1 - R^2 of the unknown on the ones eliminated before it) is treated as a dependent direction:
+// forming J^T J squares J's conditioning, so this is about cond(J) = 1e7, beyond which the
+// selected inverse loses more than half its digits (ComputeCovariances then falls back to
+// ceres::Covariance's QR on J).
+constexpr double kMinPivotRatio = 1e-14;
+}  // namespace
+
+struct SparseMarginals::Impl {
+  std::unordered_map<const double*, std::pair<int, int>> blocks;  // offset, size
+  std::unordered_map<const double*, int> fixed;                   // constant or unused: size
+  Eigen::VectorXi perm;                                           // original -> factor order
+  // The factor's pattern (column-major, rows sorted, the diagonal first) and Z on it.
+  std::vector<int> col_start, row;
+  std::vector<double> z;
+
+  // Z(a, b) in factor order; nullptr when outside the pattern.
+  const double* Find(int a, int b) const {
+    const int c = std::min(a, b), r = std::max(a, b);
+    const auto first = row.begin() + col_start[c], last = row.begin() + col_start[c + 1];
+    const auto it = std::lower_bound(first, last, r);
+    if (it == last || *it != r) return nullptr;
+    return &z[it - row.begin()];
+  }
+};
+
+SparseMarginals::SparseMarginals() = default;
+SparseMarginals::~SparseMarginals() = default;
+SparseMarginals::SparseMarginals(SparseMarginals&&) noexcept = default;
+SparseMarginals& SparseMarginals::operator=(SparseMarginals&&) noexcept = default;
+
+int SparseMarginals::num_unknowns() const { return impl_ ? static_cast<int>(impl_->perm.size()) : 0; }
+long SparseMarginals::num_factor_nonzeros() const { return impl_ ? static_cast<long>(impl_->row.size()) : 0; }
+
+bool SparseMarginals::Compute(ceres::Problem& problem) {
+  impl_.reset();
+  error_.clear();
+  failed_block_ = nullptr;
+  auto impl = std::make_unique<Impl>();
+  std::vector<double*> all, variable;
+  problem.GetParameterBlocks(&all);
+  // Blocks no residual uses carry no information: like ceres::Covariance, they are held fixed.
+  std::unordered_map<const double*, bool> used;
+  {
+    std::vector<ceres::ResidualBlockId> residual_blocks;
+    problem.GetResidualBlocks(&residual_blocks);
+    std::vector<double*> ps;
+    for (ceres::ResidualBlockId id : residual_blocks) {
+      problem.GetParameterBlocksForResidualBlock(id, &ps);
+      for (double* p : ps) used[p] = true;
+    }
+  }
+  int n = 0;
+  for (double* b : all) {
+    if (problem.IsParameterBlockConstant(b) || !used.count(b)) {
+      impl->fixed[b] = problem.ParameterBlockSize(b);
+      continue;
+    }
+    if (problem.GetManifold(b) != nullptr) {
+      error_ = "a parameter block has a manifold (not supported)";
+      return false;
+    }
+    const int size = problem.ParameterBlockSize(b);
+    impl->blocks[b] = {n, size};
+    variable.push_back(b);
+    n += size;
+  }
+  if (n == 0) {
+    error_ = "no variable parameter blocks";
+    return false;
+  }
+  ceres::Problem::EvaluateOptions eval;
+  eval.parameter_blocks = variable;
+  eval.apply_loss_function = true;
+  ceres::CRSMatrix crs;
+  if (!problem.Evaluate(eval, nullptr, nullptr, nullptr, &crs)) {
+    error_ = "a residual block failed to evaluate or gave a non-finite residual or Jacobian";
+    return false;
+  }
+  for (std::size_t k = 0; k < crs.values.size(); ++k) {
+    if (!std::isfinite(crs.values[k])) {
+      error_ = "the Jacobian has a non-finite entry (row " + std::to_string(
+                   std::upper_bound(crs.rows.begin(), crs.rows.end(), static_cast<int>(k)) - crs.rows.begin() - 1) + ")";
+      return false;
+    }
+  }
+  const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>> J(
+      crs.num_rows, crs.num_cols, static_cast<Eigen::Index>(crs.values.size()), crs.rows.data(), crs.cols.data(),
+      crs.values.data());
+  const Eigen::SparseMatrix<double> H = Eigen::SparseMatrix<double>(J.transpose()) * J;
+  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> llt(H);
+  if (llt.info() != Eigen::Success) {
+    error_ = "the information matrix J^T J is not positive definite (an unobservable direction: gauge "
+             "freedom or too few factors)";
+    return false;
+  }
+  impl->perm = llt.permutationP().indices();
+  const Eigen::SparseMatrix<double>& L = llt.matrixL().nestedExpression();
+  // A pivot that keeps almost none of its variable's information (L_jj^2 against H_jj: 1 - R^2
+  // of that unknown on the earlier ones) is a numerically dependent direction.
+  Eigen::VectorXd h_diag(n);
+  for (int a = 0; a < n; ++a) h_diag[impl->perm[a]] = H.coeff(a, a);
+  impl->col_start.assign(n + 1, 0);
+  std::vector<std::pair<int, double>> column;
+  std::vector<double> values;
+  for (int j = 0; j < n; ++j) {
+    column.clear();
+    for (Eigen::SparseMatrix<double>::InnerIterator it(L, j); it; ++it) column.emplace_back(static_cast<int>(it.row()), it.value());
+    std::sort(column.begin(), column.end());
+    if (column.empty() || column.front().first != j || !std::isfinite(h_diag[j]) ||
+        !(column.front().second > 0.0) || column.front().second * column.front().second <= kMinPivotRatio * h_diag[j]) {
+      int a = 0;
+      while (a < n && impl->perm[a] != j) ++a;
+      for (double* b : variable) {
+        const auto [offset, size] = impl->blocks[b];
+        if (a >= offset && a < offset + size) {
+          failed_block_ = b;
+          error_ = !std::isfinite(h_diag[j])
+                       ? "the information matrix J^T J overflows at a parameter block (component " +
+                             std::to_string(a - offset) + ")"
+                       : "the information matrix J^T J is (numerically) singular at a parameter block (component " +
+                             std::to_string(a - offset) +
+                             "): it has no information independent of the others (unobservable or gauge freedom)";
+          break;
+        }
+      }
+      return false;
+    }
+    for (const auto& [r, v] : column) {
+      impl->row.push_back(r);
+      values.push_back(v);
+    }
+    impl->col_start[j + 1] = static_cast<int>(impl->row.size());
+  }
+  impl->z.assign(values.size(), 0.0);
+  // Per column j: Z_RR (R = the rows below the diagonal) gathered densely, each column r_a of Z
+  // merged with R (R's rows from r_a on are a subset of that column's pattern), then one matvec.
+  Eigen::MatrixXd z_rr;
+  Eigen::VectorXd l_r;
+  const std::vector<int>& rows = impl->row;
+  for (int j = n - 1; j >= 0; --j) {
+    const int begin = impl->col_start[j], end = impl->col_start[j + 1];
+    const int m = end - begin - 1;
+    const double ljj = values[begin];
+    if (m == 0) {
+      impl->z[begin] = 1.0 / (ljj * ljj);
+      continue;
+    }
+    z_rr.resize(m, m);
+    l_r = Eigen::Map<const Eigen::VectorXd>(&values[begin + 1], m);
+    for (int a = 0; a < m; ++a) {
+      const int ra = rows[begin + 1 + a];
+      int p = impl->col_start[ra];
+      const int p_end = impl->col_start[ra + 1];
+      for (int b = a; b < m; ++b) {
+        const int rb = rows[begin + 1 + b];
+        while (p < p_end && rows[p] < rb) ++p;
+        if (p == p_end || rows[p] != rb) throw std::logic_error("SparseMarginals: factor pattern is not chordal");
+        z_rr(a, b) = z_rr(b, a) = impl->z[p];
+      }
+    }
+    const Eigen::VectorXd z_rj = -(z_rr * l_r) / ljj;
+    Eigen::Map<Eigen::VectorXd>(&impl->z[begin + 1], m) = z_rj;
+    impl->z[begin] = (1.0 / ljj - l_r.dot(z_rj)) / ljj;
+  }
+  impl_ = std::move(impl);
+  return true;
+}
+
+Eigen::MatrixXd SparseMarginals::CrossCovariance(const double* a, const double* b) const {
+  if (!impl_) throw std::logic_error("SparseMarginals: no successful Compute");
+  const auto ia = impl_->blocks.find(a), ib = impl_->blocks.find(b);
+  const auto fa = impl_->fixed.find(a), fb = impl_->fixed.find(b);
+  if ((ia == impl_->blocks.end() && fa == impl_->fixed.end()) || (ib == impl_->blocks.end() && fb == impl_->fixed.end())) {
+    throw std::logic_error("SparseMarginals: the block is not a parameter block of the problem");
+  }
+  if (fa != impl_->fixed.end() || fb != impl_->fixed.end()) {  // held fixed: no uncertainty
+    return Eigen::MatrixXd::Zero(fa != impl_->fixed.end() ? fa->second : ia->second.second,
+                                 fb != impl_->fixed.end() ? fb->second : ib->second.second);
+  }
+  const auto [oa, sa] = ia->second;
+  const auto [ob, sb] = ib->second;
+  Eigen::MatrixXd out(sa, sb);
+  for (int u = 0; u < sa; ++u) {
+    for (int v = 0; v < sb; ++v) {
+      const double* z = impl_->Find(impl_->perm[oa + u], impl_->perm[ob + v]);
+      if (z == nullptr) throw std::logic_error("SparseMarginals: the two blocks are not linked in the factor");
+      out(u, v) = *z;
+    }
+  }
+  return out;
+}
+
+Eigen::MatrixXd SparseMarginals::Covariance(const double* block) const { return CrossCovariance(block, block); }
+
+}  // namespace pushgraph::graph

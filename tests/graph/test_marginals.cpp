@@ -1,0 +1,303 @@
+// SparseMarginals (selected inversion) against ceres::Covariance on random nonlinear chains with
+// a variable shared by every link, robust losses and a constant block; failures on singular
+// problems; and the estimator's covariances by both methods.
+#include <pushgraph/graph/estimator.h>
+#include <pushgraph/graph/marginals.h>
+
+#include "graph/push_generator.h"
+
+#include <ceres/autodiff_cost_function.h>
+#include <ceres/covariance.h>
+#include <ceres/crs_matrix.h>
+#include <ceres/loss_function.h>
+#include <ceres/problem.h>
+
+#include <gtest/gtest.h>
+
+#include <Eigen/LU>
+
+#include <random>
+
+namespace pushgraph::graph {
+namespace {
+
+// r = A (b - a) + sin(b - a) * k: a nonlinear link between two 3-vectors (or a prior with a = 0).
+struct Link {
+  Eigen::Matrix3d A;
+  Eigen::Vector3d k;
+  template <class T>
+  bool operator()(const T* a, const T* b, T* r) const {
+    for (int i = 0; i < 3; ++i) {
+      r[i] = T(k[i]) * sin(b[i] - a[i]);
+      for (int j = 0; j < 3; ++j) r[i] += T(A(i, j)) * (b[j] - a[j]);
+    }
+    return true;
+  }
+};
+struct Prior {
+  Eigen::Vector3d mean, w;
+  template <class T>
+  bool operator()(const T* x, T* r) const {
+    for (int i = 0; i < 3; ++i) r[i] = T(w[i]) * (x[i] - T(mean[i]));
+    return true;
+  }
+};
+// Couples a step to the shared variable g (like the estimated c in the QS graph).
+struct Shared {
+  double w;
+  template <class T>
+  bool operator()(const T* x, const T* g, T* r) const {
+    r[0] = T(w) * (x[0] * g[0] - x[1]);
+    return true;
+  }
+};
+
+struct RandomChain {
+  ceres::Problem problem;
+  std::vector<std::array<double, 3>> x;
+  double g[1] = {0.7};
+  double fixed[3] = {0.1, 0.2, 0.3};
+
+  RandomChain(int n, unsigned seed, bool shared, bool losses, bool constant_block, bool cycle = false) : x(n) {
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> N;
+    std::uniform_real_distribution<double> U(0.1, 3.0), S(-1.0, 1.0);
+    // Seeded (Eigen's Random() would draw from std::rand's global state).
+    auto M3 = [&] { Eigen::Matrix3d m; for (int i = 0; i < 9; ++i) m(i / 3, i % 3) = S(rng); return m; };
+    auto V3 = [&] { return Eigen::Vector3d(S(rng), S(rng), S(rng)); };
+    for (auto& v : x) v = {N(rng), N(rng), N(rng)};
+    auto* first = new ceres::AutoDiffCostFunction<Prior, 3, 3>(new Prior{V3(), Eigen::Vector3d(U(rng), U(rng), U(rng))});
+    problem.AddResidualBlock(first, nullptr, x[0].data());
+    for (int i = 1; i < n; ++i) {
+      Link l{M3() + 2.0 * Eigen::Matrix3d::Identity(), V3()};
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<Link, 3, 3, 3>(new Link(l)),
+                               losses && i % 3 == 0 ? new ceres::HuberLoss(0.5) : nullptr, x[i - 1].data(), x[i].data());
+      if (i >= 2 && i % 4 == 0) {  // skip links: fill beyond the band
+        Link s{M3(), V3()};
+        problem.AddResidualBlock(new ceres::AutoDiffCostFunction<Link, 3, 3, 3>(new Link(s)),
+                                 losses ? new ceres::CauchyLoss(1.0) : nullptr, x[i - 2].data(), x[i].data());
+      }
+      if (i % 5 == 0) {
+        problem.AddResidualBlock(new ceres::AutoDiffCostFunction<Prior, 3, 3>(new Prior{V3(), Eigen::Vector3d(U(rng), U(rng), U(rng))}),
+                                 nullptr, x[i].data());
+      }
+      if (shared) {
+        problem.AddResidualBlock(new ceres::AutoDiffCostFunction<Shared, 1, 3, 1>(new Shared{U(rng)}), nullptr,
+                                 x[i].data(), g);
+      }
+    }
+    if (shared) {
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<Prior, 3, 3>(new Prior{Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones()}),
+                               nullptr, x[n / 2].data());  // keeps it well posed whatever the links
+    }
+    if (cycle) {  // a loop closure: eliminating it fills in far pairs
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<Link, 3, 3, 3>(new Link{M3(), V3()}), nullptr,
+                               x[0].data(), x[n - 1].data());
+    }
+    if (constant_block) {
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<Link, 3, 3, 3>(new Link{Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero()}),
+                               nullptr, fixed, x[n - 1].data());
+      problem.SetParameterBlockConstant(fixed);
+    }
+  }
+};
+
+double RelativeDifference(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return (a - b).cwiseAbs().maxCoeff() / std::max(b.cwiseAbs().maxCoeff(), 1e-300);
+}
+
+TEST(SparseMarginals, MatchCeresCovarianceOnRandomChains) {
+  int checked = 0;
+  for (unsigned seed = 1; seed <= 24; ++seed) {
+    const bool shared = seed % 2 == 0, losses = seed % 3 == 0, constant = seed % 4 == 1;
+    RandomChain chain(5 + static_cast<int>(seed) * 5, seed, shared, losses, constant);
+    SparseMarginals marginals;
+    ASSERT_TRUE(marginals.Compute(chain.problem)) << marginals.error();
+    ceres::Covariance::Options options;
+    options.algorithm_type = ceres::DENSE_SVD;  // the plain definition: (J^T J)^-1
+    ceres::Covariance reference(options);
+    std::vector<std::pair<const double*, const double*>> pairs;
+    for (std::size_t i = 0; i < chain.x.size(); ++i) {
+      pairs.emplace_back(chain.x[i].data(), chain.x[i].data());
+      if (i > 0) pairs.emplace_back(chain.x[i - 1].data(), chain.x[i].data());
+    }
+    if (shared) pairs.emplace_back(chain.g, chain.g);
+    ASSERT_TRUE(reference.Compute(pairs, &chain.problem));
+    for (const auto& [a, b] : pairs) {
+      const int ra = chain.problem.ParameterBlockSize(a), rb = chain.problem.ParameterBlockSize(b);
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> expected(ra, rb);
+      ASSERT_TRUE(reference.GetCovarianceBlock(a, b, expected.data()));
+      const Eigen::MatrixXd got = marginals.CrossCovariance(a, b);
+      EXPECT_LT(RelativeDifference(got, expected), 1e-9) << "seed " << seed;
+      ++checked;
+    }
+    if (constant) {
+      EXPECT_EQ(marginals.Covariance(chain.fixed), Eigen::MatrixXd::Zero(3, 3));  // no uncertainty
+    }
+  }
+  EXPECT_GT(checked, 1000);
+}
+
+// Every pair the factor links (including pairs linked only by fill-in) against the dense inverse
+// of J^T J built from the same Jacobian; pairs outside the pattern throw.
+TEST(SparseMarginals, EveryAvailablePairEqualsTheDenseInverse) {
+  int fill_only = 0, available = 0, unavailable = 0;
+  for (unsigned seed = 1; seed <= 6; ++seed) {
+    RandomChain chain(30, seed, seed % 2 == 0, true, false, true);
+    SparseMarginals marginals;
+    ASSERT_TRUE(marginals.Compute(chain.problem)) << marginals.error();
+    std::vector<double*> blocks;
+    for (auto& v : chain.x) blocks.push_back(v.data());
+    if (seed % 2 == 0) blocks.push_back(chain.g);
+    ceres::Problem::EvaluateOptions eval;
+    eval.parameter_blocks = blocks;
+    ceres::CRSMatrix crs;
+    ASSERT_TRUE(chain.problem.Evaluate(eval, nullptr, nullptr, nullptr, &crs));
+    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+    for (int r = 0; r < crs.num_rows; ++r) {
+      for (int k = crs.rows[r]; k < crs.rows[r + 1]; ++k) J(r, crs.cols[k]) = crs.values[k];
+    }
+    const Eigen::MatrixXd H = J.transpose() * J;
+    const Eigen::MatrixXd inverse = H.inverse();
+    std::vector<int> offset;
+    int o = 0;
+    for (double* b : blocks) { offset.push_back(o); o += chain.problem.ParameterBlockSize(b); }
+    for (std::size_t a = 0; a < blocks.size(); ++a) {
+      for (std::size_t b = 0; b < blocks.size(); ++b) {
+        Eigen::MatrixXd got;
+        try {
+          got = marginals.CrossCovariance(blocks[a], blocks[b]);
+        } catch (const std::logic_error&) {
+          ++unavailable;
+          continue;
+        }
+        ++available;
+        const int a_size = chain.problem.ParameterBlockSize(blocks[a]), b_size = chain.problem.ParameterBlockSize(blocks[b]);
+        const Eigen::MatrixXd expected = inverse.block(offset[a], offset[b], a_size, b_size);
+        EXPECT_LT(RelativeDifference(got, expected), 1e-8) << "seed " << seed << " blocks " << a << ", " << b;
+        const std::size_t last = chain.x.size() - 1;
+        const bool direct = a == b || (a < chain.x.size() && b < chain.x.size() && (a > b ? a - b : b - a) <= 2) ||
+                            a >= chain.x.size() || b >= chain.x.size() || (a == 0 && b == last) || (b == 0 && a == last);
+        if (!direct) ++fill_only;
+      }
+    }
+  }
+  EXPECT_GT(fill_only, 0);  // the pattern's fill was exercised, not only the factors' pairs
+  EXPECT_GT(unavailable, 0);
+  std::printf("[marginals] %d block pairs equal to the dense inverse (%d linked only by fill), %d outside the pattern\n",
+              available, fill_only, unavailable);
+}
+
+TEST(SparseMarginals, FixedAndUnusedBlocksHaveZeroCovarianceLikeCeres) {
+  RandomChain chain(12, 3, false, false, true);
+  double unused[2] = {1.0, 2.0};
+  chain.problem.AddParameterBlock(unused, 2);  // no residual uses it
+  SparseMarginals marginals;
+  ASSERT_TRUE(marginals.Compute(chain.problem)) << marginals.error();
+  EXPECT_EQ(marginals.Covariance(unused), Eigen::MatrixXd::Zero(2, 2));
+  EXPECT_EQ(marginals.Covariance(chain.fixed), Eigen::MatrixXd::Zero(3, 3));
+  EXPECT_EQ(marginals.CrossCovariance(chain.fixed, chain.x[0].data()), Eigen::MatrixXd::Zero(3, 3));
+  double stranger[3] = {0, 0, 0};
+  EXPECT_THROW(marginals.Covariance(stranger), std::logic_error);
+  // Every block fixed: nothing to compute, said so.
+  ceres::Problem empty;
+  double a[3] = {0, 0, 0};
+  empty.AddParameterBlock(a, 3);
+  empty.SetParameterBlockConstant(a);
+  EXPECT_FALSE(marginals.Compute(empty));
+  EXPECT_NE(marginals.error().find("no variable"), std::string::npos);
+}
+
+struct ScaledAuto {
+  double w;
+  template <class T>
+  bool operator()(const T* a, const T* b, T* r) const {
+    r[0] = T(w) * (b[0] - a[0]);
+    return true;
+  }
+};
+struct UnitAuto {
+  template <class T>
+  bool operator()(const T* a, T* r) const {
+    r[0] = a[0];
+    return true;
+  }
+};
+
+// A residual that evaluates to NaN in its Jacobian.
+struct NanJacobian {
+  template <class T>
+  bool operator()(const T* x, T* r) const {
+    r[0] = sqrt(x[0] - x[0]);  // d sqrt(u) / du at u = 0: infinite, times 0: NaN
+    return true;
+  }
+};
+
+TEST(SparseMarginals, RefusesSingularProblemsAndEarlyQueries) {
+  SparseMarginals m;
+  double x[3] = {0, 0, 0};
+  EXPECT_THROW(m.Covariance(x), std::logic_error);
+  // Relative links only: the chain can slide as a whole (gauge freedom).
+  ceres::Problem problem;
+  std::vector<std::array<double, 3>> v(6, {0.0, 0.0, 0.0});
+  for (int i = 1; i < 6; ++i) {
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<Link, 3, 3, 3>(new Link{Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero()}),
+                             nullptr, v[i - 1].data(), v[i].data());
+  }
+  EXPECT_FALSE(m.Compute(problem));
+  EXPECT_NE(m.error().find("unobservable"), std::string::npos) << m.error();
+  EXPECT_THROW(m.Covariance(v[0].data()), std::logic_error);
+  // Fixing the first block makes it well posed.
+  problem.SetParameterBlockConstant(v[0].data());
+  ASSERT_TRUE(m.Compute(problem)) << m.error();
+  EXPECT_NEAR(m.Covariance(v[5].data())(0, 0), 5.0, 1e-9);  // five unit-variance links in series
+  EXPECT_NEAR(m.Covariance(v[5].data())(0, 1), 0.0, 1e-12);
+  // A NaN in the Jacobian is named, not factorized.
+  double y[1] = {0.5};
+  problem.AddResidualBlock(new ceres::AutoDiffCostFunction<NanJacobian, 1, 1>(new NanJacobian), nullptr, y);
+  EXPECT_FALSE(m.Compute(problem));
+  EXPECT_NE(m.error().find("non-finite"), std::string::npos) << m.error();
+  problem.RemoveParameterBlock(y);
+  // A nearly dependent direction (a link 3e7 times stiffer than the only prior: cond(J) 3e7,
+  // pivot ratio about 1e-15) names its block.
+  ceres::Problem stiff;
+  double p0[1] = {0.0}, p1[1] = {0.0};
+  stiff.AddResidualBlock(new ceres::AutoDiffCostFunction<UnitAuto, 1, 1>(new UnitAuto), nullptr, p0);
+  stiff.AddResidualBlock(new ceres::AutoDiffCostFunction<ScaledAuto, 1, 1, 1>(new ScaledAuto{3e7}), nullptr, p0, p1);
+  EXPECT_FALSE(m.Compute(stiff));
+  EXPECT_TRUE(m.failed_block() == p0 || m.failed_block() == p1) << m.error();
+  EXPECT_NE(m.error().find("singular"), std::string::npos) << m.error();
+}
+
+TEST(SparseMarginals, EstimatorCovariancesEqualCeresCovariance) {
+  testing::PushSpec spec;
+  spec.contact_offset = 0.02;
+  spec.duration = 0.8;
+  spec.seed = 3;
+  const limit_surface::Trajectory traj = testing::GeneratePush(spec);
+  for (Mode mode : {Mode::kBatch, Mode::kIncremental}) {
+    EstimatorConfig fast, reference;
+    fast.estimate_c = reference.estimate_c = mode == Mode::kBatch;
+    reference.covariance_method = EstimatorConfig::CovarianceMethod::kCeres;
+    const EstimationResult a = Estimate(traj, Model::kQs, mode, fast);
+    const EstimationResult b = Estimate(traj, Model::kQs, mode, reference);
+    ASSERT_EQ(a.solver.covariance_status, "ok");
+    ASSERT_EQ(b.solver.covariance_status, "ok");
+    ASSERT_EQ(a.states.size(), b.states.size());
+    double worst = 0.0;
+    for (std::size_t i = 0; i < a.states.size(); ++i) {
+      worst = std::max(worst, RelativeDifference(*a.states[i].object_pose_cov, *b.states[i].object_pose_cov));
+      worst = std::max(worst, RelativeDifference(*a.states[i].finger_pose_cov, *b.states[i].finger_pose_cov));
+      if (b.states[i].contact_cov) worst = std::max(worst, RelativeDifference(*a.states[i].contact_cov, *b.states[i].contact_cov));
+      if (b.states[i].force_cov) worst = std::max(worst, RelativeDifference(*a.states[i].force_cov, *b.states[i].force_cov));
+    }
+    EXPECT_LT(worst, 1e-7) << ModeName(mode);
+    if (mode == Mode::kBatch) {
+      ASSERT_TRUE(a.c_sigma && b.c_sigma);
+      EXPECT_NEAR(*a.c_sigma, *b.c_sigma, 1e-9 * *b.c_sigma);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace pushgraph::graph
