@@ -14,7 +14,8 @@
 // cross-multiplied quasi-static factor + zero-velocity (random-walk) priors, no S.
 // Steps: the sorted union of all measurement time stamps; a step has a factor for each
 // measurement it has, contact variables only while in contact (EstimatorConfig's gating).
-// Modes: kBatch solves everything at once (Ceres LM, SPARSE_NORMAL_CHOLESKY, ceres::Covariance);
+// Modes: kBatch solves everything at once (Ceres LM, SPARSE_NORMAL_CHOLESKY; covariances by
+// SparseMarginals, marginals.h);
 // kIncremental is a fixed-lag smoother (incremental.h).
 #include <pushgraph/graph/config.h>
 #include <pushgraph/graph/factors.h>
