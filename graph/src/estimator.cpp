@@ -241,6 +241,12 @@ void GraphBuilder::EnableMuEstimation() {
   if (!(f_max_ > 0.0)) {
     throw GraphError("estimate_mu needs the object's mass and mu_surface in the trajectory");
   }
+  if (traj_.measured.force.empty()) {
+    // Scaling every force and mu together leaves D and the load factor unchanged: only the
+    // force priors would decide, and they pull mu down (measured: to its lower bound, with a
+    // confident sigma). Refuse rather than report that.
+    throw GraphError("estimate_mu needs a force stream: without force measurements mu is not observable");
+  }
   estimate_mu_ = true;
   use_load_factor_ = true;
   mu_var_[0] = mu_surface_;
@@ -453,13 +459,19 @@ void GraphBuilder::AddDynamicFactors(ceres::Problem& problem, int i) {
                                                          cfg_.quasi_static_sigma * rate_scale),
                                    nullptr, vars_[i - 1].x, v.x, v.p, v.f);
         }
-        if (use_load_factor_ && estimate_mu_) {
-          problem.AddResidualBlock(new LimitSurfaceLoadFactorWithMu(g, normal_load_, cfg_.eps_velocity, cfg_.eps_force,
-                                                                    cfg_.limit_surface_sigma * rate_scale),
-                                   nullptr, vars_[i - 1].x, v.x, v.p, v.f, mu_var_);
+        if (use_load_factor_ && (estimate_c_ || estimate_mu_)) {
+          // The same c as D's (estimated) and/or mu as variables.
+          std::vector<double*> blocks{vars_[i - 1].x, v.x, v.p, v.f};
+          if (estimate_c_) blocks.push_back(c_var_);
+          if (estimate_mu_) blocks.push_back(mu_var_);
+          problem.AddResidualBlock(
+              new LimitSurfaceLoadFactorWithParameters(g, normal_load_, mu_surface_, {estimate_c_, estimate_mu_},
+                                                       cfg_.eps_velocity, cfg_.eps_force,
+                                                       cfg_.limit_surface_sigma * rate_scale),
+              nullptr, blocks);
           // Prior around the trajectory's mu; bounds keep f_max physical.
-          if (!mu_in_problem_) AddSharedParameterPrior(problem, mu_var_, mu_surface_, cfg_.mu_prior_sigma);
-          mu_in_problem_ = true;
+          if (estimate_mu_ && !mu_in_problem_) AddSharedParameterPrior(problem, mu_var_, mu_surface_, cfg_.mu_prior_sigma);
+          mu_in_problem_ = mu_in_problem_ || estimate_mu_;
         } else if (use_load_factor_) {
           problem.AddResidualBlock(new LimitSurfaceLoadFactor(g, f_max_, cfg_.eps_velocity, cfg_.eps_force,
                                                               cfg_.limit_surface_sigma * rate_scale),
@@ -509,9 +521,12 @@ std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder, c
     const auto start = std::chrono::steady_clock::now();
     if (marginals.Compute(problem)) {
       if (SolverLogLevel() >= 1) {
+        const SparseMarginals::Timings& t = marginals.timings();
         std::cerr << "pushgraph marginals: " << marginals.num_unknowns() << " unknowns, "
                   << marginals.num_factor_nonzeros() << " factor nonzeros, "
-                  << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() << " s\n";
+                  << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
+                  << " s (Jacobian " << t.jacobian << ", J^T J " << t.normal_equations << ", Cholesky "
+                  << t.factorization << ", selected inversion " << t.inversion << ")\n";
       }
       get = [&](double* b, double* out) {
         const Eigen::MatrixXd m = marginals.Covariance(b);
@@ -659,8 +674,12 @@ EstimationResult EstimateBatch(const limit_surface::Trajectory& traj, Model mode
   }
   if (ModelHasForce(model)) r.c = builder.c();
   r.c_estimated = builder.c_block() != nullptr;
-  if (model == Model::kQs && builder.mu() > 0.0) r.mu = builder.mu();
+  if (model == Model::kQs && builder.uses_load_factor()) r.mu = builder.mu();
   r.mu_estimated = builder.mu_block() != nullptr;
+  r.c_at_bound = builder.c_at_bound();
+  r.mu_at_bound = builder.mu_at_bound();
+  if (r.c_at_bound) r.c_sigma.reset();
+  if (r.mu_at_bound) r.mu_sigma.reset();
   r.solver.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   r.solver.iterations = stage_iterations + summary.num_successful_steps + summary.num_unsuccessful_steps;
   r.solver.final_cost = summary.final_cost;

@@ -402,9 +402,10 @@ LimitSurfaceLoadFactor::LimitSurfaceLoadFactor(const QuasiStaticGeometry& geomet
 
 namespace {
 
-// r = w s_v (b / f_max - 1), b = |g'|_eps; the Jacobian with respect to f_max into *J_fmax.
+// r = w s_v (b / f_max - 1), b = |g'|_eps. With J_fmax: d r / d f_max; with J_c: d r / d c.
 bool EvaluateLoad(const QuasiStaticGeometry& geometry, double f_max, double eps_v, double eps_f, double w,
-                  double const* const* parameters, double* residuals, double** jacobians, double* J_fmax) {
+                  double const* const* parameters, double* residuals, double** jacobians, double* J_fmax,
+                  double* J_c) {
   if (!(f_max > 0.0)) return false;
   const QuasiStaticTerms t = ComputeQuasiStaticTerms(
       geometry, PoseFrom(parameters[0]), PoseFrom(parameters[1]),
@@ -422,6 +423,8 @@ bool EvaluateLoad(const QuasiStaticGeometry& geometry, double f_max, double eps_
   if (jacobians[2] != nullptr) Eigen::Map<Eigen::RowVector2d>{jacobians[2]} = J_r_g * t.J_g_p;
   if (jacobians[3] != nullptr) Eigen::Map<Eigen::RowVector2d>{jacobians[3]} = J_r_g * t.J_g_f;
   if (J_fmax != nullptr) *J_fmax = -w * sv * b / (f_max * f_max);
+  // V'_z = c omega and g'_z = tau / c: dV'/dc = (0, 0, V'_z / c), dg'/dc = (0, 0, -g'_z / c).
+  if (J_c != nullptr) *J_c = J_r_V(2) * (t.V.z() / geometry.c) - J_r_g(2) * (t.g.z() / geometry.c);
   return true;
 }
 
@@ -429,31 +432,43 @@ bool EvaluateLoad(const QuasiStaticGeometry& geometry, double f_max, double eps_
 
 bool LimitSurfaceLoadFactor::Evaluate(double const* const* parameters, double* residuals,
                                       double** jacobians) const {
-  return EvaluateLoad(geometry_, f_max_, eps_v_, eps_f_, w_, parameters, residuals, jacobians, nullptr);
+  return EvaluateLoad(geometry_, f_max_, eps_v_, eps_f_, w_, parameters, residuals, jacobians, nullptr, nullptr);
 }
 
-LimitSurfaceLoadFactorWithMu::LimitSurfaceLoadFactorWithMu(const QuasiStaticGeometry& geometry, double normal_load,
-                                                           double eps_velocity, double eps_force, double sigma)
-    : geometry_(geometry), normal_load_(normal_load), eps_v_(eps_velocity), eps_f_(eps_force),
-      w_(CheckedWeight(sigma, "limit-surface load")) {
+LimitSurfaceLoadFactorWithParameters::LimitSurfaceLoadFactorWithParameters(
+    const QuasiStaticGeometry& geometry, double normal_load, double mu, Variables variables, double eps_velocity,
+    double eps_force, double sigma)
+    : geometry_(geometry), normal_load_(normal_load), mu_(mu), eps_v_(eps_velocity), eps_f_(eps_force),
+      w_(CheckedWeight(sigma, "limit-surface load")), variables_(variables) {
   CheckGeometry(geometry_);
   if (!(normal_load > 0.0) || !std::isfinite(normal_load)) {
     throw GraphError("limit-surface load factor: the normal load m g must be > 0");
   }
+  if (!variables.mu && (!(mu > 0.0) || !std::isfinite(mu))) throw GraphError("limit-surface load factor: mu must be > 0");
   if (!(eps_v_ > 0.0) || !(eps_f_ > 0.0)) throw GraphError("limit-surface load factor: eps must be > 0");
+  set_num_residuals(1);
+  for (int size : {3, 3, 2, 2}) mutable_parameter_block_sizes()->push_back(size);
+  if (variables.c) mutable_parameter_block_sizes()->push_back(1);
+  if (variables.mu) mutable_parameter_block_sizes()->push_back(1);
 }
 
-bool LimitSurfaceLoadFactorWithMu::Evaluate(double const* const* parameters, double* residuals,
-                                            double** jacobians) const {
-  const double mu = parameters[4][0];
-  if (!(mu > 0.0) || !std::isfinite(mu)) return false;
-  double J_fmax = 0.0;
-  const bool want_mu = jacobians != nullptr && jacobians[4] != nullptr;
-  if (!EvaluateLoad(geometry_, mu * normal_load_, eps_v_, eps_f_, w_, parameters, residuals, jacobians,
-                    want_mu ? &J_fmax : nullptr)) {
+bool LimitSurfaceLoadFactorWithParameters::Evaluate(double const* const* parameters, double* residuals,
+                                                    double** jacobians) const {
+  const int c_index = variables_.c ? 4 : -1;
+  const int mu_index = variables_.mu ? (variables_.c ? 5 : 4) : -1;
+  QuasiStaticGeometry geometry = geometry_;
+  if (c_index >= 0) geometry.c = parameters[c_index][0];
+  const double mu = mu_index >= 0 ? parameters[mu_index][0] : mu_;
+  if (!(geometry.c > 0.0) || !std::isfinite(geometry.c) || !(mu > 0.0) || !std::isfinite(mu)) return false;
+  double J_fmax = 0.0, J_c = 0.0;
+  const bool want_c = jacobians != nullptr && c_index >= 0 && jacobians[c_index] != nullptr;
+  const bool want_mu = jacobians != nullptr && mu_index >= 0 && jacobians[mu_index] != nullptr;
+  if (!EvaluateLoad(geometry, mu * normal_load_, eps_v_, eps_f_, w_, parameters, residuals, jacobians,
+                    want_mu ? &J_fmax : nullptr, want_c ? &J_c : nullptr)) {
     return false;
   }
-  if (want_mu) jacobians[4][0] = J_fmax * normal_load_;  // f_max = mu N
+  if (want_c) jacobians[c_index][0] = J_c;
+  if (want_mu) jacobians[mu_index][0] = J_fmax * normal_load_;  // f_max = mu N
   return true;
 }
 

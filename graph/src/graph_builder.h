@@ -4,6 +4,7 @@
 
 #include <ceres/ceres.h>
 
+#include <cmath>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -67,6 +68,13 @@ class GraphBuilder {
   double* mu_block() { return mu_in_problem_ ? mu_var_ : nullptr; }
   /// mu of the load factor: the estimate, or the trajectory's mu_surface (0 when unknown).
   double mu() const { return estimate_mu_ ? mu_var_[0] : mu_surface_; }
+  bool uses_load_factor() const { return use_load_factor_; }
+  /// Whether an estimated c / mu sits on a bound of AddSharedParameterPrior's [0.2, 5] x start.
+  bool c_at_bound() const { return estimate_c_ && AtBound(c_var_[0], qs_.c); }
+  bool mu_at_bound() const { return estimate_mu_ && AtBound(mu_var_[0], mu_surface_); }
+  static bool AtBound(double value, double start) {
+    return std::abs(value - 0.2 * start) <= 1e-6 * start || std::abs(value - 5.0 * start) <= 1e-6 * start;
+  }
   double c_initial() const { return qs_.c; }
   /// The estimate of step i (no covariances).
   StateEstimate State(int i) const;

@@ -66,6 +66,9 @@ struct IncrementalEstimator::Impl {
 
   Impl(const limit_surface::Trajectory& t, Model model, const EstimatorConfig& c)
       : traj(t), cfg(c), builder(t, model, c) {
+    if (cfg.estimate_c || cfg.estimate_mu) {
+      throw GraphError("estimate_c and estimate_mu are batch only: the incremental mode keeps c and mu fixed");
+    }
     ceres::Problem::Options po;
     po.enable_fast_removal = true;
     problem = std::make_unique<ceres::Problem>(po);

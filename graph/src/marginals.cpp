@@ -15,6 +15,7 @@
 #include <Eigen/SparseCore>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <numeric>
 #include <stdexcept>
@@ -93,6 +94,10 @@ bool SparseMarginals::Compute(ceres::Problem& problem) {
     error_ = "no variable parameter blocks";
     return false;
   }
+  using Clock = std::chrono::steady_clock;
+  auto seconds_since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
+  timings_ = Timings{};
+  auto phase = Clock::now();
   ceres::Problem::EvaluateOptions eval;
   eval.parameter_blocks = variable;
   eval.apply_loss_function = true;
@@ -108,10 +113,14 @@ bool SparseMarginals::Compute(ceres::Problem& problem) {
       return false;
     }
   }
+  timings_.jacobian = seconds_since(phase);
+  phase = Clock::now();
   const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>> J(
       crs.num_rows, crs.num_cols, static_cast<Eigen::Index>(crs.values.size()), crs.rows.data(), crs.cols.data(),
       crs.values.data());
   const Eigen::SparseMatrix<double> H = Eigen::SparseMatrix<double>(J.transpose()) * J;
+  timings_.normal_equations = seconds_since(phase);
+  phase = Clock::now();
   Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> llt(H);
   if (llt.info() != Eigen::Success) {
     error_ = "the information matrix J^T J is not positive definite (an unobservable direction: gauge "
@@ -156,6 +165,8 @@ bool SparseMarginals::Compute(ceres::Problem& problem) {
     }
     impl->col_start[j + 1] = static_cast<int>(impl->row.size());
   }
+  timings_.factorization = seconds_since(phase);
+  phase = Clock::now();
   impl->z.assign(values.size(), 0.0);
   // Per column j: Z_RR (R = the rows below the diagonal) gathered densely, each column r_a of Z
   // merged with R (R's rows from r_a on are a subset of that column's pattern), then one matvec.
@@ -179,7 +190,10 @@ bool SparseMarginals::Compute(ceres::Problem& problem) {
       for (int b = a; b < m; ++b) {
         const int rb = rows[begin + 1 + b];
         while (p < p_end && rows[p] < rb) ++p;
-        if (p == p_end || rows[p] != rb) throw std::logic_error("SparseMarginals: factor pattern is not chordal");
+        if (p == p_end || rows[p] != rb) {  // cannot happen for a Cholesky pattern (chordal)
+          error_ = "internal error: the Cholesky factor's pattern is not chordal";
+          return false;
+        }
         z_rr(a, b) = z_rr(b, a) = impl->z[p];
       }
     }
@@ -187,6 +201,7 @@ bool SparseMarginals::Compute(ceres::Problem& problem) {
     Eigen::Map<Eigen::VectorXd>(&impl->z[begin + 1], m) = z_rj;
     impl->z[begin] = (1.0 / ljj - l_r.dot(z_rj)) / ljj;
   }
+  timings_.inversion = seconds_since(phase);
   impl_ = std::move(impl);
   return true;
 }
@@ -216,5 +231,14 @@ Eigen::MatrixXd SparseMarginals::CrossCovariance(const double* a, const double* 
 }
 
 Eigen::MatrixXd SparseMarginals::Covariance(const double* block) const { return CrossCovariance(block, block); }
+
+bool SparseMarginals::HasCrossCovariance(const double* a, const double* b) const {
+  try {
+    CrossCovariance(a, b);
+  } catch (const std::logic_error&) {
+    return false;
+  }
+  return true;
+}
 
 }  // namespace pushgraph::graph

@@ -732,6 +732,7 @@ EvaluationRow EvaluateItem(const EvaluationItem& item, const EvaluationOptions& 
       const ls::Trajectory& t = noisy.at(run.noise);
       graph::EstimatorConfig cfg = graph::ApplyMeasurementSigmas(o.estimator, *t.measurement_sigmas);
       cfg.covariance = run.covariance;
+      if (run.mode == graph::Mode::kIncremental) cfg.estimate_c = cfg.estimate_mu = false;  // batch only
       graph::EstimationResult r = graph::Estimate(t, run.model, run.mode, cfg);
       AccumulateRun(t, r, run.Prefix(), run.noise == "occluded" ? window : Window{}, sink);
       if (row.steps == 0) row.steps = static_cast<int>(r.states.size());

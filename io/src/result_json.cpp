@@ -52,16 +52,21 @@ std::string ResultToJson(const graph::EstimationResult& r, int indent) {
                  {"max_update_time_s", r.solver.max_update_time_s},
                  {"mean_update_time_s", r.solver.mean_update_time_s},
                  {"covariance", r.solver.covariance_status}};
+  // The model's shared parameters: c (QS, baseline) and the load factor's mu, estimated or not.
+  nlohmann::json parameters = nlohmann::json::object();
   if (r.c) {
-    nlohmann::json c = {{"c", *r.c}, {"estimated", r.c_estimated}};
-    if (r.c_sigma) c["c_sigma"] = *r.c_sigma;
-    if (r.mu) {
-      c["mu"] = *r.mu;
-      c["mu_estimated"] = r.mu_estimated;
-      if (r.mu_sigma) c["mu_sigma"] = *r.mu_sigma;
-    }
-    j["parameters"] = std::move(c);
+    parameters["c"] = *r.c;
+    parameters["c_estimated"] = r.c_estimated;
+    if (r.c_sigma) parameters["c_sigma"] = *r.c_sigma;
+    if (r.c_at_bound) parameters["c_at_bound"] = true;
   }
+  if (r.mu) {
+    parameters["mu"] = *r.mu;
+    parameters["mu_estimated"] = r.mu_estimated;
+    if (r.mu_sigma) parameters["mu_sigma"] = *r.mu_sigma;
+    if (r.mu_at_bound) parameters["mu_at_bound"] = true;
+  }
+  if (!parameters.empty()) j["parameters"] = std::move(parameters);
   if (!r.metrics.empty()) {
     Json m = Json::object();
     for (const auto& [k, v] : r.metrics) m[k] = v;

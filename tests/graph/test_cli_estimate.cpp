@@ -78,6 +78,24 @@ TEST_F(EstimateCli, ConfigFileIsApplied) {
   const std::string out = dir() + "/result_cfg.json";
   ASSERT_EQ(Tool("estimate " + in + " --model qs -o " + out + " --config " + cfg).status, 0);
   EXPECT_FALSE(Load(out)["states"][10].contains("object_pose_cov"));
+  // c and mu estimated: RESULT.json's "parameters" carries both with their sigmas.
+  const std::string joint = dir() + "/estimate_joint.json";
+  std::ofstream(joint) << R"({"estimate_c": true, "estimate_mu": true})";
+  ASSERT_EQ(Tool("estimate " + in + " --model qs -o " + out + " --config " + joint).status, 0);
+  const nlohmann::json p = Load(out)["parameters"];
+  EXPECT_TRUE(p["c_estimated"].get<bool>());
+  EXPECT_TRUE(p["mu_estimated"].get<bool>());
+  EXPECT_GT(p["c_sigma"].get<double>(), 0.0);
+  EXPECT_GT(p["mu_sigma"].get<double>(), 0.0);
+  EXPECT_NEAR(p["mu"].get<double>(), 0.25, 0.05);  // the push generator's mu
+  // Batch only: the incremental mode refuses with one line.
+  const pushgraph::testing::ToolRun r = Tool("estimate " + in + " --model qs --mode incremental -o " + out + " --config " + joint);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("batch only"), std::string::npos) << r.err;
+  // Default QS with a force stream: the load factor is off, so mu plays no part and is not reported.
+  ASSERT_EQ(Tool("estimate " + in + " --model qs -o " + out).status, 0);
+  EXPECT_FALSE(Load(out)["parameters"].contains("mu"));
+  EXPECT_FALSE(Load(out)["parameters"]["c_estimated"].get<bool>());
 }
 
 TEST_F(EstimateCli, BadInputGetsOneLineErrors) {

@@ -100,6 +100,16 @@ TEST(Estimator, JointEstimationOfCMovesTowardsTheTruth) {
   EXPECT_DOUBLE_EQ(*fixed.c, 1.4 * c_true);
 }
 
+// The GraphError message of a QS batch estimate ("no error" when it succeeds).
+std::string BatchQsError(const limit_surface::Trajectory& t, const EstimatorConfig& cfg) {
+  try {
+    Estimate(t, Model::kQs, Mode::kBatch, cfg);
+  } catch (const GraphError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
 // mu from the force stream: while the object slides, |g'| = mu m g (the push generator follows
 // the ellipsoidal limit surface exactly). Started 40% high, the estimate must come back.
 TEST(Estimator, JointEstimationOfMuMovesTowardsTheTruth) {
@@ -118,21 +128,51 @@ TEST(Estimator, JointEstimationOfMuMovesTowardsTheTruth) {
   EXPECT_LT(std::abs(*r.mu - mu_true), 0.25 * std::abs(1.4 * mu_true - mu_true));
   EXPECT_GT(*r.mu_sigma, 0.0);
   EXPECT_LT(std::abs(*r.mu - mu_true), 4.0 * *r.mu_sigma + 0.01 * mu_true);
-  // Off by default: mu is reported (the trajectory's) but fixed.
+  // Off by default: with a force stream the load factor is off and mu plays no part (not
+  // reported); with the load factor on it is the trajectory's, fixed.
   cfg.estimate_mu = false;
+  EXPECT_FALSE(Estimate(t, Model::kQs, Mode::kBatch, cfg).mu.has_value());
+  cfg.limit_surface_load = EstimatorConfig::LimitSurfaceLoad::kOn;
   const EstimationResult fixed = Estimate(t, Model::kQs, Mode::kBatch, cfg);
   EXPECT_FALSE(fixed.mu_estimated);
+  ASSERT_TRUE(fixed.mu.has_value());
   EXPECT_DOUBLE_EQ(*fixed.mu, 1.4 * mu_true);
+  cfg.limit_surface_load = EstimatorConfig::LimitSurfaceLoad::kAuto;
+  // c and mu together: the load factor shares D's c, and both move towards the truth.
+  {
+    PushSpec turn = OffsetPush(7);
+    turn.contact_offset = 0.03;  // off-centre: rotation makes c observable
+    limit_surface::Trajectory both = GeneratePush(turn);
+    both.object.mu_surface = 1.4 * turn.mu;
+    EstimatorConfig cm;
+    const double c_true = QuasiStaticGeometryFor(both, cm).c;
+    cm.c_scale = 1.4;
+    cm.estimate_c = cm.estimate_mu = true;
+    cm.c_prior_sigma = cm.mu_prior_sigma = 1.0;
+    const EstimationResult rb = Estimate(both, Model::kQs, Mode::kBatch, cm);
+    ASSERT_TRUE(rb.c && rb.mu && rb.c_sigma && rb.mu_sigma);
+    std::printf("[c+mu] c true %.5f estimate %.5f (sigma %.5f); mu true %.4f estimate %.4f (sigma %.4f)\n", c_true,
+                *rb.c, *rb.c_sigma, turn.mu, *rb.mu, *rb.mu_sigma);
+    EXPECT_LT(std::abs(*rb.c - c_true), 0.5 * 0.4 * c_true);
+    EXPECT_LT(std::abs(*rb.mu - turn.mu), 0.25 * 0.4 * turn.mu);
+    // Batch only: the incremental mode says so instead of ignoring the request.
+    EXPECT_THROW(Estimate(both, Model::kQs, Mode::kIncremental, cm), GraphError);
+  }
+  // Without a force stream mu is not observable (forces and mu scale together): refused.
+  {
+    limit_surface::Trajectory no_force = t;
+    no_force.measured.force.clear();
+    EstimatorConfig nf;
+    nf.estimate_mu = true;
+    const std::string why = BatchQsError(no_force, nf);
+    EXPECT_NE(why.find("force stream"), std::string::npos) << why;
+  }
   // Without the object's friction there is nothing to start from: a clear error.
   limit_surface::Trajectory no_mu = t;
   no_mu.object.mu_surface = 0.0;
   cfg.estimate_mu = true;
-  try {
-    Estimate(no_mu, Model::kQs, Mode::kBatch, cfg);
-    ADD_FAILURE() << "expected a GraphError";
-  } catch (const GraphError& e) {
-    EXPECT_NE(std::string(e.what()).find("mu_surface"), std::string::npos) << e.what();
-  }
+  const std::string why = BatchQsError(no_mu, cfg);
+  EXPECT_NE(why.find("mu_surface"), std::string::npos) << why;
 }
 
 TEST(Estimator, MeasurementSigmasSetTheMeasurementFactors) {

@@ -307,6 +307,16 @@ TEST(FactorJacobians, ContactWitness) {
   EXPECT_TRUE(tally.MostlyChecked(0.8));
 }
 
+// Evaluates a 4-block quasi-static factor.
+Eigen::VectorXd Residual(const ceres::CostFunction& f, const QsCase& c) {
+  Eigen::Vector3d a = c.x_prev.vector(), b = c.x.vector();
+  Eigen::Vector2d p = c.p, fo = c.f;
+  const double* ps[4] = {a.data(), b.data(), p.data(), fo.data()};
+  Eigen::VectorXd r(f.num_residuals());
+  EXPECT_TRUE(f.Evaluate(ps, r.data(), nullptr));
+  return r;
+}
+
 TEST(FactorJacobians, QuasiStaticBothForms) {
   Rng rng;
   QuasiStaticGeometry g;
@@ -319,9 +329,12 @@ TEST(FactorJacobians, QuasiStaticBothForms) {
   LimitSurfaceLoadFactor l(g, 2.0, 1e-3, 0.05, 0.1);
   CrossMultipliedQuasiStaticFactor y(g, 1e-3);
   QuasiStaticFactorWithC dc(g, 1e-3, 0.05, 0.1);
-  LimitSurfaceLoadFactorWithMu lm(g, 0.8 * 9.81, 1e-3, 0.05, 0.1);
-  JacobianTally tm("limit-surface load with mu");
-  WorstError wm{"D limit-surface load with mu as a variable"};
+  LimitSurfaceLoadFactorWithParameters lm(g, 0.8 * 9.81, 0.3, {false, true}, 1e-3, 0.05, 0.1);
+  LimitSurfaceLoadFactorWithParameters lc(g, 0.8 * 9.81, 0.3, {true, false}, 1e-3, 0.05, 0.1);
+  LimitSurfaceLoadFactorWithParameters lcm(g, 0.8 * 9.81, 0.3, {true, true}, 1e-3, 0.05, 0.1);
+  JacobianTally tm("limit-surface load with mu"), tlc("limit-surface load with c"), tlcm("limit-surface load with c and mu");
+  WorstError wm{"D limit-surface load with mu as a variable"}, wlc{"D limit-surface load with c as a variable"},
+      wlcm{"D limit-surface load with c and mu as variables"};
   JacobianTally tc("D with c");
   WorstError wc{"D with c as a variable"};
   int n = 0;
@@ -332,23 +345,26 @@ TEST(FactorJacobians, QuasiStaticBothForms) {
     CheckCost(l, {V(c.x_prev), V(c.x), V(c.p), V(c.f)}, tl, wl, ctx);
     CheckCost(dc, {V(c.x_prev), V(c.x), V(c.p), V(c.f), V({g.c * rng.U(0.5, 2.0)})}, tc, wc, ctx);
     CheckCost(lm, {V(c.x_prev), V(c.x), V(c.p), V(c.f), V({rng.U(0.05, 1.0)})}, tm, wm, ctx);
+    CheckCost(lc, {V(c.x_prev), V(c.x), V(c.p), V(c.f), V({g.c * rng.U(0.5, 2.0)})}, tlc, wlc, ctx);
+    CheckCost(lcm, {V(c.x_prev), V(c.x), V(c.p), V(c.f), V({g.c * rng.U(0.5, 2.0)}), V({rng.U(0.05, 1.0)})}, tlcm,
+              wlcm, ctx);
   }
   EXPECT_TRUE(tm.MostlyChecked(0.95));
+  EXPECT_TRUE(tlc.MostlyChecked(0.95));
+  EXPECT_TRUE(tlcm.MostlyChecked(0.95));
+  // With c and mu fixed at the geometry's and the constructor's values it is the plain load factor.
+  {
+    const QsCase& c = QuasiStaticCases(rng, g).front();
+    const LimitSurfaceLoadFactor plain(g, 0.3 * 0.8 * 9.81, 1e-3, 0.05, 0.1);
+    const LimitSurfaceLoadFactorWithParameters fixed(g, 0.8 * 9.81, 0.3, {}, 1e-3, 0.05, 0.1);
+    EXPECT_NEAR(Residual(plain, c)[0], Residual(fixed, c)[0], 1e-12 * (1.0 + std::abs(Residual(plain, c)[0])));
+  }
   EXPECT_TRUE(tc.MostlyChecked(0.95));
   EXPECT_TRUE(tl.MostlyChecked(0.95));
   EXPECT_TRUE(td.MostlyChecked(0.95));
   EXPECT_TRUE(ty.MostlyChecked(0.95));
 }
 
-// Evaluates a 4-block quasi-static factor.
-Eigen::VectorXd Residual(const ceres::CostFunction& f, const QsCase& c) {
-  Eigen::Vector3d a = c.x_prev.vector(), b = c.x.vector();
-  Eigen::Vector2d p = c.p, fo = c.f;
-  const double* ps[4] = {a.data(), b.data(), p.data(), fo.data()};
-  Eigen::VectorXd r(f.num_residuals());
-  EXPECT_TRUE(f.Evaluate(ps, r.data(), nullptr));
-  return r;
-}
 
 // A consistent quasi-static step: for a load (f_b, tau) the ellipsoid's twist is parallel to
 // (f_b, tau / c^2) (paper Eq. 4), so D must vanish; rotating the motion must not.

@@ -70,8 +70,10 @@ struct EstimatorConfig {
   /// limit-surface load factor (|g'| = mu m g while sliding; the factor is then on whatever
   /// limit_surface_load says), started at the trajectory's mu_surface, with a Gaussian prior of
   /// relative sigma mu_prior_sigma and bounds [0.2, 5] times it. Needs the object's mass and
-  /// mu_surface. With a force stream mu is observed through |f| while sliding; without one only
-  /// the prior and D's force direction speak, so its sigma stays near the prior's.
+  /// mu_surface, and a force stream: mu is observed through |f| while the object slides, and
+  /// without force measurements scaling all forces with mu changes nothing, so it is refused.
+  /// estimate_c and estimate_mu: the other models have no such variable (ignored, reported as
+  /// not estimated); the incremental mode refuses them (it keeps c and mu fixed).
   bool estimate_mu = false;
   double mu_prior_sigma = 0.3;  ///< relative
   /// When the limit-surface load factor is used: kAuto (the default) only without a force

@@ -71,9 +71,13 @@ struct EstimationResult {
   std::optional<double> c, c_sigma;
   bool c_estimated = false;
   /// The table friction mu of the limit-surface load; estimated when config.estimate_mu (QS
-  /// batch), with its marginal sigma. Set for QS when the trajectory has mass and mu_surface.
+  /// batch), with its marginal sigma. Set only when the load factor is used (QS with mass and
+  /// mu_surface, and no force stream or limit_surface_load "on" or estimate_mu).
   std::optional<double> mu, mu_sigma;
   bool mu_estimated = false;
+  /// An estimated c or mu that ended on its bound ([0.2, 5] times its start): the Gaussian
+  /// sigma would be meaningless there, so c_sigma / mu_sigma are left empty.
+  bool c_at_bound = false, mu_at_bound = false;
   /// RMS errors against the trajectory's ground truth (empty without it): object_position_rms
   /// (m), object_rotation_rms (rad), finger_position_rms, finger_rotation_rms, contact_rms (m),
   /// force_rms (N); the same of the raw measurements as measured_*; and the mean normalized

@@ -249,21 +249,34 @@ class LimitSurfaceLoadFactor : public ceres::SizedCostFunction<1, 3, 3, 2, 2> {
   double f_max_, eps_v_, eps_f_, w_;
 };
 
-/// The limit-surface load with the table friction mu as a fifth parameter block (1), shared by
-/// every step, to estimate mu jointly with the trajectory (EstimatorConfig::estimate_mu):
-/// f_max = mu N with N = m g the normal load, the same residual as LimitSurfaceLoadFactor
-/// written r = s_v (|g'|_eps / f_max - 1) / sigma, and d r / d mu = -s_v |g'|_eps / (f_max mu
-/// sigma). Evaluate fails (Ceres shortens the step) for mu <= 0.
-class LimitSurfaceLoadFactorWithMu : public ceres::SizedCostFunction<1, 3, 3, 2, 2, 1> {
+/// The limit-surface load with shared scalar parameters as variables, for their joint
+/// estimation: c (EstimatorConfig::estimate_c, the same c as QuasiStaticFactorWithC's) and/or the
+/// table friction mu (estimate_mu), with f_max = mu N, N = m g the normal load. The residual is
+/// LimitSurfaceLoadFactor's, written r = s_v (|g'|_eps / f_max - 1) / sigma. Parameters:
+/// x_prev (3), x_t (3), p_t (2), f_t (2), then c (1) if variable, then mu (1) if variable; a
+/// fixed c is geometry.c, a fixed mu the constructor's. Jacobians:
+///   d r / d mu = -s_v |g'|_eps / (f_max mu sigma),
+///   d r / d c through V'_z = c omega and g'_z = tau / c (as in QuasiStaticFactorWithC).
+/// Evaluate fails (Ceres shortens the step) for c <= 0 or mu <= 0.
+///
+///   LimitSurfaceLoadFactorWithParameters load(geometry, mass * 9.81, /*mu=*/0.3,
+///       {/*c=*/true, /*mu=*/true}, eps_v, eps_f, sigma);
+///   problem.AddResidualBlock(&load, nullptr, {x_prev, x, p, f, c_block, mu_block});
+class LimitSurfaceLoadFactorWithParameters : public ceres::CostFunction {
  public:
-  LimitSurfaceLoadFactorWithMu(const QuasiStaticGeometry& geometry, double normal_load,
-                               double eps_velocity, double eps_force, double sigma);
+  struct Variables {
+    bool c = false;
+    bool mu = false;
+  };
+  LimitSurfaceLoadFactorWithParameters(const QuasiStaticGeometry& geometry, double normal_load, double mu,
+                                       Variables variables, double eps_velocity, double eps_force, double sigma);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
  private:
   QuasiStaticGeometry geometry_;
-  double normal_load_, eps_v_, eps_f_, w_;
+  double normal_load_, mu_, eps_v_, eps_f_, w_;
+  Variables variables_;
 };
 
 /// The Yu-Rodriguez 2018 cross-multiplied quasi-static factor (the baseline):

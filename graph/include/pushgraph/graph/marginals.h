@@ -35,8 +35,12 @@ class SparseMarginals {
   SparseMarginals& operator=(SparseMarginals&&) noexcept;
 
   /// Factorizes H at the problem's current parameter values and computes the selected inverse.
-  /// Returns false, with error() saying why, when H is not positive definite (an unobservable
-  /// direction: gauge freedom, a variable with no factor) or an evaluation fails.
+  /// Returns false, with error() saying why, when: there is no variable block; a block has a
+  /// manifold; a residual block fails to evaluate or gives a non-finite value; H is not positive
+  /// definite or a pivot keeps less than 1e-14 of its unknown's information (an unobservable or
+  /// numerically dependent direction; failed_block() then names the block when known).
+  /// Parameter bounds are ignored (as ceres::Covariance does): a variable on its bound gets the
+  /// unconstrained Gaussian covariance.
   bool Compute(ceres::Problem& problem);
 
   /// The marginal covariance of one parameter block (size x size); zero for a block held fixed
@@ -44,21 +48,28 @@ class SparseMarginals {
   /// before a successful Compute or for a block the problem did not have.
   Eigen::MatrixXd Covariance(const double* block) const;
   /// The cross-covariance of two blocks; only pairs that share a factor (or are linked through
-  /// the factorization's fill) are available: others throw std::logic_error.
+  /// the factorization's fill) are available (HasCrossCovariance): others throw std::logic_error.
   Eigen::MatrixXd CrossCovariance(const double* a, const double* b) const;
+  bool HasCrossCovariance(const double* a, const double* b) const;
 
   const std::string& error() const { return error_; }
   /// After a failed Compute: the parameter block whose pivot failed, when one did (else nullptr).
   const double* failed_block() const { return failed_block_; }
-  /// Diagnostics: unknowns, nonzeros of the Cholesky factor.
+  /// Diagnostics: unknowns, nonzeros of the Cholesky factor, and the wall time (s) of the last
+  /// Compute's phases: Jacobian evaluation, J^T J, sparse Cholesky, selected inversion.
   int num_unknowns() const;
   long num_factor_nonzeros() const;
+  struct Timings {
+    double jacobian = 0.0, normal_equations = 0.0, factorization = 0.0, inversion = 0.0;
+  };
+  const Timings& timings() const { return timings_; }
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
   std::string error_;
   const double* failed_block_ = nullptr;
+  Timings timings_;
 };
 
 }  // namespace pushgraph::graph
