@@ -526,7 +526,8 @@ std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder, c
                   << marginals.num_factor_nonzeros() << " factor nonzeros, "
                   << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
                   << " s (Jacobian " << t.jacobian << ", J^T J " << t.normal_equations << ", Cholesky "
-                  << t.factorization << ", selected inversion " << t.inversion << ")\n";
+                  << t.factorization << ", selected inversion " << t.inversion << "), smallest pivot ratio "
+                  << marginals.min_pivot_ratio() << "\n";
       }
       get = [&](double* b, double* out) {
         const Eigen::MatrixXd m = marginals.Covariance(b);
@@ -542,7 +543,9 @@ std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder, c
         const StepVars& v = builder.vars()[i];
         const double* blocks[] = {v.x, v.e, v.p, v.f};
         for (int q = 0; q < 4; ++q) {
-          if (blocks[q] == bad) marginals_error += " [step " + std::to_string(i) + ", t = " + std::to_string(builder.steps()[i].t) + ", " + names[q] + "]";
+          if (blocks[q] != bad) continue;
+          marginals_error += " [step " + std::to_string(i) + ", t = " + std::to_string(builder.steps()[i].t) +
+                             ", " + names[q] + "]";
         }
       }
       if (bad != nullptr && bad == builder.c_block()) marginals_error += " [c]";

@@ -17,18 +17,28 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <numeric>
 #include <stdexcept>
 #include <unordered_map>
 
 namespace pushgraph::graph {
 namespace {
-// A pivot keeping less than this fraction of its unknown's information (L_jj^2 / H_jj, that is
-// 1 - R^2 of the unknown on the ones eliminated before it) is treated as a dependent direction:
-// forming J^T J squares J's conditioning, so this is about cond(J) = 1e7, beyond which the
-// selected inverse loses more than half its digits (ComputeCovariances then falls back to
-// ceres::Covariance's QR on J).
-constexpr double kMinPivotRatio = 1e-14;
+// The pivot ratio L_jj^2 / H_jj is the fraction of an unknown's information left after the
+// ones eliminated before it (1 - R^2). Forming J^T J squares J's conditioning: against
+// ceres::Covariance's QR on J, the selected inverse's worst relative error was 1e-16 to 1.3e-13
+// divided by the smallest ratio (a simulated push with C and S made stiff on purpose, ratios
+// 2e-3 to 3e-14; MIT ellip1 recordings at their full rate, about 3e-8, where 250 Hz steps make
+// V stiff: errors 1e-6 to 5e-6). Below kIllConditioned it could lose more than 4 digits: refuse
+// (the estimator then uses the QR); below kSingular the direction has no information of its own.
+constexpr double kIllConditioned = 1e-9;
+constexpr double kSingular = 1e-14;
+
+std::string FormatRatio(double ratio) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", ratio);
+  return text;
+}
 }  // namespace
 
 struct SparseMarginals::Impl {
@@ -136,29 +146,38 @@ bool SparseMarginals::Compute(ceres::Problem& problem) {
   impl->col_start.assign(n + 1, 0);
   std::vector<std::pair<int, double>> column;
   std::vector<double> values;
+  min_pivot_ratio_ = INFINITY;
   for (int j = 0; j < n; ++j) {
     column.clear();
     for (Eigen::SparseMatrix<double>::InnerIterator it(L, j); it; ++it) column.emplace_back(static_cast<int>(it.row()), it.value());
     std::sort(column.begin(), column.end());
-    if (column.empty() || column.front().first != j || !std::isfinite(h_diag[j]) ||
-        !(column.front().second > 0.0) || column.front().second * column.front().second <= kMinPivotRatio * h_diag[j]) {
+    const double ratio = column.empty() || column.front().first != j
+                             ? 0.0
+                             : column.front().second * column.front().second / h_diag[j];
+    if (!(ratio > kIllConditioned) || !std::isfinite(h_diag[j]) || !(column.front().second > 0.0)) {
       int a = 0;
       while (a < n && impl->perm[a] != j) ++a;
       for (double* b : variable) {
         const auto [offset, size] = impl->blocks[b];
         if (a >= offset && a < offset + size) {
           failed_block_ = b;
-          error_ = !std::isfinite(h_diag[j])
-                       ? "the information matrix J^T J overflows at a parameter block (component " +
-                             std::to_string(a - offset) + ")"
-                       : "the information matrix J^T J is (numerically) singular at a parameter block (component " +
-                             std::to_string(a - offset) +
-                             "): it has no information independent of the others (unobservable or gauge freedom)";
+          const std::string component = "(component " + std::to_string(a - offset) + ")";
+          if (!std::isfinite(h_diag[j])) {
+            error_ = "the information matrix J^T J overflows at a parameter block " + component;
+          } else if (!(ratio > kSingular)) {
+            error_ = "the information matrix J^T J is (numerically) singular at a parameter block " + component +
+                     ": it has no information independent of the others (unobservable or gauge freedom)";
+          } else {
+            error_ = "the information matrix J^T J is ill-conditioned at a parameter block " + component +
+                     ": pivot ratio " + FormatRatio(ratio) +
+                     " below 1e-9, the selected inverse could lose more than 4 digits (use a QR on J)";
+          }
           break;
         }
       }
       return false;
     }
+    min_pivot_ratio_ = std::min(min_pivot_ratio_, ratio);
     for (const auto& [r, v] : column) {
       impl->row.push_back(r);
       values.push_back(v);

@@ -266,6 +266,41 @@ TEST(SparseMarginals, RefusesSingularProblemsAndEarlyQueries) {
   EXPECT_FALSE(m.Compute(stiff));
   EXPECT_TRUE(m.failed_block() == p0 || m.failed_block() == p1) << m.error();
   EXPECT_NE(m.error().find("singular"), std::string::npos) << m.error();
+  // 1e5 times stiffer (pivot ratio about 1e-10): well posed, but J^T J could cost 4+ digits.
+  ceres::Problem conditioned;
+  conditioned.AddResidualBlock(new ceres::AutoDiffCostFunction<UnitAuto, 1, 1>(new UnitAuto), nullptr, p0);
+  conditioned.AddResidualBlock(new ceres::AutoDiffCostFunction<ScaledAuto, 1, 1, 1>(new ScaledAuto{1e5}), nullptr, p0, p1);
+  EXPECT_FALSE(m.Compute(conditioned));
+  EXPECT_NE(m.error().find("ill-conditioned"), std::string::npos) << m.error();
+  // 1e3 (ratio about 1e-6): accepted, and right to about 1e-16 / ratio = 1e-10.
+  ceres::Problem fine;
+  fine.AddResidualBlock(new ceres::AutoDiffCostFunction<UnitAuto, 1, 1>(new UnitAuto), nullptr, p0);
+  fine.AddResidualBlock(new ceres::AutoDiffCostFunction<ScaledAuto, 1, 1, 1>(new ScaledAuto{1e3}), nullptr, p0, p1);
+  ASSERT_TRUE(m.Compute(fine)) << m.error();
+  EXPECT_NEAR(m.Covariance(p1)(0, 0), 1.0 + 1e-6, 1e-9);  // Var(x0) + 1/w^2
+  EXPECT_GT(m.min_pivot_ratio(), 1e-8);
+  EXPECT_LT(m.min_pivot_ratio(), 1e-4);
+}
+
+// Stiff geometric factors make the estimator's J^T J ill-conditioned: the default method falls
+// back to the QR of ceres::Covariance and reports the same covariances as asking for it.
+TEST(SparseMarginals, EstimatorFallsBackToTheQrWhenIllConditioned) {
+  testing::PushSpec spec;
+  spec.contact_offset = 0.02;
+  spec.duration = 0.4;
+  spec.seed = 4;
+  const limit_surface::Trajectory traj = testing::GeneratePush(spec);
+  EstimatorConfig stiff;
+  stiff.touching_sigma = stiff.contact_object_sigma = stiff.contact_finger_sigma = stiff.intersection_sigma = 1e-10;
+  EstimatorConfig reference = stiff;
+  reference.covariance_method = EstimatorConfig::CovarianceMethod::kCeres;
+  const EstimationResult a = Estimate(traj, Model::kCp, Mode::kBatch, stiff);
+  const EstimationResult b = Estimate(traj, Model::kCp, Mode::kBatch, reference);
+  ASSERT_EQ(a.solver.covariance_status, "ok");
+  ASSERT_EQ(b.solver.covariance_status, "ok");
+  for (std::size_t i = 0; i < a.states.size(); ++i) {
+    EXPECT_LT(RelativeDifference(*a.states[i].object_pose_cov, *b.states[i].object_pose_cov), 1e-9) << i;
+  }
 }
 
 TEST(SparseMarginals, EstimatorCovariancesEqualCeresCovariance) {

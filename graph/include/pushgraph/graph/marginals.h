@@ -16,7 +16,8 @@
 //
 // The Jacobian is the one Ceres uses (loss functions applied, as ceres::Covariance does);
 // constant parameter blocks, and blocks no residual uses, are held fixed. Blocks with a manifold
-// are not supported. H must be positive definite to about cond(J) = 1e7 (see marginals.cpp).
+// are not supported. Forming J^T J squares J's condition: Compute refuses when that could cost
+// more than 4 digits (see min_pivot_ratio), and ceres::Covariance's QR on J is the tool then.
 #include <ceres/problem.h>
 
 #include <Eigen/Core>
@@ -37,8 +38,9 @@ class SparseMarginals {
   /// Factorizes H at the problem's current parameter values and computes the selected inverse.
   /// Returns false, with error() saying why, when: there is no variable block; a block has a
   /// manifold; a residual block fails to evaluate or gives a non-finite value; H is not positive
-  /// definite or a pivot keeps less than 1e-14 of its unknown's information (an unobservable or
-  /// numerically dependent direction; failed_block() then names the block when known).
+  /// definite, or a pivot keeps less than 1e-9 of its unknown's information (min_pivot_ratio():
+  /// below it the result could lose more than 4 digits, measured against a QR on J; below 1e-14
+  /// the direction is unobservable). failed_block() then names the block when known.
   /// Parameter bounds are ignored (as ceres::Covariance does): a variable on its bound gets the
   /// unconstrained Gaussian covariance.
   bool Compute(ceres::Problem& problem);
@@ -63,6 +65,10 @@ class SparseMarginals {
     double jacobian = 0.0, normal_equations = 0.0, factorization = 0.0, inversion = 0.0;
   };
   const Timings& timings() const { return timings_; }
+  /// The smallest L_jj^2 / H_jj of the last factorization: the fraction of an unknown's
+  /// information left after conditioning on the ones eliminated before it (1 for independent
+  /// unknowns; small for nearly dependent directions, where J^T J loses digits).
+  double min_pivot_ratio() const { return min_pivot_ratio_; }
 
  private:
   struct Impl;
@@ -70,6 +76,7 @@ class SparseMarginals {
   std::string error_;
   const double* failed_block_ = nullptr;
   Timings timings_;
+  double min_pivot_ratio_ = 0.0;
 };
 
 }  // namespace pushgraph::graph
