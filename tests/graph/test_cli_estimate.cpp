@@ -81,7 +81,10 @@ TEST_F(EstimateCli, ConfigFileIsApplied) {
   // c and mu estimated: RESULT.json's "parameters" carries both with their sigmas.
   const std::string joint = dir() + "/estimate_joint.json";
   std::ofstream(joint) << R"({"estimate_c": true, "estimate_mu": true})";
-  ASSERT_EQ(Tool("estimate " + in + " --model qs -o " + out + " --config " + joint).status, 0);
+  const pushgraph::testing::ToolRun joint_run = Tool("estimate " + in + " --model qs -o " + out + " --config " + joint);
+  ASSERT_EQ(joint_run.status, 0) << joint_run.err;
+  const nlohmann::json printed = nlohmann::json::parse(joint_run.out);  // the summary line echoes them
+  EXPECT_TRUE(printed.contains("mu_sigma") && printed.contains("c_sigma")) << joint_run.out;
   const nlohmann::json p = Load(out)["parameters"];
   EXPECT_TRUE(p["c_estimated"].get<bool>());
   EXPECT_TRUE(p["mu_estimated"].get<bool>());

@@ -116,6 +116,15 @@ void RunEstimate(const EstimateOptions& o) {
   if (!o.add_noise.empty()) summary["noise"] = {{"kind", o.add_noise}, {"seed", o.seed}};
   if (!o.svg.empty()) summary["svg"] = o.svg;
   if (!result.metrics.empty()) summary["metrics"] = result.metrics;
+  // Jointly estimated parameters are a result in their own right: echo them.
+  if (result.c_estimated && result.c) {
+    summary["c"] = *result.c;
+    if (result.c_sigma) summary["c_sigma"] = *result.c_sigma;
+  }
+  if (result.mu_estimated && result.mu) {
+    summary["mu"] = *result.mu;
+    if (result.mu_sigma) summary["mu_sigma"] = *result.mu_sigma;
+  }
   std::cout << DumpJson(summary, -1) << "\n";
 }
 
