@@ -8,6 +8,8 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 namespace pushgraph::graph {
 namespace {
@@ -70,6 +72,22 @@ std::map<std::string, LossConfig EstimatorConfig::*> LossFields() {
   throw GraphError(source + ": config key '" + key + "': " + what);
 }
 
+// A string-valued choice: the value's enum, or an error listing the allowed names.
+template <class Enum>
+Enum ParseChoice(const Json& value, const std::string& source, const std::string& key,
+                 const std::vector<std::pair<std::string, Enum>>& choices) {
+  if (value.is_string()) {
+    for (const auto& [name, choice] : choices) {
+      if (value.get<std::string>() == name) return choice;
+    }
+  }
+  std::string allowed;
+  for (std::size_t k = 0; k < choices.size(); ++k) {
+    allowed += (k == 0 ? "" : k + 1 == choices.size() ? " or " : ", ") + ("\"" + choices[k].first + "\"");
+  }
+  Fail(source, key, "expected " + allowed + ", got " + value.dump());
+}
+
 LossConfig ParseLoss(const Json& j, const std::string& source, const std::string& key) {
   if (!j.is_object()) Fail(source, key, "expected an object {\"type\": ..., \"scale\": ...}");
   LossConfig loss;
@@ -121,21 +139,18 @@ EstimatorConfig ParseEstimatorConfig(const std::string& json_text, const std::st
       if (!it->is_number_integer()) Fail(source, key, "expected an integer");
       cfg.*(i->second) = it->get<int>();
     } else if (key == "contact_finger") {
-      const std::string v = it->is_string() ? it->get<std::string>() : "";
-      if (v == "witness") cfg.contact_finger = EstimatorConfig::ContactFinger::kWitness;
-      else if (v == "boundary") cfg.contact_finger = EstimatorConfig::ContactFinger::kBoundary;
-      else Fail(source, key, "expected \"witness\" or \"boundary\", got " + it->dump());
+      cfg.contact_finger = ParseChoice<EstimatorConfig::ContactFinger>(
+          *it, source, key, {{"witness", EstimatorConfig::ContactFinger::kWitness},
+                             {"boundary", EstimatorConfig::ContactFinger::kBoundary}});
     } else if (key == "limit_surface_load") {
-      const std::string v = it->is_string() ? it->get<std::string>() : "";
-      if (v == "auto") cfg.limit_surface_load = EstimatorConfig::LimitSurfaceLoad::kAuto;
-      else if (v == "on") cfg.limit_surface_load = EstimatorConfig::LimitSurfaceLoad::kOn;
-      else if (v == "off") cfg.limit_surface_load = EstimatorConfig::LimitSurfaceLoad::kOff;
-      else Fail(source, key, "expected \"auto\", \"on\" or \"off\", got " + it->dump());
+      cfg.limit_surface_load = ParseChoice<EstimatorConfig::LimitSurfaceLoad>(
+          *it, source, key, {{"auto", EstimatorConfig::LimitSurfaceLoad::kAuto},
+                             {"on", EstimatorConfig::LimitSurfaceLoad::kOn},
+                             {"off", EstimatorConfig::LimitSurfaceLoad::kOff}});
     } else if (key == "covariance_method") {
-      const std::string v = it->is_string() ? it->get<std::string>() : "";
-      if (v == "selected_inversion") cfg.covariance_method = EstimatorConfig::CovarianceMethod::kSelectedInversion;
-      else if (v == "ceres") cfg.covariance_method = EstimatorConfig::CovarianceMethod::kCeres;
-      else Fail(source, key, "expected \"selected_inversion\" or \"ceres\", got " + it->dump());
+      cfg.covariance_method = ParseChoice<EstimatorConfig::CovarianceMethod>(
+          *it, source, key, {{"selected_inversion", EstimatorConfig::CovarianceMethod::kSelectedInversion},
+                             {"ceres", EstimatorConfig::CovarianceMethod::kCeres}});
     } else if (key == "covariance" || key == "estimate_c" || key == "estimate_mu") {
       if (!it->is_boolean()) Fail(source, key, "expected true or false");
       (key == "covariance" ? cfg.covariance : key == "estimate_c" ? cfg.estimate_c : cfg.estimate_mu) = it->get<bool>();
