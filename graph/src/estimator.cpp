@@ -692,27 +692,10 @@ EstimationResult EstimateBatch(const limit_surface::Trajectory& traj, Model mode
   return r;
 }
 
-// Ground-truth helpers: interpolation only between samples at most `gap` apart.
-template <class Sample, class Get>
-bool GroundTruthAt(const std::vector<Sample>& s, double t, double gap, Get get, decltype(get(s[0]))* out) {
-  if (s.empty() || t < s.front().t - 1e-9 || t > s.back().t + 1e-9) return false;
-  auto it = std::lower_bound(s.begin(), s.end(), t - 1e-9, [](const Sample& a, double tt) { return a.t < tt; });
-  if (it == s.end()) it = s.end() - 1;
-  if (std::abs(it->t - t) <= 1e-9) { *out = get(*it); return true; }
-  if (it == s.begin()) return false;
-  const Sample& a = *(it - 1);
-  const Sample& b = *it;
-  if (b.t - a.t > gap) return false;
-  const double w = (t - a.t) / (b.t - a.t);
-  *out = get(a) + w * (get(b) - get(a));
-  return true;
-}
-
+// Ground truth: interpolation only between samples at most `gap` apart.
 bool GroundTruthPose(const std::vector<limit_surface::PoseSample>& s, double t, double gap, Eigen::Vector3d* out) {
-  if (!GroundTruthAt(s, t, gap, [](const limit_surface::PoseSample& a) { return Eigen::Vector3d(a.pose.vector()); }, out)) {
-    return false;
-  }
-  return true;
+  return limit_surface::StreamValueAt(
+      s, t, gap, [](const limit_surface::PoseSample& a) { return Eigen::Vector3d(a.pose.vector()); }, out);
 }
 
 struct Accumulator {
@@ -753,12 +736,12 @@ std::map<std::string, double> ComputeMetrics(const limit_surface::Trajectory& tr
       if (s.finger_pose_cov) nees_f.Add(nees(e, *s.finger_pose_cov));
     }
     Vec2 v;
-    if (s.contact && GroundTruthAt(gt.contact_point, s.t, gap, [](const limit_surface::PointSample& a) { return Vec2(a.point); }, &v)) {
+    if (s.contact && limit_surface::StreamValueAt(gt.contact_point, s.t, gap, [](const limit_surface::PointSample& a) { return Vec2(a.point); }, &v)) {
       const Vec2 e = *s.contact - v;
       cp.Add(e.squaredNorm());
       if (s.contact_cov) nees_c.Add(nees(e, *s.contact_cov));
     }
-    if (s.force && GroundTruthAt(gt.force, s.t, gap, [](const limit_surface::ForceSample& a) { return Vec2(a.force); }, &v)) {
+    if (s.force && limit_surface::StreamValueAt(gt.force, s.t, gap, [](const limit_surface::ForceSample& a) { return Vec2(a.force); }, &v)) {
       const Vec2 e = *s.force - v;
       fo.Add(e.squaredNorm());
       if (s.force_cov) nees_force.Add(nees(e, *s.force_cov));
@@ -795,13 +778,13 @@ std::map<std::string, double> ComputeMetrics(const limit_surface::Trajectory& tr
   }
   for (const auto& s : meas.contact_point) {
     Vec2 v;
-    if (GroundTruthAt(gt.contact_point, s.t, gap, [](const limit_surface::PointSample& a) { return Vec2(a.point); }, &v)) {
+    if (limit_surface::StreamValueAt(gt.contact_point, s.t, gap, [](const limit_surface::PointSample& a) { return Vec2(a.point); }, &v)) {
       mcp.Add((s.point - v).squaredNorm());
     }
   }
   for (const auto& s : meas.force) {
     Vec2 v;
-    if (GroundTruthAt(gt.force, s.t, gap, [](const limit_surface::ForceSample& a) { return Vec2(a.force); }, &v)) {
+    if (limit_surface::StreamValueAt(gt.force, s.t, gap, [](const limit_surface::ForceSample& a) { return Vec2(a.force); }, &v)) {
       mfo.Add((s.force - v).squaredNorm());
     }
   }

@@ -316,6 +316,13 @@ void CheckGeometry(const QuasiStaticGeometry& g) {
   }
   if (!g.centre_of_pressure.allFinite()) throw GraphError("quasi-static factor: non-finite centre of pressure");
 }
+
+// The regularizers of |V'| and |g'| (D and the load factor).
+void CheckEps(double eps_velocity, double eps_force, const char* factor) {
+  if (!(eps_velocity > 0.0) || !(eps_force > 0.0) || !std::isfinite(eps_velocity) || !std::isfinite(eps_force)) {
+    throw GraphError(std::string(factor) + " factor: eps_velocity and eps_force must be finite and > 0");
+  }
+}
 }  // namespace
 
 QuasiStaticFactor::QuasiStaticFactor(const QuasiStaticGeometry& geometry, double eps_velocity,
@@ -325,9 +332,7 @@ QuasiStaticFactor::QuasiStaticFactor(const QuasiStaticGeometry& geometry, double
       eps_f_(eps_force),
       w_(CheckedWeight(sigma, "quasi-static")) {
   CheckGeometry(geometry_);
-  if (!(eps_v_ > 0.0) || !(eps_f_ > 0.0)) {
-    throw GraphError("quasi-static factor: eps_velocity and eps_force must be > 0");
-  }
+  CheckEps(eps_v_, eps_f_, "quasi-static");
 }
 
 // r = w u / (a b), u = V' x g', a = sqrt(|V'|^2 + eps_v^2), b = sqrt(|g'|^2 + eps_f^2):
@@ -381,9 +386,7 @@ QuasiStaticFactorWithC::QuasiStaticFactorWithC(const QuasiStaticGeometry& geomet
     : geometry_(geometry), eps_v_(eps_velocity), eps_f_(eps_force),
       w_(CheckedWeight(sigma, "quasi-static")) {
   CheckGeometry(geometry_);
-  if (!(eps_v_ > 0.0) || !(eps_f_ > 0.0)) {
-    throw GraphError("quasi-static factor: eps_velocity and eps_force must be > 0");
-  }
+  CheckEps(eps_v_, eps_f_, "quasi-static");
 }
 
 bool QuasiStaticFactorWithC::Evaluate(double const* const* parameters, double* residuals,
@@ -397,7 +400,7 @@ LimitSurfaceLoadFactor::LimitSurfaceLoadFactor(const QuasiStaticGeometry& geomet
       w_(CheckedWeight(sigma, "limit-surface load")) {
   CheckGeometry(geometry_);
   if (!(f_max > 0.0) || !std::isfinite(f_max)) throw GraphError("limit-surface load factor: f_max must be > 0");
-  if (!(eps_v_ > 0.0) || !(eps_f_ > 0.0)) throw GraphError("limit-surface load factor: eps must be > 0");
+  CheckEps(eps_v_, eps_f_, "limit-surface load");
 }
 
 namespace {
@@ -445,7 +448,7 @@ LimitSurfaceLoadFactorWithParameters::LimitSurfaceLoadFactorWithParameters(
     throw GraphError("limit-surface load factor: the normal load m g must be > 0");
   }
   if (!variables.mu && (!(mu > 0.0) || !std::isfinite(mu))) throw GraphError("limit-surface load factor: mu must be > 0");
-  if (!(eps_v_ > 0.0) || !(eps_f_ > 0.0)) throw GraphError("limit-surface load factor: eps must be > 0");
+  CheckEps(eps_v_, eps_f_, "limit-surface load");
   set_num_residuals(1);
   for (int size : {3, 3, 2, 2}) mutable_parameter_block_sizes()->push_back(size);
   if (variables.c) mutable_parameter_block_sizes()->push_back(1);

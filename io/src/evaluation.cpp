@@ -65,26 +65,7 @@ bool HasProtocol(const std::vector<Protocol>& ps, Protocol p) { return std::find
 // Ground truth at a time: linear interpolation between samples at most kGroundTruthGap apart.
 template <class Sample, class Get>
 bool TruthAt(const std::vector<Sample>& s, double t, Get get, decltype(get(s[0]))* out) {
-  if (s.empty() || t < s.front().t - 1e-9 || t > s.back().t + 1e-9) return false;
-  auto it = std::lower_bound(s.begin(), s.end(), t, [](const Sample& a, double tt) { return a.t < tt; });
-  if (it != s.end() && std::abs(it->t - t) <= 1e-9) {
-    *out = get(*it);
-    return true;
-  }
-  if (it == s.end()) {
-    if (std::abs(s.back().t - t) <= 1e-9) {
-      *out = get(s.back());
-      return true;
-    }
-    return false;
-  }
-  if (it == s.begin()) return false;
-  const Sample& a = *(it - 1);
-  const Sample& b = *it;
-  if (b.t - a.t > kGroundTruthGap) return false;
-  const double w = (t - a.t) / (b.t - a.t);
-  *out = get(a) + w * (get(b) - get(a));
-  return true;
+  return ls::StreamValueAt(s, t, kGroundTruthGap, get, out);
 }
 
 Eigen::Vector3d PoseVec(const ls::PoseSample& s) { return s.pose.vector(); }

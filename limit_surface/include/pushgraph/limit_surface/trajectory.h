@@ -13,6 +13,8 @@
 #include <pushgraph/geometry/pose.h>
 #include <pushgraph/geometry/shape.h>
 
+#include <algorithm>
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -73,5 +75,32 @@ struct Trajectory {
   std::optional<Streams> ground_truth;
   std::optional<MeasurementSigmas> measurement_sigmas;
 };
+
+/// A time-sorted stream's value at t (e.g. ground truth at an estimate's time): the sample at t
+/// (within 1e-9 s), or the linear interpolation of its two neighbours when they are at most
+/// max_gap apart; false outside the stream or across a larger gap. `get` maps a sample to the
+/// interpolated quantity (for poses pose.vector(), theta linearly).
+///
+///   Eigen::Vector3d x;
+///   if (StreamValueAt(gt.object_pose, t, 0.1, [](const PoseSample& s) { return s.pose.vector(); }, &x)) ...
+template <class Sample, class Get>
+bool StreamValueAt(const std::vector<Sample>& samples, double t, double max_gap, Get get,
+                   decltype(get(samples[0]))* out) {
+  if (samples.empty() || t < samples.front().t - 1e-9 || t > samples.back().t + 1e-9) return false;
+  const auto it = std::lower_bound(samples.begin(), samples.end(), t - 1e-9,
+                                   [](const Sample& a, double tt) { return a.t < tt; });
+  if (it == samples.end()) return false;  // unreachable: t <= back().t + 1e-9
+  if (std::abs(it->t - t) <= 1e-9) {
+    *out = get(*it);
+    return true;
+  }
+  if (it == samples.begin()) return false;
+  const Sample& a = *(it - 1);
+  const Sample& b = *it;
+  if (b.t - a.t > max_gap) return false;
+  const double w = (t - a.t) / (b.t - a.t);
+  *out = get(a) + w * (get(b) - get(a));
+  return true;
+}
 
 }  // namespace pushgraph::limit_surface
