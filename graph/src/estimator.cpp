@@ -82,32 +82,12 @@ QuasiStaticGeometry QuasiStaticGeometryFor(const limit_surface::Trajectory& traj
 namespace internal {
 namespace {
 
-template <class Sample, class Get>
-auto Interpolate(const std::vector<Sample>& samples, double t, Get get) {
-  auto it = std::lower_bound(samples.begin(), samples.end(), t,
-                             [](const Sample& s, double tt) { return s.t < tt; });
-  if (it == samples.begin()) return get(samples.front());
-  if (it == samples.end()) return get(samples.back());
-  const Sample& b = *it;
-  const Sample& a = *(it - 1);
-  const double w = (t - a.t) / (b.t - a.t);
-  return decltype(get(a))(get(a) + w * (get(b) - get(a)));
-}
-
 Pose2 InterpolatePose(const std::vector<limit_surface::PoseSample>& all, double t, double limit) {
   // Only the samples up to `limit`.
   const auto end = std::upper_bound(all.begin(), all.end(), limit,
                                     [](double tt, const limit_surface::PoseSample& a) { return tt < a.t; });
   if (end == all.begin()) return all.front().pose;
-  auto it = std::lower_bound(all.begin(), end, t,
-                             [](const limit_surface::PoseSample& a, double tt) { return a.t < tt; });
-  if (it == all.begin()) return all.front().pose;
-  if (it == end) return (end - 1)->pose;
-  const Pose2& a = (it - 1)->pose;
-  const Pose2& b = it->pose;
-  const double w = (t - (it - 1)->t) / (it->t - (it - 1)->t);
-  return {a.x + w * (b.x - a.x), a.y + w * (b.y - a.y),
-          a.theta + w * geometry::WrapAngle(b.theta - a.theta)};
+  return limit_surface::PoseAtClamped(all.begin(), end, t);
 }
 
 template <class Sample>
@@ -277,7 +257,7 @@ void GraphBuilder::Initialize(int i, double limit) {
       const Vec2 c = m.contact_point[s.contact].point;
       v.p[0] = c.x(); v.p[1] = c.y();
     } else if (!m.contact_point.empty() && !causal) {
-      const Vec2 c = Interpolate(m.contact_point, s.t, [](const limit_surface::PointSample& a) { return Vec2(a.point); });
+      const Vec2 c = limit_surface::StreamValueClamped(m.contact_point, s.t, [](const limit_surface::PointSample& a) { return Vec2(a.point); });
       v.p[0] = c.x(); v.p[1] = c.y();
     } else if (causal && prev != nullptr && steps_[i - 1].in_contact) {
       v.p[0] = prev->p[0]; v.p[1] = prev->p[1];
@@ -289,7 +269,7 @@ void GraphBuilder::Initialize(int i, double limit) {
     if (s.force >= 0) {
       v.f[0] = m.force[s.force].force.x(); v.f[1] = m.force[s.force].force.y();
     } else if (!m.force.empty() && !causal) {
-      const Vec2 f = Interpolate(m.force, s.t, [](const limit_surface::ForceSample& a) { return Vec2(a.force); });
+      const Vec2 f = limit_surface::StreamValueClamped(m.force, s.t, [](const limit_surface::ForceSample& a) { return Vec2(a.force); });
       v.f[0] = f.x(); v.f[1] = f.y();
     } else if (causal && prev != nullptr && steps_[i - 1].in_contact) {
       v.f[0] = prev->f[0]; v.f[1] = prev->f[1];

@@ -205,24 +205,8 @@ double MedianStep(const std::vector<double>& t) {
   return steps[steps.size() / 2];
 }
 
-// Linear interpolation of a time-sorted stream at t (clamped at the ends).
-template <class Sample, class Get>
-auto Interpolate(const std::vector<Sample>& samples, double t, Get get) -> decltype(get(samples[0])) {
-  auto it = std::lower_bound(samples.begin(), samples.end(), t,
-                             [](const Sample& s, double time) { return s.t < time; });
-  if (it == samples.begin()) return get(samples.front());
-  if (it == samples.end()) return get(samples.back());
-  const Sample& b = *it;
-  const Sample& a = *(it - 1);
-  const double w = b.t > a.t ? (t - a.t) / (b.t - a.t) : 1.0;
-  return get(a) + w * (get(b) - get(a));
-}
-
 Pose2 InterpolatePose(const std::vector<limit_surface::PoseSample>& samples, double t) {
-  const Eigen::Vector3d v = Interpolate(samples, t, [](const limit_surface::PoseSample& s) -> Eigen::Vector3d {
-    return s.pose.vector();
-  });
-  return Pose2::FromVector(v);
+  return limit_surface::PoseAtClamped(samples.begin(), samples.end(), t);
 }
 
 // The sample of a stream nearest in time to t, if one lies within `tolerance`.

@@ -76,6 +76,33 @@ struct Trajectory {
   std::optional<MeasurementSigmas> measurement_sigmas;
 };
 
+/// A time-sorted, non-empty stream's value at t by linear interpolation, clamped to the first
+/// and last samples outside them (initial guesses, plot positions).
+template <class Sample, class Get>
+auto StreamValueClamped(const std::vector<Sample>& samples, double t, Get get) -> decltype(get(samples[0])) {
+  const auto it = std::lower_bound(samples.begin(), samples.end(), t,
+                                   [](const Sample& s, double tt) { return s.t < tt; });
+  if (it == samples.begin()) return get(samples.front());
+  if (it == samples.end()) return get(samples.back());
+  const Sample& a = *(it - 1);
+  const Sample& b = *it;  // a.t < t <= b.t
+  const double w = (t - a.t) / (b.t - a.t);
+  return get(a) + w * (get(b) - get(a));
+}
+
+/// A pose stream [first, last) (time-sorted, non-empty) at t, clamped like StreamValueClamped,
+/// with theta interpolated along the shorter arc.
+template <class It>
+geometry::Pose2 PoseAtClamped(It first, It last, double t) {
+  const auto it = std::lower_bound(first, last, t, [](const PoseSample& s, double tt) { return s.t < tt; });
+  if (it == first) return first->pose;
+  if (it == last) return (last - 1)->pose;
+  const geometry::Pose2& a = (it - 1)->pose;
+  const geometry::Pose2& b = it->pose;
+  const double w = (t - (it - 1)->t) / (it->t - (it - 1)->t);
+  return {a.x + w * (b.x - a.x), a.y + w * (b.y - a.y), a.theta + w * geometry::WrapAngle(b.theta - a.theta)};
+}
+
 /// A time-sorted stream's value at t (e.g. ground truth at an estimate's time): the sample at t
 /// (within 1e-9 s), or the linear interpolation of its two neighbours when they are at most
 /// max_gap apart; false outside the stream or across a larger gap. `get` maps a sample to the
