@@ -151,16 +151,38 @@ GraphBuilder::GraphBuilder(const limit_surface::Trajectory& trajectory, Model mo
     : traj_(trajectory), model_(model), cfg_(config) {
   ValidateConfig(cfg_);
   ValidateTrajectory(traj_);
+  streams_.contact_point = !traj_.measured.contact_point.empty();
+  streams_.force = !traj_.measured.force.empty();
+  AppendSteps(INFINITY);
+  SetUpShapes();
+}
+
+GraphBuilder::GraphBuilder(const limit_surface::Trajectory& trajectory, Model model,
+                           const EstimatorConfig& config, const OnlineStreams& streams)
+    : traj_(trajectory), model_(model), cfg_(config), streams_(streams) {
+  ValidateConfig(cfg_);
+  if (traj_.object.shape.empty()) throw GraphError("trajectory: object.shape is missing or empty");
+  if (traj_.finger.shape.empty()) throw GraphError("trajectory: finger.shape is missing or empty");
+  SetUpShapes();
+}
+
+int GraphBuilder::AppendSteps(double until) {
   const auto& m = traj_.measured;
   // Steps: the union of all time stamps (merged when closer than 1e-9 s).
   std::vector<std::tuple<double, int, int>> events;  // t, stream, index
-  for (std::size_t i = 0; i < m.object_pose.size(); ++i) events.emplace_back(m.object_pose[i].t, 0, int(i));
-  for (std::size_t i = 0; i < m.finger_pose.size(); ++i) events.emplace_back(m.finger_pose[i].t, 1, int(i));
-  for (std::size_t i = 0; i < m.contact_point.size(); ++i) events.emplace_back(m.contact_point[i].t, 2, int(i));
-  for (std::size_t i = 0; i < m.force.size(); ++i) events.emplace_back(m.force[i].t, 3, int(i));
+  auto take = [&](const auto& stream, int id) {
+    std::size_t& i = used_[id];
+    for (; i < stream.size() && stream[i].t <= until; ++i) events.emplace_back(stream[i].t, id, int(i));
+  };
+  take(m.object_pose, 0);
+  take(m.finger_pose, 1);
+  take(m.contact_point, 2);
+  take(m.force, 3);
   std::sort(events.begin(), events.end());
+  const std::size_t first_new = steps_.size();
   for (const auto& [t, stream, index] : events) {
-    if (steps_.empty() || t - steps_.back().t > 1e-9) {
+    // (OnlineEstimator only accepts samples more than 1e-9 s after the last update's steps.)
+    if (steps_.size() == first_new || t - steps_.back().t > 1e-9) {
       steps_.push_back(Step{});
       steps_.back().t = t;
     }
@@ -168,19 +190,24 @@ GraphBuilder::GraphBuilder(const limit_surface::Trajectory& trajectory, Model mo
     int* slot = stream == 0 ? &s.object : stream == 1 ? &s.finger : stream == 2 ? &s.contact : &s.force;
     *slot = index;
   }
-  // Contact gating.
-  for (Step& s : steps_) {
-    if (!m.contact_point.empty()) {
+  // Contact gating, on the samples received so far (all of them in batch).
+  for (std::size_t i = first_new; i < steps_.size(); ++i) {
+    Step& s = steps_[i];
+    if (streams_.contact_point) {
       s.in_contact = NearestGap(m.contact_point, s.t) <= cfg_.contact_max_gap;
-    } else if (!m.force.empty()) {
+    } else if (streams_.force) {
       int k = -1;
       const double gap = NearestGap(m.force, s.t, &k);
-      s.in_contact = gap <= cfg_.contact_max_gap && m.force[k].force.norm() >= cfg_.contact_force_threshold;
+      s.in_contact = k >= 0 && gap <= cfg_.contact_max_gap && m.force[k].force.norm() >= cfg_.contact_force_threshold;
     } else {
       s.in_contact = true;
     }
   }
   vars_.resize(steps_.size());
+  return static_cast<int>(steps_.size() - first_new);
+}
+
+void GraphBuilder::SetUpShapes() {
   geometry::ShapePairQuerier::Options pair_options;
   pair_options.angle_cache_resolution = cfg_.finger_angle_resolution;
   pair_options.max_cached_angles = 4096;
@@ -193,7 +220,7 @@ GraphBuilder::GraphBuilder(const limit_surface::Trajectory& trajectory, Model mo
   }
   using Load = EstimatorConfig::LimitSurfaceLoad;
   use_load_factor_ = f_max_ > 0.0 && (cfg_.limit_surface_load == Load::kOn ||
-                                      (cfg_.limit_surface_load == Load::kAuto && m.force.empty()));
+                                      (cfg_.limit_surface_load == Load::kAuto && !streams_.force));
 }
 
 void GraphBuilder::EnableCEstimation() {
@@ -283,7 +310,6 @@ void GraphBuilder::Initialize(int i, double limit) {
 }
 
 int GraphBuilder::SmoothInitialMotion(int max_iterations, double function_tolerance, int first, int last) {
-  const auto& m = traj_.measured;
   ceres::Problem problem;
   const int n = last < 0 ? static_cast<int>(steps_.size()) : last;
   for (int i = first; i < n; ++i) {
@@ -303,7 +329,7 @@ int GraphBuilder::SmoothInitialMotion(int max_iterations, double function_tolera
   ceres::Solver::Summary summary;
   ceres::Solve(SolverOptions(max_iterations, function_tolerance), &problem, &summary);
   LogSummary("motion-only initialization", summary);
-  if (m.contact_point.empty()) {
+  if (!streams_.contact_point) {
     for (int i = first; i < n; ++i) {
       if (!steps_[i].in_contact) continue;
       StepVars& v = vars_[i];

@@ -1,10 +1,12 @@
 #pragma once
 // Internal: steps, variables and factor assembly shared by the batch and incremental solvers.
 #include <pushgraph/graph/estimator.h>
+#include <pushgraph/graph/incremental.h>
 
 #include <ceres/ceres.h>
 
 #include <cmath>
+#include <deque>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -30,10 +32,19 @@ struct StepVars {
 class GraphBuilder {
  public:
   GraphBuilder(const limit_surface::Trajectory& trajectory, Model model, const EstimatorConfig& config);
+  /// Online use (OnlineEstimator): `trajectory` starts with empty streams and grows as the
+  /// caller appends measurements; steps come from AppendSteps. `streams` says which streams will
+  /// arrive (contact gating, and the load factor runs when no force stream will).
+  GraphBuilder(const limit_surface::Trajectory& trajectory, Model model, const EstimatorConfig& config,
+               const OnlineStreams& streams);
+
+  /// Appends a step for every time stamp in (last step, until] of the measurements not yet
+  /// used, gating contact on the samples received so far. Returns the number of new steps.
+  int AppendSteps(double until);
 
   const std::vector<Step>& steps() const { return steps_; }
-  std::vector<StepVars>& vars() { return vars_; }
-  const std::vector<StepVars>& vars() const { return vars_; }
+  std::deque<StepVars>& vars() { return vars_; }
+  const std::deque<StepVars>& vars() const { return vars_; }
   Model model() const { return model_; }
   bool HasContactVars(int i) const { return steps_[i].in_contact; }
   bool HasForceVars(int i) const { return steps_[i].in_contact && ModelHasForce(model_); }
@@ -85,12 +96,15 @@ class GraphBuilder {
   void AddPoseMeasurementFactors(ceres::Problem& problem, int i);   ///< M of both poses
   void AddConstantVelocityFactors(ceres::Problem& problem, int i);  ///< V on steps i-2, i-1, i
   void AddDynamicFactors(ceres::Problem& problem, int i);
+  void SetUpShapes();  ///< querier, quasi-static geometry, friction (both constructors)
 
   const limit_surface::Trajectory& traj_;
   Model model_;
   EstimatorConfig cfg_;
+  OnlineStreams streams_;  ///< which streams exist (batch: the non-empty ones)
   std::vector<Step> steps_;
-  std::vector<StepVars> vars_;
+  std::deque<StepVars> vars_;  ///< a deque: appending keeps the addresses Ceres holds
+  std::size_t used_[4] = {0, 0, 0, 0};  ///< samples of each stream already in steps
   std::shared_ptr<const geometry::ShapePairQuerier> querier_;
   QuasiStaticGeometry qs_;
   bool estimate_c_ = false;

@@ -8,6 +8,8 @@
 #include <chrono>
 #include <iostream>
 #include <map>
+#include <sstream>
+#include <string>
 
 namespace pushgraph::graph {
 
@@ -48,14 +50,25 @@ bool MarginalPriorFactor::Evaluate(double const* const* parameters, double* resi
   return true;
 }
 
-struct IncrementalEstimator::Impl {
+namespace {
+
+// The median spacing of the object stream's samples (0 with fewer than two).
+double MedianObjectPeriod(const std::vector<limit_surface::PoseSample>& obj) {
+  std::vector<double> periods;
+  for (std::size_t i = 1; i < obj.size(); ++i) periods.push_back(obj[i].t - obj[i - 1].t);
+  if (periods.empty()) return 0.0;
+  std::nth_element(periods.begin(), periods.begin() + periods.size() / 2, periods.end());
+  return periods[periods.size() / 2];
+}
+
+// The fixed-lag smoother both front ends drive: steps join at updates, the window is re-solved,
+// steps older than the window are marginalized.
+struct FixedLagSmoother {
   const limit_surface::Trajectory& traj;
   EstimatorConfig cfg;
   internal::GraphBuilder builder;
   std::unique_ptr<ceres::Problem> problem;
-  std::vector<double> triggers;
-  std::size_t next_trigger = 0;
-  double window_duration = 0.0;
+  double window_duration = INFINITY;
   int next_step = 0;  // first step not yet added
   int lo = 0;         // oldest step in the window
   std::vector<StateEstimate> states;
@@ -64,37 +77,17 @@ struct IncrementalEstimator::Impl {
   double total_update_time = 0.0;
   double last_cost = 0.0;
 
-  Impl(const limit_surface::Trajectory& t, Model model, const EstimatorConfig& c)
-      : traj(t), cfg(c), builder(t, model, c) {
+  // online == nullptr: every step of the recorded `t` exists from the start.
+  FixedLagSmoother(const limit_surface::Trajectory& t, Model model, const EstimatorConfig& c,
+                   const OnlineStreams* online)
+      : traj(t), cfg(c),
+        builder(online != nullptr ? internal::GraphBuilder(t, model, c, *online) : internal::GraphBuilder(t, model, c)) {
     if (cfg.estimate_c || cfg.estimate_mu) {
       throw GraphError("estimate_c and estimate_mu are batch only: the incremental mode keeps c and mu fixed");
     }
     ceres::Problem::Options po;
     po.enable_fast_removal = true;
     problem = std::make_unique<ceres::Problem>(po);
-    const auto& obj = traj.measured.object_pose;
-    std::vector<double> periods;
-    for (std::size_t i = 1; i < obj.size(); ++i) periods.push_back(obj[i].t - obj[i - 1].t);
-    double period;
-    if (!periods.empty()) {
-      std::nth_element(periods.begin(), periods.begin() + periods.size() / 2, periods.end());
-      period = periods[periods.size() / 2];
-    } else {
-      const auto& steps = builder.steps();
-      period = steps.size() > 1 ? 10.0 * (steps.back().t - steps.front().t) / double(steps.size() - 1) : 1.0;
-    }
-    const int k = cfg.incremental_update_every;
-    window_duration = cfg.incremental_window * period;
-    const double max_spacing = 1.5 * k * period;
-    for (std::size_t j = k - 1; j < obj.size(); j += k) {
-      // While the object stream is occluded, update on time anyway.
-      while (!triggers.empty() && obj[j].t - triggers.back() > max_spacing) triggers.push_back(triggers.back() + k * period);
-      triggers.push_back(obj[j].t);
-    }
-    const double t_end = builder.steps().back().t;
-    if (triggers.empty()) triggers.push_back(builder.steps().front().t);
-    while (t_end - triggers.back() > max_spacing) triggers.push_back(triggers.back() + k * period);
-    if (triggers.back() < t_end) triggers.push_back(t_end);
     states.resize(builder.steps().size());
     done.assign(builder.steps().size(), false);
   }
@@ -205,15 +198,18 @@ struct IncrementalEstimator::Impl {
     problem->AddResidualBlock(new MarginalPriorFactor(sizes, x_bar, S, r0), nullptr, sep);
   }
 
-  double Update() {
+  // Adds the steps up to `target` (every remaining one when take_all) and solves the window.
+  double Update(double target, bool take_all) {
     const auto start = std::chrono::steady_clock::now();
-    const double target = triggers[next_trigger++];
     const int n = static_cast<int>(builder.steps().size());
+    states.resize(n);
+    done.resize(n, false);
     const int first_new = next_step;
-    while (next_step < n && (builder.steps()[next_step].t <= target + 1e-12 || next_trigger == triggers.size())) {
+    while (next_step < n && (builder.steps()[next_step].t <= target + 1e-12 || take_all)) {
       builder.Initialize(next_step, target);
       ++next_step;
     }
+    if (next_step == first_new) return 0.0;
     // The new steps start from a causal motion-only smoother (as the batch solver's start).
     stats.iterations += builder.SmoothInitialMotion(10, 1e-3, first_new, next_step);
     for (int i = first_new; i < next_step; ++i) builder.AddFactors(*problem, i, internal::GraphBuilder::kKinematic);
@@ -264,6 +260,61 @@ struct IncrementalEstimator::Impl {
     stats.max_update_time_s = std::max(stats.max_update_time_s, dt);
     return dt;
   }
+
+  // The remaining window's covariances and the whole result.
+  EstimationResult Finish() {
+    const auto start = std::chrono::steady_clock::now();
+    std::vector<int> rest;
+    for (int i = lo; i < next_step; ++i) rest.push_back(i);
+    Record(rest);
+    total_update_time += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    EstimationResult r;
+    r.model = builder.model();
+    r.mode = Mode::kIncremental;
+    r.states.assign(states.begin(), states.begin() + next_step);
+    r.solver = stats;
+    r.solver.time_s = total_update_time;
+    r.solver.final_cost = last_cost;
+    r.solver.mean_update_time_s = stats.updates > 0 ? total_update_time / stats.updates : 0.0;
+    r.metrics = ComputeMetrics(traj, r.states);
+    return r;
+  }
+
+  StateEstimate LatestState(const char* who) const {
+    if (next_step == 0) throw GraphError(std::string(who) + "::LatestState before the first Update");
+    return builder.State(next_step - 1);
+  }
+};
+
+}  // namespace
+
+// Replay: the update times come from the recorded object stream.
+struct IncrementalEstimator::Impl {
+  FixedLagSmoother smoother;
+  std::vector<double> triggers;
+  std::size_t next_trigger = 0;
+
+  Impl(const limit_surface::Trajectory& traj, Model model, const EstimatorConfig& cfg)
+      : smoother(traj, model, cfg, nullptr) {
+    const auto& obj = traj.measured.object_pose;
+    const auto& steps = smoother.builder.steps();
+    double period = MedianObjectPeriod(obj);
+    if (!(period > 0.0)) {
+      period = steps.size() > 1 ? 10.0 * (steps.back().t - steps.front().t) / double(steps.size() - 1) : 1.0;
+    }
+    const int k = cfg.incremental_update_every;
+    smoother.window_duration = cfg.incremental_window * period;
+    const double max_spacing = 1.5 * k * period;
+    for (std::size_t j = k - 1; j < obj.size(); j += k) {
+      // While the object stream is occluded, update on time anyway.
+      while (!triggers.empty() && obj[j].t - triggers.back() > max_spacing) triggers.push_back(triggers.back() + k * period);
+      triggers.push_back(obj[j].t);
+    }
+    const double t_end = steps.back().t;
+    if (triggers.empty()) triggers.push_back(steps.front().t);
+    while (t_end - triggers.back() > max_spacing) triggers.push_back(triggers.back() + k * period);
+    if (triggers.back() < t_end) triggers.push_back(t_end);
+  }
 };
 
 IncrementalEstimator::IncrementalEstimator(const limit_surface::Trajectory& trajectory, Model model,
@@ -274,34 +325,149 @@ IncrementalEstimator::~IncrementalEstimator() = default;
 bool IncrementalEstimator::Done() const { return impl_->next_trigger >= impl_->triggers.size(); }
 double IncrementalEstimator::Update() {
   if (Done()) throw GraphError("IncrementalEstimator::Update called after the last update");
-  return impl_->Update();
+  const double target = impl_->triggers[impl_->next_trigger++];
+  return impl_->smoother.Update(target, Done());
 }
-StateEstimate IncrementalEstimator::LatestState() const {
-  if (impl_->next_step == 0) throw GraphError("IncrementalEstimator::LatestState before the first Update");
-  return impl_->builder.State(impl_->next_step - 1);
-}
-int IncrementalEstimator::WindowSteps() const { return impl_->next_step - impl_->lo; }
-int IncrementalEstimator::StepsAdded() const { return impl_->next_step; }
-int IncrementalEstimator::TotalSteps() const { return static_cast<int>(impl_->builder.steps().size()); }
+StateEstimate IncrementalEstimator::LatestState() const { return impl_->smoother.LatestState("IncrementalEstimator"); }
+int IncrementalEstimator::WindowSteps() const { return impl_->smoother.next_step - impl_->smoother.lo; }
+int IncrementalEstimator::StepsAdded() const { return impl_->smoother.next_step; }
+int IncrementalEstimator::TotalSteps() const { return static_cast<int>(impl_->smoother.builder.steps().size()); }
 
 EstimationResult IncrementalEstimator::Finish() {
-  Impl& m = *impl_;
   if (!Done()) throw GraphError("IncrementalEstimator::Finish called before the last update");
-  const auto start = std::chrono::steady_clock::now();
-  std::vector<int> rest;
-  for (int i = m.lo; i < m.next_step; ++i) rest.push_back(i);
-  m.Record(rest);
-  m.total_update_time += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  EstimationResult r;
-  r.model = m.builder.model();
-  r.mode = Mode::kIncremental;
-  r.states = m.states;
-  r.solver = m.stats;
-  r.solver.time_s = m.total_update_time;
-  r.solver.final_cost = m.last_cost;
-  r.solver.mean_update_time_s = m.stats.updates > 0 ? m.total_update_time / m.stats.updates : 0.0;
-  r.metrics = ComputeMetrics(m.traj, r.states);
-  return r;
+  return impl_->smoother.Finish();
+}
+
+// Online: the samples are appended to an owned trajectory as they arrive.
+struct OnlineEstimator::Impl {
+  limit_surface::Trajectory traj;  // grows; the smoother's builder reads it
+  FixedLagSmoother smoother;
+  double last_update_t = -INFINITY;
+  double newest_t = -INFINITY;
+  double first_t = INFINITY;
+  bool finished = false;
+
+  static const limit_surface::Trajectory& Empty(const limit_surface::Trajectory& setup) {
+    const auto& m = setup.measured;
+    if (!m.object_pose.empty() || !m.finger_pose.empty() || !m.contact_point.empty() || !m.force.empty()) {
+      throw GraphError("OnlineEstimator: the setup trajectory must have empty streams (measurements arrive through Add*)");
+    }
+    return setup;
+  }
+  Impl(const limit_surface::Trajectory& setup, Model model, const EstimatorConfig& cfg, const OnlineStreams& streams)
+      : traj(Empty(setup)), smoother(traj, model, cfg, &streams) {}
+
+  template <class Sample>
+  void Check(const std::vector<Sample>& stream, const char* name, double t, bool finite) const {
+    auto where = [&] {
+      std::ostringstream o;
+      o.precision(17);
+      o << "OnlineEstimator: streams." << name << "[" << stream.size() << "] at t = " << t;
+      return o.str();
+    };
+    if (finished) throw GraphError(where() + " arrived after Finish()");
+    if (!std::isfinite(t) || !finite) throw GraphError(where() + " is not finite");
+    if (!stream.empty() && !(t > stream.back().t)) {
+      std::ostringstream o;
+      o.precision(17);
+      o << where() << " is not after the previous sample (t = " << stream.back().t << "): each stream must arrive in time order";
+      throw GraphError(o.str());
+    }
+    if (!(t > last_update_t + 1e-9)) {
+      std::ostringstream o;
+      o.precision(17);
+      o << where() << " is not after the last update (t = " << last_update_t
+        << "): it would belong to steps already solved";
+      throw GraphError(o.str());
+    }
+  }
+  void Arrived(double t) {
+    newest_t = std::max(newest_t, t);
+    first_t = std::min(first_t, t);
+  }
+
+  int ObjectSamplesSinceUpdate() const {
+    const auto& obj = traj.measured.object_pose;
+    return static_cast<int>(obj.end() - std::upper_bound(obj.begin(), obj.end(), last_update_t,
+                                                         [](double t, const limit_surface::PoseSample& a) { return t < a.t; }));
+  }
+};
+
+OnlineEstimator::OnlineEstimator(const limit_surface::Trajectory& setup, Model model, const EstimatorConfig& config,
+                                 const OnlineStreams& streams)
+    : impl_(std::make_unique<Impl>(setup, model, config, streams)) {}
+OnlineEstimator::~OnlineEstimator() = default;
+
+void OnlineEstimator::AddObjectPose(double t, const geometry::Pose2& pose) {
+  auto& s = impl_->traj.measured.object_pose;
+  impl_->Check(s, "object_pose", t, pose.vector().allFinite());
+  s.push_back({t, pose});
+  impl_->Arrived(t);
+}
+void OnlineEstimator::AddFingerPose(double t, const geometry::Pose2& pose) {
+  auto& s = impl_->traj.measured.finger_pose;
+  impl_->Check(s, "finger_pose", t, pose.vector().allFinite());
+  s.push_back({t, pose});
+  impl_->Arrived(t);
+}
+void OnlineEstimator::AddContactPoint(double t, const geometry::Vec2& point) {
+  auto& s = impl_->traj.measured.contact_point;
+  impl_->Check(s, "contact_point", t, point.allFinite());
+  s.push_back({t, point});
+  impl_->Arrived(t);
+}
+void OnlineEstimator::AddForce(double t, const geometry::Vec2& force) {
+  auto& s = impl_->traj.measured.force;
+  impl_->Check(s, "force", t, force.allFinite());
+  s.push_back({t, force});
+  impl_->Arrived(t);
+}
+
+bool OnlineEstimator::UpdateDue() const {
+  const Impl& m = *impl_;
+  const int k = m.smoother.cfg.incremental_update_every;
+  if (m.ObjectSamplesSinceUpdate() >= k) return true;
+  // The object stream is silent (occlusion): update on time, as IncrementalEstimator does.
+  const double period = MedianObjectPeriod(m.traj.measured.object_pose);
+  const double since = std::isfinite(m.last_update_t) ? m.last_update_t : m.first_t;
+  return period > 0.0 && m.newest_t - since > 1.5 * k * period;
+}
+
+double OnlineEstimator::Update(double until) {
+  Impl& m = *impl_;
+  if (m.finished) throw GraphError("OnlineEstimator::Update called after Finish()");
+  if (std::isnan(until)) throw GraphError("OnlineEstimator::Update: the update time is NaN");
+  until = std::min(until, m.newest_t);
+  if (!(until > m.last_update_t)) return 0.0;  // nothing new
+  const auto& meas = m.traj.measured;
+  if (m.smoother.next_step == 0) {
+    // The first update needs both poses: nothing else anchors the object and the finger.
+    if (meas.object_pose.empty() || meas.object_pose.front().t > until) {
+      throw GraphError("OnlineEstimator::Update: no object pose measurement up to t = " + std::to_string(until) +
+                       " (the first update needs one to anchor the object)");
+    }
+    if (meas.finger_pose.empty() || meas.finger_pose.front().t > until) {
+      throw GraphError("OnlineEstimator::Update: no finger pose measurement up to t = " + std::to_string(until));
+    }
+  }
+  m.smoother.builder.AppendSteps(until);
+  const double period = MedianObjectPeriod(meas.object_pose);
+  if (period > 0.0) m.smoother.window_duration = m.smoother.cfg.incremental_window * period;
+  m.last_update_t = until;
+  return m.smoother.Update(until, false);
+}
+
+StateEstimate OnlineEstimator::LatestState() const { return impl_->smoother.LatestState("OnlineEstimator"); }
+int OnlineEstimator::WindowSteps() const { return impl_->smoother.next_step - impl_->smoother.lo; }
+int OnlineEstimator::StepsAdded() const { return impl_->smoother.next_step; }
+
+EstimationResult OnlineEstimator::Finish() {
+  Impl& m = *impl_;
+  if (m.finished) throw GraphError("OnlineEstimator::Finish called twice");
+  if (m.newest_t > m.last_update_t) Update();
+  m.finished = true;
+  if (m.smoother.next_step == 0) throw GraphError("OnlineEstimator::Finish: no measurements were added");
+  return m.smoother.Finish();
 }
 
 }  // namespace pushgraph::graph

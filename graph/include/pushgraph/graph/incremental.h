@@ -11,15 +11,29 @@
 // window stays bounded, so the cost of an update does not grow with the trajectory.
 // A leaving state keeps its estimate and the marginal covariance of the window it leaves.
 //
-//   graph::IncrementalEstimator inc(traj, graph::Model::kQs, cfg);
-//   while (!inc.Done()) { inc.Update(); use(inc.LatestState()); }
-//   graph::EstimationResult r = inc.Finish();
+// Two front ends share the smoother:
+// - IncrementalEstimator replays a recorded trajectory (the tool's --mode incremental):
+//
+//     graph::IncrementalEstimator inc(traj, graph::Model::kQs, cfg);
+//     while (!inc.Done()) { inc.Update(); use(inc.LatestState()); }
+//     graph::EstimationResult r = inc.Finish();
+//
+// - OnlineEstimator takes measurements one at a time as a robot's sensors deliver them:
+//
+//     limit_surface::Trajectory setup;  // object and finger shapes, mass, frictions; no samples
+//     graph::OnlineEstimator online(setup, graph::Model::kQs, cfg, {/*contact_point=*/false, /*force=*/true});
+//     online.AddObjectPose(t, pose);    // from the sensor callbacks, each stream in time order
+//     online.AddFingerPose(t, pose);
+//     online.AddForce(t, force);
+//     if (online.UpdateDue()) { online.Update(); use(online.LatestState()); }  // in the loop
+//     graph::EstimationResult r = online.Finish();
 #include <pushgraph/graph/estimator.h>
 
 #include <ceres/cost_function.h>
 
 #include <Eigen/Core>
 
+#include <cmath>
 #include <memory>
 #include <vector>
 
@@ -40,6 +54,15 @@ class MarginalPriorFactor : public ceres::CostFunction {
   Eigen::MatrixXd S_;
 };
 
+/// Which measurement streams an online run will receive. They shape the graph as the
+/// recorded streams do in batch: contact is gated on the contact stream if there is one, else
+/// on the force stream (force above contact_force_threshold), else always on; and the
+/// limit-surface load factor runs (limit_surface_load "auto") only when no force will arrive.
+struct OnlineStreams {
+  bool contact_point = false;  ///< a tactile sensor reports contact points
+  bool force = true;           ///< a force/torque sensor reports the contact force
+};
+
 class IncrementalEstimator {
  public:
   IncrementalEstimator(const limit_surface::Trajectory& trajectory, Model model,
@@ -58,6 +81,50 @@ class IncrementalEstimator {
   int StepsAdded() const;    ///< steps added so far
   int TotalSteps() const;
   /// Covariances of the remaining window, the full result and its metrics. Call once, after Done().
+  EstimationResult Finish();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// The fixed-lag smoother fed online, one measurement at a time (the paper's incremental
+/// inference on a running robot). Every stream must arrive in strictly increasing time, and
+/// after the last update: a sample at or before the last update's time would belong to steps
+/// already solved, so it is refused (GraphError, naming the stream and both times), as are
+/// non-finite samples. An update turns every buffered sample up to its time into steps,
+/// exactly as IncrementalEstimator does for a recording (on the same samples and update times
+/// both give the same estimate, up to contact gating, which here sees only past samples).
+class OnlineEstimator {
+ public:
+  /// `setup` gives the object, the finger and, when the trajectory has them, mass and
+  /// frictions; its measured streams must be empty. Its ground truth, if any, is only used
+  /// for Finish()'s metrics (simulation and testing).
+  OnlineEstimator(const limit_surface::Trajectory& setup, Model model, const EstimatorConfig& config = {},
+                  const OnlineStreams& streams = {});
+  ~OnlineEstimator();
+  OnlineEstimator(const OnlineEstimator&) = delete;
+  OnlineEstimator& operator=(const OnlineEstimator&) = delete;
+
+  void AddObjectPose(double t, const geometry::Pose2& pose);
+  void AddFingerPose(double t, const geometry::Pose2& pose);
+  void AddContactPoint(double t, const geometry::Vec2& point);
+  void AddForce(double t, const geometry::Vec2& force);
+
+  /// True once incremental_update_every object measurements arrived since the last update, or,
+  /// while the object stream is silent (occlusion), once the other streams ran that many object
+  /// periods (1.5 x) past it: the schedule IncrementalEstimator follows.
+  bool UpdateDue() const;
+  /// Turns the samples up to `until` (default: the newest sample of any stream) into steps and
+  /// solves the window; later samples stay buffered. Needs at least one object and one finger
+  /// pose. Returns the wall time of the update (s); 0 when there was nothing new.
+  double Update(double until = INFINITY);
+  /// The newest state of the window (after at least one Update()).
+  StateEstimate LatestState() const;
+  int WindowSteps() const;  ///< steps currently in the window
+  int StepsAdded() const;   ///< steps solved so far
+  /// Updates with whatever is still buffered, then computes the last window's covariances and
+  /// returns every step's estimate (metrics when the setup has ground truth). Call once.
   EstimationResult Finish();
 
  private:

@@ -1,0 +1,187 @@
+// OnlineEstimator: the fixed-lag smoother fed one measurement at a time, against the replay
+// of the same recording (IncrementalEstimator), and its refusals of bad or late samples.
+#include <pushgraph/graph/estimator.h>
+#include <pushgraph/graph/incremental.h>
+
+#include "graph/push_generator.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <vector>
+
+namespace pushgraph::graph {
+namespace {
+
+using testing::GeneratePush;
+using testing::PushSpec;
+
+PushSpec OffsetPush(unsigned seed, double duration) {
+  PushSpec s;
+  s.contact_offset = 0.02;
+  s.duration = duration;
+  s.seed = seed;
+  return s;
+}
+
+limit_surface::Trajectory SetupOf(const limit_surface::Trajectory& t) {
+  limit_surface::Trajectory setup;
+  setup.object = t.object;
+  setup.finger = t.finger;
+  setup.ground_truth = t.ground_truth;  // for Finish()'s metrics only
+  return setup;
+}
+
+// Every sample of `t` in time order; samples sharing a time stamp are delivered together,
+// then `after_stamp` runs (a robot loop polling UpdateDue).
+void Feed(const limit_surface::Trajectory& t, OnlineEstimator& online, const std::function<void()>& after_stamp) {
+  struct Event { double t; int stream; std::size_t i; };
+  std::vector<Event> events;
+  const auto& m = t.measured;
+  for (std::size_t i = 0; i < m.object_pose.size(); ++i) events.push_back({m.object_pose[i].t, 0, i});
+  for (std::size_t i = 0; i < m.finger_pose.size(); ++i) events.push_back({m.finger_pose[i].t, 1, i});
+  for (std::size_t i = 0; i < m.contact_point.size(); ++i) events.push_back({m.contact_point[i].t, 2, i});
+  for (std::size_t i = 0; i < m.force.size(); ++i) events.push_back({m.force[i].t, 3, i});
+  std::stable_sort(events.begin(), events.end(), [](const Event& a, const Event& b) { return a.t < b.t; });
+  for (std::size_t k = 0; k < events.size(); ++k) {
+    const Event& e = events[k];
+    if (e.stream == 0) online.AddObjectPose(e.t, m.object_pose[e.i].pose);
+    if (e.stream == 1) online.AddFingerPose(e.t, m.finger_pose[e.i].pose);
+    if (e.stream == 2) online.AddContactPoint(e.t, m.contact_point[e.i].point);
+    if (e.stream == 3) online.AddForce(e.t, m.force[e.i].force);
+    if (k + 1 == events.size() || events[k + 1].t > e.t + 1e-9) after_stamp();
+  }
+}
+
+double WorstTranslationGap(const EstimationResult& a, const EstimationResult& b) {
+  double worst = 0.0;
+  for (std::size_t i = 0; i < a.states.size(); ++i) {
+    worst = std::max(worst, (a.states[i].object_pose.translation() - b.states[i].object_pose.translation()).norm());
+    worst = std::max(worst, (a.states[i].finger_pose.translation() - b.states[i].finger_pose.translation()).norm());
+  }
+  return worst;
+}
+
+// Fed the same samples at the same update times, the online smoother is the replay.
+TEST(Online, SameEstimateAsTheReplayOfTheRecording) {
+  const limit_surface::Trajectory t = GeneratePush(OffsetPush(21, 2.0));
+  for (Model model : {Model::kQs, Model::kCp}) {
+    IncrementalEstimator replay(t, model);
+    while (!replay.Done()) replay.Update();
+    const EstimationResult expected = replay.Finish();
+
+    OnlineStreams streams;
+    streams.contact_point = !t.measured.contact_point.empty();
+    streams.force = !t.measured.force.empty();
+    OnlineEstimator online(SetupOf(t), model, {}, streams);
+    int updates = 0, max_window = 0;
+    double last_until = -1.0;
+    Feed(t, online, [&] {
+      if (!online.UpdateDue()) return;
+      online.Update();
+      ++updates;
+      max_window = std::max(max_window, online.WindowSteps());
+      // The newest estimate is the newest step: causal, nothing after the update.
+      const double newest = online.LatestState().t;
+      EXPECT_GT(newest, last_until);
+      last_until = newest;
+    });
+    const EstimationResult r = online.Finish();
+    ASSERT_EQ(r.states.size(), expected.states.size());
+    for (std::size_t i = 0; i < r.states.size(); ++i) ASSERT_EQ(r.states[i].t, expected.states[i].t);
+    const double gap = WorstTranslationGap(r, expected);
+    std::printf("[online] %s: %d updates (replay %d), window <= %d steps, worst |online - replay| %.3g m; "
+                "object RMS %.3f mm (replay %.3f mm)\n",
+                ModelName(model).c_str(), r.solver.updates, expected.solver.updates, max_window, gap,
+                1e3 * r.metrics.at("object_position_rms"), 1e3 * expected.metrics.at("object_position_rms"));
+    EXPECT_EQ(r.solver.updates, expected.solver.updates);
+    EXPECT_LT(gap, 1e-9);
+    EXPECT_LE(max_window, (20 + 5) * 10 + 5);
+    ASSERT_TRUE(r.states.back().object_pose_cov.has_value());
+    EXPECT_NEAR(std::sqrt((*r.states.back().object_pose_cov)(0, 0)),
+                std::sqrt((*expected.states.back().object_pose_cov)(0, 0)), 1e-9);
+  }
+}
+
+// While the camera is occluded the online smoother keeps updating on time (force and finger
+// keep arriving) and stays about as accurate as the replay, whose time triggers differ.
+TEST(Online, KeepsUpdatingThroughAnOcclusion) {
+  PushSpec spec = OffsetPush(5, 2.0);
+  spec.occlusion_begin = 0.6;
+  spec.occlusion_end = 1.4;
+  const limit_surface::Trajectory t = GeneratePush(spec);
+  IncrementalEstimator replay(t, Model::kQs);
+  while (!replay.Done()) replay.Update();
+  const EstimationResult expected = replay.Finish();
+
+  OnlineEstimator online(SetupOf(t), Model::kQs);
+  int updates_in_occlusion = 0;
+  Feed(t, online, [&] {
+    if (!online.UpdateDue()) return;
+    online.Update();
+    const double now = online.LatestState().t;
+    if (now > spec.occlusion_begin + 0.25 && now < spec.occlusion_end) ++updates_in_occlusion;
+  });
+  const EstimationResult r = online.Finish();
+  const double rms = r.metrics.at("object_position_rms");
+  std::printf("[online] occlusion %.1f-%.1f s: %d updates inside it; object RMS %.3f mm (replay %.3f, raw %.3f mm)\n",
+              spec.occlusion_begin, spec.occlusion_end, updates_in_occlusion, 1e3 * rms,
+              1e3 * expected.metrics.at("object_position_rms"), 1e3 * r.metrics.at("measured_object_position_rms"));
+  // Time triggers every 1.5 k object periods (0.3 s) from 0.6 s: 0.9 and 1.2 s.
+  EXPECT_GE(updates_in_occlusion, 2);
+  EXPECT_LT(rms, 1.5 * expected.metrics.at("object_position_rms"));
+  EXPECT_LT(rms, 0.6 * r.metrics.at("measured_object_position_rms"));
+}
+
+TEST(Online, RefusesBadAndLateSamples) {
+  const limit_surface::Trajectory t = GeneratePush(OffsetPush(3, 0.3));
+  const limit_surface::Trajectory setup = SetupOf(t);
+  const geometry::Pose2 pose = t.measured.object_pose.front().pose;
+  const geometry::Pose2 finger = t.measured.finger_pose.front().pose;
+
+  EXPECT_THROW(OnlineEstimator(t, Model::kQs), GraphError);  // samples belong in Add*
+  EstimatorConfig with_c;
+  with_c.estimate_c = true;
+  EXPECT_THROW(OnlineEstimator(setup, Model::kQs, with_c), GraphError);  // batch only
+
+  OnlineEstimator online(setup, Model::kQs);
+  EXPECT_THROW(online.LatestState(), GraphError);
+  EXPECT_THROW(online.AddObjectPose(NAN, pose), GraphError);
+  EXPECT_THROW(online.AddObjectPose(0.0, geometry::Pose2{NAN, 0.0, 0.0}), GraphError);
+  EXPECT_THROW(online.AddForce(0.0, geometry::Vec2(INFINITY, 0.0)), GraphError);
+  online.AddFingerPose(0.0, finger);
+  EXPECT_THROW(online.Update(), GraphError);  // no object pose yet: nothing anchors the object
+  online.AddObjectPose(0.0, pose);
+  online.AddObjectPose(0.04, pose);
+  try {
+    online.AddObjectPose(0.02, pose);
+    ADD_FAILURE() << "out-of-order sample accepted";
+  } catch (const GraphError& e) {
+    EXPECT_NE(std::string(e.what()).find("streams.object_pose[2]"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("time order"), std::string::npos) << e.what();
+  }
+  online.AddFingerPose(0.004, finger);
+  online.AddFingerPose(0.008, finger);
+  online.AddForce(0.004, geometry::Vec2(1.0, 0.0));
+  EXPECT_GT(online.Update(0.006), 0.0);
+  EXPECT_EQ(online.StepsAdded(), 2);  // t = 0 and 0.004; 0.008 and 0.04 stay buffered
+  try {
+    online.AddForce(0.005, geometry::Vec2(1.0, 0.0));
+    ADD_FAILURE() << "late sample accepted";
+  } catch (const GraphError& e) {
+    EXPECT_NE(std::string(e.what()).find("last update"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(online.Update(0.006), 0.0);  // nothing new
+  online.AddForce(0.009, geometry::Vec2(1.0, 0.0));
+  const EstimationResult r = online.Finish();
+  EXPECT_EQ(r.states.size(), 5u);  // 0, 0.004, 0.008, 0.009, 0.04
+  EXPECT_THROW(online.Finish(), GraphError);
+  EXPECT_THROW(online.AddFingerPose(1.0, finger), GraphError);
+  EXPECT_THROW(online.Update(), GraphError);
+}
+
+}  // namespace
+}  // namespace pushgraph::graph
