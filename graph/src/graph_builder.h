@@ -6,12 +6,40 @@
 #include <ceres/ceres.h>
 
 #include <cmath>
-#include <deque>
+#include <algorithm>
 #include <memory>
 #include <optional>
 #include <vector>
 
 namespace pushgraph::graph::internal {
+
+/// Per-step parameter blocks in chunks that never move (Ceres keeps pointers to them). One
+/// chunk holds a batch's steps, so their addresses rise with the step index as in a vector:
+/// Ceres orders parameter blocks by address in places (ParameterBlockOrdering's sets), and
+/// heap-dependent orders would change last bits between runs. Online runs grow by chunks.
+template <class T>
+class StableArray {
+ public:
+  std::size_t size() const { return size_; }
+  T& operator[](std::size_t i) { return chunks_[Chunk(i)][i - starts_[Chunk(i)]]; }
+  const T& operator[](std::size_t i) const { return chunks_[Chunk(i)][i - starts_[Chunk(i)]]; }
+  void resize(std::size_t n) {
+    if (n <= capacity_) { size_ = std::max(size_, n); return; }
+    const std::size_t count = std::max<std::size_t>(n - capacity_, 4096);
+    chunks_.push_back(std::make_unique<T[]>(count));
+    starts_.push_back(capacity_);
+    capacity_ += count;
+    size_ = n;
+  }
+
+ private:
+  std::size_t Chunk(std::size_t i) const {
+    return static_cast<std::size_t>(std::upper_bound(starts_.begin(), starts_.end(), i) - starts_.begin()) - 1;
+  }
+  std::vector<std::unique_ptr<T[]>> chunks_;
+  std::vector<std::size_t> starts_;
+  std::size_t size_ = 0, capacity_ = 0;
+};
 
 /// One estimation step: a time stamp and the index of the measurement of each stream taken at
 /// that time (-1 when the step has none).
@@ -43,8 +71,8 @@ class GraphBuilder {
   int AppendSteps(double until);
 
   const std::vector<Step>& steps() const { return steps_; }
-  std::deque<StepVars>& vars() { return vars_; }
-  const std::deque<StepVars>& vars() const { return vars_; }
+  StableArray<StepVars>& vars() { return vars_; }
+  const StableArray<StepVars>& vars() const { return vars_; }
   Model model() const { return model_; }
   bool HasContactVars(int i) const { return steps_[i].in_contact; }
   bool HasForceVars(int i) const { return steps_[i].in_contact && ModelHasForce(model_); }
@@ -103,7 +131,7 @@ class GraphBuilder {
   EstimatorConfig cfg_;
   OnlineStreams streams_;  ///< which streams exist (batch: the non-empty ones)
   std::vector<Step> steps_;
-  std::deque<StepVars> vars_;  ///< a deque: appending keeps the addresses Ceres holds
+  StableArray<StepVars> vars_;  ///< appending keeps the addresses Ceres holds
   std::size_t used_[4] = {0, 0, 0, 0};  ///< samples of each stream already in steps
   std::shared_ptr<const geometry::ShapePairQuerier> querier_;
   QuasiStaticGeometry qs_;

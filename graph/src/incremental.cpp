@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <string>
@@ -52,10 +53,13 @@ bool MarginalPriorFactor::Evaluate(double const* const* parameters, double* resi
 
 namespace {
 
-// The median spacing of the object stream's samples (0 with fewer than two).
-double MedianObjectPeriod(const std::vector<limit_surface::PoseSample>& obj) {
+// The median spacing of the object stream's samples (0 with fewer than two); of the newest
+// `recent` only, when given (the online front end: constant cost per call).
+double MedianObjectPeriod(const std::vector<limit_surface::PoseSample>& obj,
+                          std::size_t recent = std::numeric_limits<std::size_t>::max()) {
   std::vector<double> periods;
-  for (std::size_t i = 1; i < obj.size(); ++i) periods.push_back(obj[i].t - obj[i - 1].t);
+  const std::size_t first = obj.size() > recent ? obj.size() - recent : 0;
+  for (std::size_t i = first + 1; i < obj.size(); ++i) periods.push_back(obj[i].t - obj[i - 1].t);
   if (periods.empty()) return 0.0;
   std::nth_element(periods.begin(), periods.begin() + periods.size() / 2, periods.end());
   return periods[periods.size() / 2];
@@ -345,7 +349,12 @@ struct OnlineEstimator::Impl {
   double last_update_t = -INFINITY;
   double newest_t = -INFINITY;
   double first_t = INFINITY;
+  double last_seen[4] = {-INFINITY, -INFINITY, -INFINITY, -INFINITY};  // per stream, dropped samples included
+  std::size_t seen[4] = {0, 0, 0, 0};
+  int dropped_late = 0;
   bool finished = false;
+  bool declared[4] = {true, true, false, false};
+  static constexpr std::size_t kRecentPeriods = 64;  // object periods the schedule looks at
 
   static const limit_surface::Trajectory& Empty(const limit_surface::Trajectory& setup) {
     const auto& m = setup.measured;
@@ -355,35 +364,55 @@ struct OnlineEstimator::Impl {
     return setup;
   }
   Impl(const limit_surface::Trajectory& setup, Model model, const EstimatorConfig& cfg, const OnlineStreams& streams)
-      : traj(Empty(setup)), smoother(traj, model, cfg, &streams) {}
+      : traj(Empty(setup)), smoother(traj, model, cfg, &streams) {
+    declared[2] = streams.contact_point;
+    declared[3] = streams.force;
+  }
 
-  template <class Sample>
-  void Check(const std::vector<Sample>& stream, const char* name, double t, bool finite) const {
+  // Throws for a sample that is not finite or not after its stream's previous one; returns
+  // false (and counts it) for one at or before the last update: it would belong to steps
+  // already solved, so it is dropped.
+  bool Accept(int stream, const char* name, std::size_t index, double t, bool finite) {
     auto where = [&] {
       std::ostringstream o;
       o.precision(17);
-      o << "OnlineEstimator: streams." << name << "[" << stream.size() << "] at t = " << t;
+      o << "OnlineEstimator: streams." << name << "[" << index << "] at t = " << t;
       return o.str();
     };
     if (finished) throw GraphError(where() + " arrived after Finish()");
+    if (!declared[stream]) {
+      throw GraphError(where() + ": the stream was not declared in OnlineStreams (it decides contact gating and the load factor)");
+    }
     if (!std::isfinite(t) || !finite) throw GraphError(where() + " is not finite");
-    if (!stream.empty() && !(t > stream.back().t)) {
+    if (!(t > last_seen[stream])) {
       std::ostringstream o;
       o.precision(17);
-      o << where() << " is not after the previous sample (t = " << stream.back().t << "): each stream must arrive in time order";
+      o << where() << " is not after the previous sample (t = " << last_seen[stream]
+        << "): each stream must arrive in time order";
       throw GraphError(o.str());
     }
-    if (!(t > last_update_t + 1e-9)) {
-      std::ostringstream o;
-      o.precision(17);
-      o << where() << " is not after the last update (t = " << last_update_t
-        << "): it would belong to steps already solved";
-      throw GraphError(o.str());
-    }
-  }
-  void Arrived(double t) {
+    last_seen[stream] = t;
+    ++seen[stream];
     newest_t = std::max(newest_t, t);
     first_t = std::min(first_t, t);
+    if (!(t > last_update_t + 1e-9)) {
+      ++dropped_late;
+      return false;
+    }
+    return true;
+  }
+
+  // The newest time every live stream has reached: a stream is live when it reported within
+  // 1.5 k object periods of the newest sample (an occluded camera, or a tactile sensor silent
+  // out of contact, does not hold the others back); a slower sensor is waited for.
+  double SettledTime() const {
+    const double period = MedianObjectPeriod(traj.measured.object_pose, kRecentPeriods);
+    const double live = period > 0.0 ? 1.5 * smoother.cfg.incremental_update_every * period : INFINITY;
+    double settled = newest_t;
+    for (double t : last_seen) {
+      if (std::isfinite(t) && newest_t - t <= live) settled = std::min(settled, t);
+    }
+    return settled;
   }
 
   int ObjectSamplesSinceUpdate() const {
@@ -398,37 +427,34 @@ OnlineEstimator::OnlineEstimator(const limit_surface::Trajectory& setup, Model m
     : impl_(std::make_unique<Impl>(setup, model, config, streams)) {}
 OnlineEstimator::~OnlineEstimator() = default;
 
-void OnlineEstimator::AddObjectPose(double t, const geometry::Pose2& pose) {
-  auto& s = impl_->traj.measured.object_pose;
-  impl_->Check(s, "object_pose", t, pose.vector().allFinite());
-  s.push_back({t, pose});
-  impl_->Arrived(t);
+bool OnlineEstimator::AddObjectPose(double t, const geometry::Pose2& pose) {
+  if (!impl_->Accept(0, "object_pose", impl_->seen[0], t, pose.vector().allFinite())) return false;
+  impl_->traj.measured.object_pose.push_back({t, pose});
+  return true;
 }
-void OnlineEstimator::AddFingerPose(double t, const geometry::Pose2& pose) {
-  auto& s = impl_->traj.measured.finger_pose;
-  impl_->Check(s, "finger_pose", t, pose.vector().allFinite());
-  s.push_back({t, pose});
-  impl_->Arrived(t);
+bool OnlineEstimator::AddFingerPose(double t, const geometry::Pose2& pose) {
+  if (!impl_->Accept(1, "finger_pose", impl_->seen[1], t, pose.vector().allFinite())) return false;
+  impl_->traj.measured.finger_pose.push_back({t, pose});
+  return true;
 }
-void OnlineEstimator::AddContactPoint(double t, const geometry::Vec2& point) {
-  auto& s = impl_->traj.measured.contact_point;
-  impl_->Check(s, "contact_point", t, point.allFinite());
-  s.push_back({t, point});
-  impl_->Arrived(t);
+bool OnlineEstimator::AddContactPoint(double t, const geometry::Vec2& point) {
+  if (!impl_->Accept(2, "contact_point", impl_->seen[2], t, point.allFinite())) return false;
+  impl_->traj.measured.contact_point.push_back({t, point});
+  return true;
 }
-void OnlineEstimator::AddForce(double t, const geometry::Vec2& force) {
-  auto& s = impl_->traj.measured.force;
-  impl_->Check(s, "force", t, force.allFinite());
-  s.push_back({t, force});
-  impl_->Arrived(t);
+bool OnlineEstimator::AddForce(double t, const geometry::Vec2& force) {
+  if (!impl_->Accept(3, "force", impl_->seen[3], t, force.allFinite())) return false;
+  impl_->traj.measured.force.push_back({t, force});
+  return true;
 }
+int OnlineEstimator::DroppedLateSamples() const { return impl_->dropped_late; }
 
 bool OnlineEstimator::UpdateDue() const {
   const Impl& m = *impl_;
   const int k = m.smoother.cfg.incremental_update_every;
   if (m.ObjectSamplesSinceUpdate() >= k) return true;
   // The object stream is silent (occlusion): update on time, as IncrementalEstimator does.
-  const double period = MedianObjectPeriod(m.traj.measured.object_pose);
+  const double period = MedianObjectPeriod(m.traj.measured.object_pose, Impl::kRecentPeriods);
   const double since = std::isfinite(m.last_update_t) ? m.last_update_t : m.first_t;
   return period > 0.0 && m.newest_t - since > 1.5 * k * period;
 }
@@ -437,21 +463,31 @@ double OnlineEstimator::Update(double until) {
   Impl& m = *impl_;
   if (m.finished) throw GraphError("OnlineEstimator::Update called after Finish()");
   if (std::isnan(until)) throw GraphError("OnlineEstimator::Update: the update time is NaN");
-  until = std::min(until, m.newest_t);
+  // Default: up to where every live stream has reported; an explicit time is taken as given.
+  until = until == INFINITY ? m.SettledTime() : std::min(until, m.newest_t);
   if (!(until > m.last_update_t)) return 0.0;  // nothing new
   const auto& meas = m.traj.measured;
+  auto at = [](double t) {
+    std::ostringstream o;
+    o.precision(17);
+    o << t;
+    return o.str();
+  };
   if (m.smoother.next_step == 0) {
     // The first update needs both poses: nothing else anchors the object and the finger.
     if (meas.object_pose.empty() || meas.object_pose.front().t > until) {
-      throw GraphError("OnlineEstimator::Update: no object pose measurement up to t = " + std::to_string(until) +
-                       " (the first update needs one to anchor the object)");
+      throw GraphError("OnlineEstimator::Update: no object pose measurement (streams.object_pose) up to t = " +
+                       at(until) + ": the first update needs one to anchor the object");
     }
     if (meas.finger_pose.empty() || meas.finger_pose.front().t > until) {
-      throw GraphError("OnlineEstimator::Update: no finger pose measurement up to t = " + std::to_string(until));
+      throw GraphError("OnlineEstimator::Update: no finger pose measurement (streams.finger_pose) up to t = " + at(until));
     }
   }
+  // Samples within 1e-9 s after `until` join its step now (as batch merges them), so no later
+  // step can be closer than that to a solved one.
+  until += 1e-9;
   m.smoother.builder.AppendSteps(until);
-  const double period = MedianObjectPeriod(meas.object_pose);
+  const double period = MedianObjectPeriod(meas.object_pose, Impl::kRecentPeriods);
   if (period > 0.0) m.smoother.window_duration = m.smoother.cfg.incremental_window * period;
   m.last_update_t = until;
   return m.smoother.Update(until, false);
@@ -464,7 +500,7 @@ int OnlineEstimator::StepsAdded() const { return impl_->smoother.next_step; }
 EstimationResult OnlineEstimator::Finish() {
   Impl& m = *impl_;
   if (m.finished) throw GraphError("OnlineEstimator::Finish called twice");
-  if (m.newest_t > m.last_update_t) Update();
+  if (m.newest_t > m.last_update_t) Update(m.newest_t);  // the end: wait for nobody
   m.finished = true;
   if (m.smoother.next_step == 0) throw GraphError("OnlineEstimator::Finish: no measurements were added");
   return m.smoother.Finish();

@@ -89,12 +89,13 @@ class IncrementalEstimator {
 };
 
 /// The fixed-lag smoother fed online, one measurement at a time (the paper's incremental
-/// inference on a running robot). Every stream must arrive in strictly increasing time, and
-/// after the last update: a sample at or before the last update's time would belong to steps
-/// already solved, so it is refused (GraphError, naming the stream and both times), as are
-/// non-finite samples. An update turns every buffered sample up to its time into steps,
-/// exactly as IncrementalEstimator does for a recording (on the same samples and update times
-/// both give the same estimate, up to contact gating, which here sees only past samples).
+/// inference on a running robot). Each stream must arrive in strictly increasing time, with
+/// finite values (else GraphError, naming the stream, the sample's index and times). Streams may
+/// lag one another (a camera tracker is often slower than a force sensor): Update() solves only
+/// up to where every live stream has reported. A sample at or before the last update's time
+/// would belong to steps already solved: it is dropped, Add* returns false and
+/// DroppedLateSamples() counts it. On the same samples and update times the estimate is
+/// IncrementalEstimator's (up to contact gating, which here sees only past samples).
 class OnlineEstimator {
  public:
   /// `setup` gives the object, the finger and, when the trajectory has them, mass and
@@ -106,18 +107,22 @@ class OnlineEstimator {
   OnlineEstimator(const OnlineEstimator&) = delete;
   OnlineEstimator& operator=(const OnlineEstimator&) = delete;
 
-  void AddObjectPose(double t, const geometry::Pose2& pose);
-  void AddFingerPose(double t, const geometry::Pose2& pose);
-  void AddContactPoint(double t, const geometry::Vec2& point);
-  void AddForce(double t, const geometry::Vec2& force);
+  /// Each returns false when the sample came too late (at or before the last update) and was dropped.
+  bool AddObjectPose(double t, const geometry::Pose2& pose);
+  bool AddFingerPose(double t, const geometry::Pose2& pose);
+  bool AddContactPoint(double t, const geometry::Vec2& point);
+  bool AddForce(double t, const geometry::Vec2& force);
+  int DroppedLateSamples() const;
 
   /// True once incremental_update_every object measurements arrived since the last update, or,
   /// while the object stream is silent (occlusion), once the other streams ran that many object
   /// periods (1.5 x) past it: the schedule IncrementalEstimator follows.
   bool UpdateDue() const;
-  /// Turns the samples up to `until` (default: the newest sample of any stream) into steps and
-  /// solves the window; later samples stay buffered. Needs at least one object and one finger
-  /// pose. Returns the wall time of the update (s); 0 when there was nothing new.
+  /// Turns the samples up to `until` into steps and solves the window; later samples stay
+  /// buffered. Default `until`: the newest time every live stream has reached (a stream is live
+  /// when it reported within 1.5 k object periods of the newest sample, so an occluded camera or
+  /// a silent tactile sensor does not stall the others). The first update needs an object and a
+  /// finger pose. Returns the wall time of the update (s); 0 when there was nothing new.
   double Update(double until = INFINITY);
   /// The newest state of the window (after at least one Update()).
   StateEstimate LatestState() const;
