@@ -1,6 +1,7 @@
 // Batch solve time against the number of steps (the push generator's 250 Hz clock with object
 // poses at 25 Hz), with and without marginal covariances, and the incremental (fixed-lag)
-// update time against trajectory length: it must stay flat.
+// update time against trajectory length: it must stay flat, replayed (IncrementalEstimator) and
+// fed sample by sample (OnlineEstimator).
 #include <pushgraph/graph/estimator.h>
 #include <pushgraph/graph/incremental.h>
 
@@ -8,7 +9,10 @@
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <chrono>
 #include <map>
+#include <vector>
 
 namespace {
 
@@ -85,6 +89,59 @@ void BM_IncrementalQs(benchmark::State& s) { Incremental(s, false); }
 void BM_IncrementalQsWithCovariance(benchmark::State& s) { Incremental(s, true); }
 BENCHMARK(BM_IncrementalQs)->Arg(500)->Arg(2000)->Arg(8000)->Unit(benchmark::kMillisecond)->Iterations(1);
 BENCHMARK(BM_IncrementalQsWithCovariance)->Arg(500)->Arg(2000)->Unit(benchmark::kMillisecond)->Iterations(1);
+
+// The same push through graph::OnlineEstimator, one sample at a time (grouped by time stamp,
+// UpdateDue polled after each stamp): the update times, and the bookkeeping per sample outside
+// the updates (Add* and UpdateDue), which must not grow with the length either.
+void BM_OnlineQs(benchmark::State& state) {
+  const auto& traj = Push(static_cast<int>(state.range(0)));
+  struct Sample { double t; int stream; std::size_t i; };
+  std::vector<Sample> samples;
+  const auto& m = traj.measured;
+  for (std::size_t i = 0; i < m.object_pose.size(); ++i) samples.push_back({m.object_pose[i].t, 0, i});
+  for (std::size_t i = 0; i < m.finger_pose.size(); ++i) samples.push_back({m.finger_pose[i].t, 1, i});
+  for (std::size_t i = 0; i < m.contact_point.size(); ++i) samples.push_back({m.contact_point[i].t, 2, i});
+  for (std::size_t i = 0; i < m.force.size(); ++i) samples.push_back({m.force[i].t, 3, i});
+  std::stable_sort(samples.begin(), samples.end(), [](const Sample& a, const Sample& b) { return a.t < b.t; });
+  limit_surface::Trajectory setup;
+  setup.object = traj.object;
+  setup.finger = traj.finger;
+  graph::EstimatorConfig cfg;
+  cfg.covariance = false;
+  double mean = 0, worst = 0, per_sample_us = 0;
+  for (auto _ : state) {
+    graph::OnlineEstimator online(setup, graph::Model::kQs, cfg, {!m.contact_point.empty(), !m.force.empty()});
+    std::vector<double> times;
+    double total = 0;
+    const auto start = std::chrono::steady_clock::now();
+    for (std::size_t k = 0; k < samples.size(); ++k) {
+      const Sample& e = samples[k];
+      if (e.stream == 0) online.AddObjectPose(e.t, m.object_pose[e.i].pose);
+      if (e.stream == 1) online.AddFingerPose(e.t, m.finger_pose[e.i].pose);
+      if (e.stream == 2) online.AddContactPoint(e.t, m.contact_point[e.i].point);
+      if (e.stream == 3) online.AddForce(e.t, m.force[e.i].force);
+      const bool stamp_complete = k + 1 == samples.size() || samples[k + 1].t > e.t;
+      if (stamp_complete && online.UpdateDue()) {
+        times.push_back(online.Update());
+        total += times.back();
+      }
+    }
+    const double loop = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const auto r = online.Finish();
+    benchmark::DoNotOptimize(r.states.data());
+    mean = worst = 0;
+    for (double t : times) {
+      mean += t / times.size();
+      worst = std::max(worst, t);
+    }
+    per_sample_us = 1e6 * (loop - total) / samples.size();
+  }
+  state.counters["steps"] = static_cast<double>(state.range(0));
+  state.counters["mean_update_ms"] = 1e3 * mean;
+  state.counters["max_update_ms"] = 1e3 * worst;
+  state.counters["per_sample_us"] = per_sample_us;
+}
+BENCHMARK(BM_OnlineQs)->Arg(500)->Arg(2000)->Arg(8000)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 }  // namespace
 
