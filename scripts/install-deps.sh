@@ -8,6 +8,7 @@ packages=(
   libceres-dev libsuitesparse-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libtinyobjloader-dev nlohmann-json3-dev libcli11-dev libhdf5-dev
+  python3  # scripts/check-docs.py, run by the docs tests
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -111,7 +111,9 @@ LossConfig ParseLoss(const Json& j, const std::string& source, const std::string
 
 void CheckPositive(double v, const std::string& key) {
   if (!(v > 0.0) || !std::isfinite(v)) {
-    throw GraphError("config key '" + key + "' must be finite and > 0, got " + std::to_string(v));
+    std::ostringstream text;
+    text << v;  // 6 significant digits: 1e-07, not 0.000000
+    throw GraphError("config key '" + key + "' must be finite and > 0, got " + text.str());
   }
 }
 

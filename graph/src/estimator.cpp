@@ -498,6 +498,20 @@ std::vector<double*> GraphBuilder::Blocks(int i) {
   return b;
 }
 
+void GraphBuilder::DropUnobservableForces(EstimationResult& result) const {
+  if (ForceScaleObservable()) return;
+  for (StateEstimate& s : result.states) {
+    s.force.reset();
+    s.force_cov.reset();
+  }
+  const std::string how = model_ == Model::kYu
+                              ? "the baseline has no limit-surface load"
+                              : (f_max_ > 0.0 ? "limit_surface_load is off"
+                                              : "the object's mass or mu_surface is missing, so there is no limit-surface load");
+  result.warnings.push_back("forces not reported: there is no force stream and " + how +
+                            ", so nothing fixes their size (the quasi-static factor fixes only their direction)");
+}
+
 StateEstimate GraphBuilder::State(int i) const {
   StateEstimate s;
   const StepVars& v = vars_[i];
@@ -694,6 +708,7 @@ EstimationResult EstimateBatch(const limit_surface::Trajectory& traj, Model mode
   r.solver.final_cost = summary.final_cost;
   r.solver.updates = 1;
   r.solver.max_update_time_s = r.solver.mean_update_time_s = r.solver.time_s;
+  builder.DropUnobservableForces(r);
   r.metrics = ComputeMetrics(traj, r.states);
   return r;
 }

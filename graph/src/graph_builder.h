@@ -108,6 +108,13 @@ class GraphBuilder {
   /// mu of the load factor: the estimate, or the trajectory's mu_surface (0 when unknown).
   double mu() const { return estimate_mu_ ? mu_var_[0] : mu_surface_; }
   bool uses_load_factor() const { return use_load_factor_; }
+  /// Whether anything fixes the forces' size: a force stream or the limit-surface load. Without
+  /// either D fixes only their direction and the weak prior pulls them to zero.
+  bool ForceScaleObservable() const {
+    return !ModelHasForce(model_) || streams_.force || (model_ == Model::kQs && use_load_factor_);
+  }
+  /// Drops the forces of `result` (and says why in its warnings) when !ForceScaleObservable().
+  void DropUnobservableForces(EstimationResult& result) const;
   /// Whether an estimated c / mu sits on a bound of AddSharedParameterPrior's [0.2, 5] x start.
   bool c_at_bound() const { return estimate_c_ && AtBound(c_var_[0], qs_.c); }
   bool mu_at_bound() const { return estimate_mu_ && AtBound(mu_var_[0], mu_surface_); }

@@ -280,6 +280,7 @@ struct FixedLagSmoother {
     r.solver.time_s = total_update_time;
     r.solver.final_cost = last_cost;
     r.solver.mean_update_time_s = stats.updates > 0 ? total_update_time / stats.updates : 0.0;
+    builder.DropUnobservableForces(r);
     r.metrics = ComputeMetrics(traj, r.states);
     return r;
   }

@@ -456,6 +456,8 @@ ls::Trajectory AddNoise(const ls::Trajectory& trajectory, const ls::NoiseModel& 
 }
 
 InputKind DetectInputKind(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw IoError(path + ": is a directory, not an input file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw IoError(path + ": cannot open file");
   char magic[8] = {};
@@ -468,6 +470,8 @@ InputKind DetectInputKind(const std::string& path) {
     doc = nlohmann::json::parse(in);
   } catch (const nlohmann::json::exception& e) {
     throw IoError(path + ": neither an HDF5 file nor valid JSON (" + e.what() + ")");
+  } catch (const std::exception& e) {
+    throw IoError(path + ": cannot read the file (" + e.what() + ")");
   }
   if (doc.is_object() && doc.contains("format")) {
     if (doc["format"] == kTrajectoryFormat) return InputKind::kTrajectory;

@@ -67,6 +67,7 @@ std::string ResultToJson(const graph::EstimationResult& r, int indent) {
     if (r.mu_at_bound) parameters["mu_at_bound"] = true;
   }
   if (!parameters.empty()) j["parameters"] = std::move(parameters);
+  if (!r.warnings.empty()) j["warnings"] = r.warnings;
   if (!r.metrics.empty()) {
     Json m = Json::object();
     for (const auto& [k, v] : r.metrics) m[k] = v;

@@ -49,8 +49,14 @@ class Reader {
 
   double NonNegative(const json& value, const std::string& path) const {
     const double v = Number(value, path);
-    if (v < 0.0) Fail(path, "must be >= 0, got " + std::to_string(v));
+    if (v < 0.0) Fail(path, "must be >= 0, got " + Text(v));
     return v;
+  }
+
+  static std::string Text(double v) {
+    std::ostringstream o;
+    o << v;
+    return o.str();
   }
 
   geometry::Shape ShapeOf(const json& value, const std::string& path) const {
@@ -67,6 +73,7 @@ class Reader {
     if (!value.is_array()) Fail(path, "must be an array of rows");
     std::vector<Sample> out;
     out.reserve(value.size());
+    std::vector<std::size_t> row_of;  // each sample's row in the file, for messages after sorting
     for (std::size_t i = 0; i < value.size(); ++i) {
       const std::string row_path = path + "[" + std::to_string(i) + "]";
       const json& row = value[i];
@@ -75,11 +82,24 @@ class Reader {
       std::vector<double> v(width);
       for (std::size_t k = 0; k < width; ++k) v[k] = Number(row[k], row_path + "[" + std::to_string(k) + "]");
       out.push_back(make(v));
+      row_of.push_back(i);
     }
-    std::stable_sort(out.begin(), out.end(), [](const Sample& a, const Sample& b) { return a.t < b.t; });
-    for (std::size_t i = 1; i < out.size(); ++i)
-      if (out[i].t == out[i - 1].t) Fail(path, "two samples with the same time stamp " + std::to_string(out[i].t));
-    return out;
+    std::vector<std::size_t> order(out.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return out[a].t < out[b].t; });
+    std::vector<Sample> sorted;
+    sorted.reserve(out.size());
+    for (std::size_t i = 0; i < order.size(); ++i) {
+      if (i > 0 && out[order[i]].t == out[order[i - 1]].t) {
+        std::ostringstream o;
+        o.precision(17);
+        o << "rows [" << row_of[order[i - 1]] << "] and [" << row_of[order[i]] << "] have the same time stamp "
+          << out[order[i]].t;
+        Fail(path, o.str());
+      }
+      sorted.push_back(out[order[i]]);
+    }
+    return sorted;
   }
 
   Streams StreamsOf(const json& value, const std::string& path) const {
@@ -162,8 +182,8 @@ Trajectory ParseTrajectoryJson(const std::string& text, const std::string& sourc
   const json& object = r.Require(doc, "object", "top level");
   r.CheckKeys(object, {"shape", "mass", "mu_surface", "pressure"}, "object");
   t.object.shape = r.ShapeOf(r.Require(object, "shape", "object"), "object.shape");
-  t.object.mass = r.NonNegative(r.Require(object, "mass", "object"), "object.mass");
-  if (t.object.mass == 0.0) r.Fail("object.mass", "must be > 0");
+  t.object.mass = r.Number(r.Require(object, "mass", "object"), "object.mass");
+  if (!(t.object.mass > 0.0)) r.Fail("object.mass", "must be > 0 (kg), got " + r.Text(t.object.mass));
   t.object.mu_surface = r.NonNegative(r.Require(object, "mu_surface", "object"), "object.mu_surface");
   if (object.contains("pressure")) {
     if (!object["pressure"].is_string() || object["pressure"].get<std::string>() != "uniform")

@@ -127,6 +127,91 @@ TEST_F(EstimateCli, BadInputGetsOneLineErrors) {
   EXPECT_NE(r.err.find("'window'"), std::string::npos) << r.err;
 }
 
+// The data's measurement sigmas first, the configuration file's keys on top: a config that
+// claims a 20x smaller object noise than the file's makes the covariances overconfident.
+TEST_F(EstimateCli, ConfigOverridesTheDataMeasurementSigmas) {
+  limit_surface::Trajectory t = io::LoadTrajectoryJson(WritePush());
+  limit_surface::MeasurementSigmas sigmas;
+  sigmas.object_trans = 0.005;
+  sigmas.object_rot = 0.05;
+  sigmas.finger_trans = 0.005;
+  sigmas.finger_rot = 0.05;
+  sigmas.contact = 0.005;
+  sigmas.force = 0.5;
+  t.measurement_sigmas = sigmas;
+  const std::string in = dir() + "/estimate_sigmas.json";
+  io::SaveTrajectoryJson(t, in);
+  const std::string cfg = dir() + "/estimate_tight.json";
+  std::ofstream(cfg) << R"({"object_pose_sigma_trans": 0.00025, "object_pose_sigma_rot": 0.0025})";
+  const std::string plain = dir() + "/result_plain.json", tight = dir() + "/result_tight.json";
+  ASSERT_EQ(Tool("estimate " + in + " --model cp -o " + plain).status, 0);
+  ASSERT_EQ(Tool("estimate " + in + " --model cp -o " + tight + " --config " + cfg).status, 0);
+  const double nees_plain = Load(plain)["metrics"]["object_pose_nees"].get<double>();
+  const double nees_tight = Load(tight)["metrics"]["object_pose_nees"].get<double>();
+  std::printf("[config over data sigmas] object NEES %.2f with the file's sigmas, %.2f with the config's\n",
+              nees_plain, nees_tight);
+  EXPECT_LT(nees_plain, 10.0);
+  EXPECT_GT(nees_tight, 5.0 * nees_plain);
+}
+
+// Forces whose size nothing fixes (no force stream, no limit-surface load) are not reported:
+// RESULT.json has no force and a warning says why, also on stderr.
+TEST_F(EstimateCli, ForcesWithoutAScaleAreLeftOutWithAWarning) {
+  limit_surface::Trajectory t = io::LoadTrajectoryJson(WritePush());
+  t.measured.force.clear();
+  const std::string in = dir() + "/estimate_no_force.json";
+  io::SaveTrajectoryJson(t, in);
+  const std::string off = dir() + "/estimate_load_off.json";
+  std::ofstream(off) << R"({"limit_surface_load": "off"})";
+  const std::string out = dir() + "/result_no_force.json";
+  for (const std::string& args : {"--model qs --config " + off, std::string("--model yu")}) {
+    const pushgraph::testing::ToolRun r = Tool("estimate " + in + " -o " + out + " " + args);
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("warning: forces not reported"), std::string::npos) << args << ": " << r.err;
+    const nlohmann::json j = Load(out);
+    ASSERT_TRUE(j.contains("warnings")) << args;
+    for (const auto& s : j["states"]) EXPECT_FALSE(s.contains("force") || s.contains("force_cov")) << args;
+  }
+  // QS with the load factor (auto: no force stream, mass and mu known): forces reported.
+  const pushgraph::testing::ToolRun r = Tool("estimate " + in + " --model qs -o " + out);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_FALSE(Load(out).contains("warnings"));
+  EXPECT_TRUE(Load(out)["states"][75].contains("force"));
+}
+
+TEST_F(EstimateCli, RefusesInputsItWouldMisread) {
+  const std::string in = WritePush();
+  const std::string out = dir() + "/result_misread.json";
+  // A directory.
+  pushgraph::testing::ToolRun r = Tool("estimate " + dir() + " -o " + out);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("is a directory"), std::string::npos) << r.err;
+  // Noise on streams that already carry it, with no ground truth to score against.
+  limit_surface::Trajectory t = io::LoadTrajectoryJson(in);
+  t.ground_truth.reset();
+  t.measurement_sigmas = limit_surface::MeasurementSigmas{0.005, 0.05, 0.005, 0.05, 0.005, 0.5};
+  const std::string noisy = dir() + "/estimate_noisy_no_truth.json";
+  io::SaveTrajectoryJson(t, noisy);
+  r = Tool("estimate " + noisy + " --add-noise gaussian -o " + out);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("already carry noise"), std::string::npos) << r.err;
+  // A non-physical mass or friction.
+  r = Tool("estimate " + in + " --mass -1 -o " + out);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("--mass"), std::string::npos) << r.err;
+  r = Tool("estimate " + in + " --mu -0.1 -o " + out);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("--mu"), std::string::npos) << r.err;
+  // Duplicate time stamps name both rows.
+  nlohmann::json doc = Load(in);
+  doc["streams"]["finger_pose"][3][0] = doc["streams"]["finger_pose"][2][0];
+  const std::string dup = dir() + "/estimate_dup.json";
+  std::ofstream(dup) << doc.dump();
+  r = Tool("estimate " + dup + " -o " + out);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("rows [2] and [3]"), std::string::npos) << r.err;
+}
+
 // An MIT recording (HDF5) read directly: trimmed to contact, time stamps kept (unix seconds),
 // the paper's noise added with the clean recording as ground truth, and a picture.
 TEST_F(EstimateCli, MitRecordingWithAddedNoise) {

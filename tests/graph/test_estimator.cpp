@@ -345,6 +345,28 @@ TEST(Estimator, OcclusionQsKeepsAPhysicalPath) {
   EXPECT_LT(occluded_rms[Model::kQs], occluded_rms[Model::kCp]);
 }
 
+// With no force stream and no limit-surface load nothing fixes the forces' size: both modes
+// leave them out and say why, rather than reporting 0 N with a confident covariance.
+TEST(Estimator, ForcesWithoutAScaleAreNotReported) {
+  limit_surface::Trajectory t = GeneratePush(OffsetPush(3, 0.4));
+  t.measured.force.clear();
+  EstimatorConfig off;
+  off.limit_surface_load = EstimatorConfig::LimitSurfaceLoad::kOff;
+  for (Mode mode : {Mode::kBatch, Mode::kIncremental}) {
+    for (Model model : {Model::kQs, Model::kYu}) {
+      const EstimationResult r = Estimate(t, model, mode, off);
+      ASSERT_EQ(r.warnings.size(), 1u) << ModelName(model);
+      EXPECT_NE(r.warnings[0].find("forces not reported"), std::string::npos);
+      for (const StateEstimate& s : r.states) EXPECT_FALSE(s.force || s.force_cov);
+      EXPECT_EQ(r.metrics.count("force_rms"), 0u);
+    }
+    const EstimationResult with_load = Estimate(t, Model::kQs, mode);  // auto: the load factor runs
+    EXPECT_TRUE(with_load.warnings.empty());
+    EXPECT_TRUE(with_load.states[50].force.has_value());
+    EXPECT_EQ(Estimate(t, Model::kYu, mode).warnings.size(), 1u);  // the baseline has no load factor
+  }
+}
+
 // Incremental fixed-lag smoothing: the window stays bounded as the trajectory grows, and the
 // final estimate is close to the batch one.
 TEST(Incremental, BoundedWindowAndCloseToBatch) {

@@ -78,10 +78,18 @@ limit_surface::Trajectory LoadInput(const EstimateOptions& o, std::string* sourc
 void RunEstimate(const EstimateOptions& o) {
   const graph::Model model = graph::ParseModel(o.model);
   const graph::Mode mode = graph::ParseMode(o.mode);
-  graph::EstimatorConfig config;
-  if (!o.config.empty()) config = graph::LoadEstimatorConfig(o.config);
+  // A bad configuration file is reported before any input is read.
+  if (!o.config.empty()) graph::LoadEstimatorConfig(o.config);
   std::string source;
   limit_surface::Trajectory traj = LoadInput(o, &source);
+  if (!o.add_noise.empty() && !traj.ground_truth && traj.measurement_sigmas) {
+    const auto& m = *traj.measurement_sigmas;
+    if (m.object_trans > 0 || m.object_rot > 0 || m.finger_trans > 0 || m.finger_rot > 0 || m.contact > 0 || m.force > 0) {
+      throw CliError(o.input + ": --add-noise needs clean streams, but this trajectory's streams already carry noise "
+                     "(measurement_sigmas) and it has no ground_truth: the noise would be added twice and the "
+                     "metrics scored against noisy streams");
+    }
+  }
   if (!o.add_noise.empty()) {
     // The paper's Sec. IV noise on the clean streams (the recording, or the file's ground truth);
     // the clean streams stay as ground truth, so metrics are computed.
@@ -90,13 +98,21 @@ void RunEstimate(const EstimateOptions& o) {
     traj = io::AddNoise(traj, io::MakePaperNoise(kind), o.seed);
   }
   // Measurement factors weighted by the known noise (added here, or recorded by the simulator).
+  // The data's sigmas first, then the configuration file's keys on top (docs/estimation.md).
+  graph::EstimatorConfig config;
   if (traj.measurement_sigmas) config = graph::ApplyMeasurementSigmas(config, *traj.measurement_sigmas);
+  if (!o.config.empty()) config = graph::LoadEstimatorConfig(o.config, config);
+  if (mode == graph::Mode::kIncremental && (config.estimate_c || config.estimate_mu)) {
+    throw CliError(o.config + ": estimate_c and estimate_mu are batch only (the incremental mode keeps c and mu "
+                   "fixed): use --mode batch or drop them");
+  }
   graph::EstimationResult result;
   try {
     result = graph::Estimate(traj, model, mode, config);
   } catch (const graph::GraphError& e) {
     throw CliError(o.input + ": " + e.what());
   }
+  for (const std::string& w : result.warnings) std::cerr << "estimate: warning: " << w << "\n";
   io::SaveResultJson(result, o.output);
   if (!o.svg.empty()) {
     io::TrajectoryPlotOptions plot;
@@ -142,9 +158,11 @@ void RegisterEstimate(CLI::App& app) {
   sub->add_option("--config", opts->config, "Estimator configuration JSON (sigmas, losses, window; docs/estimation.md)");
   sub->add_option("--object", opts->object, "Object shape JSON (required for MIT recordings; overrides a trajectory's)");
   sub->add_option("--finger", opts->finger, "Finger (probe) shape JSON (required for MIT recordings)");
-  sub->add_option("--mass", opts->mass, "Object mass in kg (required for MIT recordings)");
-  sub->add_option("--mu", opts->mu, "Object-table friction coefficient (required for MIT recordings)");
+  sub->add_option("--mass", opts->mass, "Object mass in kg (required for MIT recordings)")->check(CLI::PositiveNumber);
+  sub->add_option("--mu", opts->mu, "Object-table friction coefficient (required for MIT recordings)")
+      ->check(CLI::NonNegativeNumber);
   sub->add_option("--mu-contact", opts->mu_contact, "Finger-object friction coefficient (MIT recordings)")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   sub->add_option("--add-noise", opts->add_noise,
                   "Add the paper's noise (5 mm, 0.05 rad, 0.5 N per axis) to the clean streams, which stay as ground truth")

@@ -5,9 +5,12 @@
 //
 //   limit_surface::Trajectory traj = io::LoadTrajectoryJson("push.json");
 //   graph::EstimatorConfig cfg;                        // or graph::LoadEstimatorConfig(path)
+//   if (traj.measurement_sigmas)                       // the data's known noise (simulator, --add-noise)
+//     cfg = graph::ApplyMeasurementSigmas(cfg, *traj.measurement_sigmas);
 //   graph::EstimationResult r = graph::Estimate(traj, graph::Model::kQs, graph::Mode::kBatch, cfg);
 //   for (const graph::StateEstimate& s : r.states) { s.t, s.object_pose, *s.object_pose_cov ... }
 //   r.metrics["object_position_rms"]                   // when traj.ground_truth is present
+//   r.warnings                                         // e.g. forces left out: nothing fixes their size
 //
 // Models (Fig. 2): kCp = M + C + V; kSdf = CP + S; kQs = SDF + force variables, force M and the
 // non-singular quasi-static factor D; kYu = the Yu-Rodriguez 2018 baseline: M + C +
@@ -83,10 +86,16 @@ struct EstimationResult {
   /// force_rms (N); the same of the raw measurements as measured_*; and the mean normalized
   /// estimation error squared object_pose_nees (dimension 3) etc. where covariances exist.
   std::map<std::string, double> metrics;
+  /// What the caller should know about the result, one sentence each (RESULT.json "warnings",
+  /// printed by the tool): e.g. forces left out because nothing in the graph fixes their size.
+  std::vector<std::string> warnings;
 };
 
 /// Runs the estimator. Throws GraphError for unusable input (no object or finger
-/// measurements, non-finite samples, missing shapes, a model needing mass/friction without them).
+/// measurements, non-finite samples, missing shapes, estimate_mu without mass, mu_surface or a
+/// force stream). QS and the baseline report forces only when something fixes their size: a
+/// force stream, or (QS) the limit-surface load from the object's mass and mu_surface; otherwise
+/// D fixes only their direction, the states carry no force and `warnings` says why.
 EstimationResult Estimate(const limit_surface::Trajectory& trajectory, Model model, Mode mode,
                           const EstimatorConfig& config = {});
 

@@ -259,9 +259,9 @@ class LimitSurfaceLoadFactor : public ceres::SizedCostFunction<1, 3, 3, 2, 2> {
 ///   d r / d c through V'_z = c omega and g'_z = tau / c (as in QuasiStaticFactorWithC).
 /// Evaluate fails (Ceres shortens the step) for c <= 0 or mu <= 0.
 ///
-///   LimitSurfaceLoadFactorWithParameters load(geometry, mass * 9.81, /*mu=*/0.3,
+///   auto* load = new LimitSurfaceLoadFactorWithParameters(geometry, mass * 9.81, /*mu=*/0.3,
 ///       {/*c=*/true, /*mu=*/true}, eps_v, eps_f, sigma);
-///   problem.AddResidualBlock(&load, nullptr, {x_prev, x, p, f, c_block, mu_block});
+///   problem.AddResidualBlock(load, nullptr, {x_prev, x, p, f, c_block, mu_block});  // Ceres owns it
 class LimitSurfaceLoadFactorWithParameters : public ceres::CostFunction {
  public:
   struct Variables {
