@@ -21,7 +21,8 @@ using limit_surface::Trajectory;
 
 class Reader {
  public:
-  explicit Reader(std::string source) : source_(std::move(source)) {}
+  explicit Reader(std::string source, std::vector<std::string>* notes = nullptr)
+      : source_(std::move(source)), notes_(notes) {}
 
   [[noreturn]] void Fail(const std::string& path, const std::string& what) const {
     throw IoError(source_ + ": " + path + ": " + what);
@@ -84,6 +85,16 @@ class Reader {
       out.push_back(make(v));
       row_of.push_back(i);
     }
+    if (notes_ != nullptr) {
+      std::size_t late = 0, first = 0;
+      for (std::size_t i = 1; i < out.size(); ++i) {
+        if (out[i].t < out[i - 1].t && late++ == 0) first = row_of[i];
+      }
+      if (late > 0) {
+        notes_->push_back(path + ": sorted " + std::to_string(late) + " row(s) that came after a later time stamp (first: row [" +
+                          std::to_string(first) + "])");
+      }
+    }
     std::vector<std::size_t> order(out.size());
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
     std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return out[a].t < out[b].t; });
@@ -138,6 +149,7 @@ class Reader {
 
  private:
   std::string source_;
+  std::vector<std::string>* notes_ = nullptr;
 };
 
 json ShapeJson(const geometry::Shape& shape) { return json::parse(geometry::ShapeToJson(shape, -1)); }
@@ -165,14 +177,14 @@ json StreamsJson(const Streams& s) {
 
 }  // namespace
 
-Trajectory ParseTrajectoryJson(const std::string& text, const std::string& source) {
+Trajectory ParseTrajectoryJson(const std::string& text, const std::string& source, std::vector<std::string>* notes) {
   json doc;
   try {
     doc = json::parse(text);
   } catch (const json::exception& e) {
     throw IoError(source + ": malformed JSON: " + e.what());
   }
-  const Reader r(source);
+  const Reader r(source, notes);
   r.CheckKeys(doc, {"format", "object", "finger", "streams", "ground_truth", "measurement_sigmas"}, "top level");
   const json& format = r.Require(doc, "format", "top level");
   if (!format.is_string() || format.get<std::string>() != kTrajectoryFormat)
@@ -200,12 +212,12 @@ Trajectory ParseTrajectoryJson(const std::string& text, const std::string& sourc
   return t;
 }
 
-Trajectory LoadTrajectoryJson(const std::string& path) {
+Trajectory LoadTrajectoryJson(const std::string& path, std::vector<std::string>* notes) {
   std::ifstream in(path);
   if (!in) throw IoError(path + ": cannot open file");
   std::stringstream buffer;
   buffer << in.rdbuf();
-  return ParseTrajectoryJson(buffer.str(), path);
+  return ParseTrajectoryJson(buffer.str(), path, notes);
 }
 
 // One stream row per line: readable, diff-friendly and still plain JSON.

@@ -50,6 +50,15 @@ TEST(TrajectoryJson, MissingStreamsAreEmptyAndOutOfOrderSamplesAreSorted) {
   EXPECT_EQ(t.measured.force[0].t, 0.1);
   EXPECT_EQ(t.measured.force[0].force.x(), 2.0);
   EXPECT_EQ(t.measured.force[2].t, 0.3);
+  // The reordering is reported when asked for.
+  std::vector<std::string> notes;
+  ParseTrajectoryJson(Doc(R"({"force": [[0.3, 1, 0], [0.1, 2, 0], [0.2, 3, 0]]})"), "push.json", &notes);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("streams.force: sorted 1 row(s)"), std::string::npos) << notes[0];
+  EXPECT_NE(notes[0].find("row [1]"), std::string::npos) << notes[0];
+  notes.clear();
+  ParseTrajectoryJson(Doc(R"({"force": [[0.1, 1, 0], [0.2, 2, 0]]})"), "push.json", &notes);
+  EXPECT_TRUE(notes.empty());
 }
 
 void ExpectError(const std::string& text, const std::string& needle) {

@@ -44,7 +44,9 @@ limit_surface::Trajectory LoadInput(const EstimateOptions& o, std::string* sourc
   const io::InputKind kind = io::DetectInputKind(o.input);
   if (kind == io::InputKind::kTrajectory) {
     *source = "trajectory";
-    limit_surface::Trajectory t = io::LoadTrajectoryJson(o.input);
+    std::vector<std::string> notes;
+    limit_surface::Trajectory t = io::LoadTrajectoryJson(o.input, &notes);
+    for (const std::string& note : notes) std::cerr << "estimate: " << o.input << ": " << note << "\n";
     // Optional overrides of the file's object and finger.
     if (!o.object.empty()) t.object.shape = LoadShape(o.object, "--object");
     if (!o.finger.empty()) t.finger.shape = LoadShape(o.finger, "--finger");

@@ -20,6 +20,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace pushgraph::io {
 
@@ -31,8 +32,12 @@ class IoError : public std::runtime_error {
 
 inline constexpr const char* kTrajectoryFormat = "pushgraph-trajectory-1";
 
-limit_surface::Trajectory LoadTrajectoryJson(const std::string& path);
-limit_surface::Trajectory ParseTrajectoryJson(const std::string& text, const std::string& source_name = "<string>");
+/// Rows of a stream are sorted by time (stable); when `notes` is given, each stream that needed
+/// it gets a line there ("streams.force: sorted 2 rows that came after a later time stamp (first:
+/// row [5])") for the caller to show: a large reordering often means a clock glitch.
+limit_surface::Trajectory LoadTrajectoryJson(const std::string& path, std::vector<std::string>* notes = nullptr);
+limit_surface::Trajectory ParseTrajectoryJson(const std::string& text, const std::string& source_name = "<string>",
+                                              std::vector<std::string>* notes = nullptr);
 std::string TrajectoryToJson(const limit_surface::Trajectory& trajectory, int indent = 1);
 void SaveTrajectoryJson(const limit_surface::Trajectory& trajectory, const std::string& path);
 
