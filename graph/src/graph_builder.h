@@ -14,9 +14,10 @@
 namespace pushgraph::graph::internal {
 
 /// Per-step parameter blocks in chunks that never move (Ceres keeps pointers to them). One
-/// chunk holds a batch's steps, so their addresses rise with the step index as in a vector:
-/// Ceres orders parameter blocks by address in places (ParameterBlockOrdering's sets), and
-/// heap-dependent orders would change last bits between runs. Online runs grow by chunks.
+/// chunk holds a batch's (or replay's) steps, so their addresses rise with the step index as in
+/// a vector: Ceres orders parameter blocks by address in places (ParameterBlockOrdering's sets),
+/// and heap-dependent orders would change last bits between runs. Online runs grow by chunks of
+/// 4096 steps; addresses rise within a chunk only.
 template <class T>
 class StableArray {
  public:

@@ -287,7 +287,9 @@ struct FixedLagSmoother {
 
   StateEstimate LatestState(const char* who) const {
     if (next_step == 0) throw GraphError(std::string(who) + "::LatestState before the first Update");
-    return builder.State(next_step - 1);
+    StateEstimate s = builder.State(next_step - 1);
+    if (!builder.ForceScaleObservable()) s.force.reset();  // as Finish() reports it
+    return s;
   }
 };
 
@@ -355,6 +357,7 @@ struct OnlineEstimator::Impl {
   int dropped_late = 0;
   bool finished = false;
   bool declared[4] = {true, true, false, false};
+  double max_latency = 0.2;
   static constexpr std::size_t kRecentPeriods = 64;  // object periods the schedule looks at
 
   static const limit_surface::Trajectory& Empty(const limit_surface::Trajectory& setup) {
@@ -368,6 +371,10 @@ struct OnlineEstimator::Impl {
       : traj(Empty(setup)), smoother(traj, model, cfg, &streams) {
     declared[2] = streams.contact_point;
     declared[3] = streams.force;
+    if (!(streams.max_latency >= 0.0) || !std::isfinite(streams.max_latency)) {
+      throw GraphError("OnlineStreams::max_latency must be finite and >= 0 (s)");
+    }
+    max_latency = streams.max_latency;
   }
 
   // Throws for a sample that is not finite or not after its stream's previous one; returns
@@ -403,12 +410,13 @@ struct OnlineEstimator::Impl {
     return true;
   }
 
-  // The newest time every live stream has reached: a stream is live when it reported within
-  // 1.5 k object periods of the newest sample (an occluded camera, or a tactile sensor silent
-  // out of contact, does not hold the others back); a slower sensor is waited for.
+  // The newest time every live stream has reached: a stream is live when its newest sample is
+  // within max_latency (and 1.5 k object periods) of the newest sample of any stream, so a late
+  // camera is waited for while an occluded one, or a tactile sensor silent out of contact, does
+  // not hold the others back.
   double SettledTime() const {
     const double period = MedianObjectPeriod(traj.measured.object_pose, kRecentPeriods);
-    const double live = period > 0.0 ? 1.5 * smoother.cfg.incremental_update_every * period : INFINITY;
+    const double live = std::max(max_latency, 1.5 * smoother.cfg.incremental_update_every * period);
     double settled = newest_t;
     for (double t : last_seen) {
       if (std::isfinite(t) && newest_t - t <= live) settled = std::min(settled, t);
@@ -416,10 +424,13 @@ struct OnlineEstimator::Impl {
     return settled;
   }
 
-  int ObjectSamplesSinceUpdate() const {
+  // Object samples with from < t <= to.
+  int ObjectSamplesSince(double from, double to) const {
     const auto& obj = traj.measured.object_pose;
-    return static_cast<int>(obj.end() - std::upper_bound(obj.begin(), obj.end(), last_update_t,
-                                                         [](double t, const limit_surface::PoseSample& a) { return t < a.t; }));
+    auto after = [&](double t) {
+      return std::upper_bound(obj.begin(), obj.end(), t, [](double x, const limit_surface::PoseSample& a) { return x < a.t; });
+    };
+    return to > from ? static_cast<int>(after(to) - after(from)) : 0;
   }
 };
 
@@ -453,11 +464,14 @@ int OnlineEstimator::DroppedLateSamples() const { return impl_->dropped_late; }
 bool OnlineEstimator::UpdateDue() const {
   const Impl& m = *impl_;
   const int k = m.smoother.cfg.incremental_update_every;
-  if (m.ObjectSamplesSinceUpdate() >= k) return true;
+  // Only what an update would take counts: samples up to the settled time (a late camera's
+  // poses are waited for, not counted before they arrive).
+  const double settled = m.SettledTime();
+  if (m.ObjectSamplesSince(m.last_update_t, settled) >= k) return true;
   // The object stream is silent (occlusion): update on time, as IncrementalEstimator does.
   const double period = MedianObjectPeriod(m.traj.measured.object_pose, Impl::kRecentPeriods);
   const double since = std::isfinite(m.last_update_t) ? m.last_update_t : m.first_t;
-  return period > 0.0 && m.newest_t - since > 1.5 * k * period;
+  return period > 0.0 && settled - since > 1.5 * k * period;
 }
 
 double OnlineEstimator::Update(double until) {
@@ -486,11 +500,11 @@ double OnlineEstimator::Update(double until) {
   }
   // Samples within 1e-9 s after `until` join its step now (as batch merges them), so no later
   // step can be closer than that to a solved one.
+  m.last_update_t = until;  // later samples must come more than 1e-9 s after it (Accept)
   until += 1e-9;
   m.smoother.builder.AppendSteps(until);
   const double period = MedianObjectPeriod(meas.object_pose, Impl::kRecentPeriods);
   if (period > 0.0) m.smoother.window_duration = m.smoother.cfg.incremental_window * period;
-  m.last_update_t = until;
   return m.smoother.Update(until, false);
 }
 

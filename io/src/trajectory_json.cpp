@@ -87,8 +87,10 @@ class Reader {
     }
     if (notes_ != nullptr) {
       std::size_t late = 0, first = 0;
+      double latest = out.empty() ? 0.0 : out[0].t;
       for (std::size_t i = 1; i < out.size(); ++i) {
-        if (out[i].t < out[i - 1].t && late++ == 0) first = row_of[i];
+        if (out[i].t < latest && late++ == 0) first = row_of[i];  // after a later stamp
+        latest = std::max(latest, out[i].t);
       }
       if (late > 0) {
         notes_->push_back(path + ": sorted " + std::to_string(late) + " row(s) that came after a later time stamp (first: row [" +

@@ -202,6 +202,11 @@ TEST_F(EstimateCli, RefusesInputsItWouldMisread) {
   r = Tool("estimate " + in + " --mu -0.1 -o " + out);
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find("--mu"), std::string::npos) << r.err;
+  for (const std::string flag : {"--mass", "--mu", "--mu-contact"}) {  // CLI11's range checks pass NaN
+    r = Tool("estimate " + in + " " + flag + " nan -o " + out);
+    EXPECT_NE(r.status, 0) << flag;
+    EXPECT_NE(r.err.find("must be a finite number"), std::string::npos) << flag << ": " << r.err;
+  }
   // Duplicate time stamps name both rows.
   nlohmann::json doc = Load(in);
   doc["streams"]["finger_pose"][3][0] = doc["streams"]["finger_pose"][2][0];

@@ -1,8 +1,8 @@
 #include "cli_common.h"
 
-#include <cmath>
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -89,6 +89,25 @@ std::vector<std::string> JoinNegativeValues(const std::vector<std::string>& args
     out.push_back(arg);
   }
   return out;
+}
+
+CLI::Validator FiniteNumber(double min, bool inclusive, const std::string& rule) {
+  return CLI::Validator(
+      [min, inclusive, rule](std::string& text) -> std::string {
+        std::size_t used = 0;
+        double v = 0.0;
+        try {
+          v = std::stod(text, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        const bool number = used > 0 && used == text.size();
+        if (!number || !std::isfinite(v) || (inclusive ? !(v >= min) : !(v > min))) {
+          return "must be a finite number " + rule + ", got " + text;
+        }
+        return std::string();
+      },
+      rule);
 }
 
 }  // namespace pushgraph::cli

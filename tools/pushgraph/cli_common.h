@@ -36,6 +36,10 @@ std::string DefaultDataDir();
 geometry::Pose2 ParsePose(const std::string& text, const std::string& what);
 /// Parses a comma-separated list of exactly `count` finite numbers.
 std::vector<double> ParseNumbers(const std::string& text, std::size_t count, const std::string& what);
+/// A CLI11 check for a finite number above `min` (or at least `min` when `inclusive`): rejects
+/// NaN and infinities, which CLI11's range checks let through, with a short message ("must be a
+/// finite number > 0 (kg), got nan"). `rule` is shown in the message and the help.
+CLI::Validator FiniteNumber(double min, bool inclusive, const std::string& rule);
 /// Formats a double with 17 significant digits (round-trips exactly).
 std::string FormatDouble(double value);
 /// Writes JSON with doubles printed to 17 significant digits.

@@ -61,6 +61,10 @@ class MarginalPriorFactor : public ceres::CostFunction {
 struct OnlineStreams {
   bool contact_point = false;  ///< a tactile sensor reports contact points
   bool force = true;           ///< a force/torque sensor reports the contact force
+  /// How far (s, in the samples' time) a stream may lag the newest sample of any stream and
+  /// still be waited for by Update(); a stream further behind (also at least 1.5 k object
+  /// periods) counts as silent: an occluded camera, a tactile sensor out of contact.
+  double max_latency = 0.2;
 };
 
 class IncrementalEstimator {
@@ -114,14 +118,16 @@ class OnlineEstimator {
   bool AddForce(double t, const geometry::Vec2& force);
   int DroppedLateSamples() const;
 
-  /// True once incremental_update_every object measurements arrived since the last update, or,
-  /// while the object stream is silent (occlusion), once the other streams ran that many object
-  /// periods (1.5 x) past it: the schedule IncrementalEstimator follows.
+  /// True once incremental_update_every object measurements up to the settled time (see
+  /// Update) arrived since the last update, or, while the object stream is silent (occlusion),
+  /// once the settled time ran that many object periods (1.5 x) past it: the schedule
+  /// IncrementalEstimator follows.
   bool UpdateDue() const;
   /// Turns the samples up to `until` into steps and solves the window; later samples stay
   /// buffered. Default `until`: the newest time every live stream has reached (a stream is live
-  /// when it reported within 1.5 k object periods of the newest sample, so an occluded camera or
-  /// a silent tactile sensor does not stall the others). The first update needs an object and a
+  /// when its newest sample is within OnlineStreams::max_latency, and 1.5 k object periods, of the
+  /// newest sample of any stream, so an occluded camera or a silent tactile sensor does not
+  /// stall the others). The first update needs an object and a
   /// finger pose. Returns the wall time of the update (s); 0 when there was nothing new.
   double Update(double until = INFINITY);
   /// The newest state of the window (after at least one Update()).
