@@ -363,9 +363,26 @@ ShapePairQuerier& ShapePairQuerier::operator=(ShapePairQuerier&&) noexcept = def
 ShapePairResult ShapePairQuerier::Query(const Pose2& object_pose, const Pose2& finger_pose, ShapePairJacobians* J) const {
   CheckPose(object_pose, "object");
   CheckPose(finger_pose, "finger");
-  if (impl_->point_finger) return impl_->QueryPointFinger(object_pose, finger_pose, J);
-  if (impl_->options.method == Method::kVertexSampling) return impl_->QuerySampled(object_pose, finger_pose, J);
-  return impl_->QueryExact(object_pose, finger_pose, J);
+  const Impl& m = *impl_;
+  auto query = [&m](const Pose2& object, const Pose2& finger, ShapePairJacobians* jacobians) {
+    if (m.point_finger) return m.QueryPointFinger(object, finger, jacobians);
+    if (m.options.method == Method::kVertexSampling) return m.QuerySampled(object, finger, jacobians);
+    return m.QueryExact(object, finger, jacobians);
+  };
+  ShapePairResult r = query(object_pose, finger_pose, J);
+  if (!r.intersecting) return r;
+  if (!m.point_finger && m.options.method == Method::kVertexSampling) {
+    r.depth_exact = false;  // an estimate (header)
+  } else if (m.object.radius() + m.finger.radius() > 0.0) {
+    // The rounded-shape depth (core depth + radii) is exact only if it separates: move the
+    // finger by it and look (apart shapes' separations are exact, so this test is sound).
+    Pose2 moved = finger_pose;
+    moved.x += r.depth * r.normal.x();
+    moved.y += r.depth * r.normal.y();
+    const ShapePairResult after = query(object_pose, moved, nullptr);
+    r.depth_exact = !(after.signed_distance < -(1e-12 + 1e-8 * r.depth));
+  }
+  return r;
 }
 
 const Shape& ShapePairQuerier::object() const { return impl_->object; }

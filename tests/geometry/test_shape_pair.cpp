@@ -239,6 +239,37 @@ TEST(ShapePairDisk, TouchingApartOverlapping) {
   EXPECT_EQ(w.signed_distance, -0.25);
 }
 
+// The rounded-shape depth (core depth + radius) is a lower bound where the disk cannot leave
+// along the core normal; the query checks itself and says so in depth_exact.
+TEST(ShapePairDisk, RoundedDepthIsFlaggedWhereItDoesNotSeparate) {
+  Polygon square;
+  square.outer = {Vec2(0, 0), Vec2(1, 0), Vec2(1, 1), Vec2(0, 1)};
+  square.holes = {{Vec2(0.45, 0.45), Vec2(0.45, 0.55), Vec2(0.55, 0.55), Vec2(0.55, 0.45)}};
+  const Shape holed = Shape::FromPolygons({square});
+  const ShapePairQuerier q(holed, Shape::Disk(0.2));
+  // Centre 0.15 below a hole narrower than the disk: core depth + radius = 0.35 towards the hole,
+  // but the disk does not fit there; the true depth is 0.5 (out through the bottom edge).
+  const ShapePairResult r = q.Query(Pose2{}, Pose2{0.5, 0.3, 0.0});
+  EXPECT_TRUE(r.intersecting);
+  EXPECT_NEAR(r.depth, 0.35, 1e-15);
+  EXPECT_FALSE(r.depth_exact);
+  const ShapePairResult moved = q.Query(Pose2{}, Pose2{0.5 + r.depth * r.normal.x(), 0.3 + r.depth * r.normal.y(), 0.0});
+  EXPECT_LT(moved.signed_distance, -0.01);                              // still overlapping
+  EXPECT_EQ(q.Query(Pose2{}, Pose2{0.5, -0.2, 0.0}).signed_distance, 0.0);  // 0.5 down: touching
+  // Near the outer edge the same query is exact, and says so.
+  const ShapePairResult edge = q.Query(Pose2{}, Pose2{0.5, 0.1, 0.0});
+  EXPECT_NEAR(edge.depth, 0.3, 1e-15);
+  EXPECT_TRUE(edge.depth_exact);
+  // A rounded polygonal finger in the same spot: flagged too.
+  const ShapePairQuerier rounded(holed, Shape::Box(0.1, 0.1, 0.15));
+  EXPECT_FALSE(rounded.Query(Pose2{}, Pose2{0.5, 0.3, 0.0}).depth_exact);
+  // Sharp polygons through the exact obstacle: always exact.
+  const ShapePairQuerier sharp(holed, Shape::Box(0.3, 0.3));
+  const ShapePairResult s = sharp.Query(Pose2{}, Pose2{0.5, 0.3, 0.0});
+  EXPECT_TRUE(s.intersecting);
+  EXPECT_TRUE(s.depth_exact);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Polygonal fingers: kExact against the Minkowski oracle.
 

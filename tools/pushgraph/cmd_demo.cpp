@@ -72,7 +72,7 @@ void RunGeometryDemo(const std::string& data_dir, const std::string& svg_path) {
   std::printf("object: %d vertices, area %.6g m^2 (data/shapes/notched_block.json)\n\n", object.num_vertices(),
               object.core_area());
   std::printf("%9s | %-32s | %-32s\n", "finger y", "disk finger r=5 mm", "rounded square 8+2 mm, turned 0.3 rad");
-  std::printf("%9s | %12s %8s %10s | %12s %8s %10s\n", "[mm]", "separation", "depth", "direction", "separation",
+  std::printf("%9s | %12s %9s %10s | %12s %9s %10s\n", "[mm]", "separation", "depth", "direction", "separation",
               "depth", "direction");
   std::string markers;
   const double scale = 4000.0;
@@ -88,8 +88,9 @@ void RunGeometryDemo(const std::string& data_dir, const std::string& svg_path) {
       else std::snprintf(buf, sizeof buf, "%s", "apart");
       return std::string(buf);
     };
-    std::printf("%9.1f | %+12.6f %8.5f %10s | %+12.6f %8.5f %10s\n", y * 1e3, a.signed_distance, a.depth,
-                dir(a).c_str(), b.signed_distance, b.depth, dir(b).c_str());
+    std::printf("%9.1f | %+12.6f %8.5f%s %10s | %+12.6f %8.5f%s %10s\n", y * 1e3, a.signed_distance, a.depth,
+                a.depth_exact ? " " : "*", dir(a).c_str(), b.signed_distance, b.depth, b.depth_exact ? " " : "*",
+                dir(b).c_str());
     char buf[256];
     std::snprintf(buf, sizeof buf,
                   "<circle cx='%.2f' cy='%.2f' r='%.2f' fill='none' stroke='%s'/>"
@@ -100,6 +101,8 @@ void RunGeometryDemo(const std::string& data_dir, const std::string& svg_path) {
                   (origin.y() - a.object_point.y()) * scale);
     markers += buf;
   }
+  std::printf("* depth is a lower bound: the rounded finger's obstacle fills the V there, and moving by it\n"
+              "  still overlaps (ShapePairResult::depth_exact; docs/geometry.md)\n");
 
   // Accelerated queries agree bit for bit with the brute-force edge loop.
   std::mt19937 rng(7);

@@ -12,8 +12,12 @@
 // C = object_core (+) (-finger_core) at the current relative angle, built exactly with CGAL
 // (Epeck Minkowski sums, reduced convolution; cached per relative angle) and queried with the
 // exact point query. For a finger whose core is a point (a disk) C is the object itself and no
-// Minkowski sum is needed: exact and fast. Rounding radii add to the core depth (the
-// rounded-shape convention of point_query.h).
+// Minkowski sum is needed. Rounding radii (a disk finger's, a rounded object's) add to the core
+// depth (the rounded-shape convention of point_query.h). That sum is the true depth when the
+// finger can leave along the core's normal, but only a lower bound where the rounded obstacle
+// fills a concave corner, a notch or a hole narrower than the finger (moving by it still
+// overlaps): each overlapping rounded query checks its own answer by moving the finger and
+// reports the outcome in depth_exact. Separations of apart shapes are always exact.
 //
 // The fast path (Method::kVertexSampling) takes the deepest vertex of either shape inside the
 // other; it is exact when apart and for point/disk fingers, and an estimate for polygonal
@@ -37,6 +41,10 @@ struct ShapePairResult {
   Vec2 object_point{0.0, 0.0};   ///< world frame: closest object point / projection G_delta
   Vec2 finger_point{0.0, 0.0};   ///< world frame: closest finger point / deepest point delta
   double depth = 0.0;            ///< max(0, -signed_distance)
+  /// False when `depth` is only a lower bound of the penetration depth: rounded shapes whose
+  /// obstacle fills a concave corner, notch or hole (moving the finger by depth along normal
+  /// leaves it overlapping), or the vertex-sampling estimate of a polygonal finger.
+  bool depth_exact = true;
   /// Unit vector, world frame, in which the finger moves to increase the separation fastest
   /// (to separate, when intersecting); object_point - finger_point = -signed_distance * normal.
   Vec2 normal{1.0, 0.0};
