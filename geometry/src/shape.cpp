@@ -280,8 +280,11 @@ Shape::Shape() = default;
 Shape::Shape(std::shared_ptr<const Impl> impl) : impl_(std::move(impl)) {}
 
 Shape Shape::FromPolygons(std::vector<Polygon> polygons, double radius) {
-  if (!std::isfinite(radius) || radius < 0.0)
-    throw GeometryError("rounding radius must be finite and >= 0, got " + std::to_string(radius));
+  if (!std::isfinite(radius) || radius < 0.0) {
+    std::ostringstream text;
+    text << radius;  // 6 significant digits: -1e-09, not -0.000000
+    throw GeometryError("rounding radius must be finite and >= 0, got " + text.str());
+  }
   if (polygons.empty()) throw GeometryError("shape has no polygons");
   const int np = static_cast<int>(polygons.size());
   for (int p = 0; p < np; ++p) {

@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -82,6 +83,8 @@ Shape ParseShapeJson(const std::string& text, const std::string& source) {
 }
 
 Shape LoadShapeJson(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw GeometryError(path + ": is a directory, not a shape file");
   std::ifstream in(path);
   if (!in) throw GeometryError(path + ": cannot open file");
   std::stringstream buffer;

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 
 namespace pushgraph::io {
@@ -161,6 +162,8 @@ UpAxis ParseUpAxis(const std::string& text) {
 
 geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& options, FootprintReport* report) {
   if (!(options.scale > 0.0) || !std::isfinite(options.scale)) throw IoError(path + ": scale must be finite and > 0");
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw IoError(path + ": is a directory, not a mesh file");
   tinyobj::ObjReaderConfig config;
   config.triangulate = true;
   config.vertex_color = false;

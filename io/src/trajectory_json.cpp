@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -215,6 +216,8 @@ Trajectory ParseTrajectoryJson(const std::string& text, const std::string& sourc
 }
 
 Trajectory LoadTrajectoryJson(const std::string& path, std::vector<std::string>* notes) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw IoError(path + ": is a directory, not a trajectory file");
   std::ifstream in(path);
   if (!in) throw IoError(path + ": cannot open file");
   std::stringstream buffer;

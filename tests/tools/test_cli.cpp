@@ -105,7 +105,16 @@ TEST_F(CliTest, PenetrationJsonContractAndNegativeNumberOptions) {
     EXPECT_EQ(j["direction"][1].get<double>(), 0.0);
     EXPECT_NEAR(j["finger_point"][0].get<double>(), 0.05, 1e-15);   // deepest finger point
     EXPECT_NEAR(j["object_point"][0].get<double>(), 0.0, 1e-15);    // its projection
+    EXPECT_TRUE(j["depth_exact"].get<bool>());                       // it leaves along -x
   }
+  // Centred 0.05 below the 0.2-wide hole, the 0.2-radius disk cannot leave into it: the
+  // reported depth (0.25) is a lower bound, and the output says so.
+  const std::string big = Write("big.json", R"({"polygons":[{"outer":[[0,0]]}],"radius":0.2})");
+  const ToolRun hole = Exec("penetration " + object + " " + big + " --finger-pose 0.5,0.35,0");
+  ASSERT_EQ(hole.status, 0) << hole.err;
+  const auto h = nlohmann::json::parse(hole.out);
+  EXPECT_NEAR(h["depth"].get<double>(), 0.25, 1e-15);
+  EXPECT_FALSE(h["depth_exact"].get<bool>());
   const ToolRun apart = Exec("penetration " + object + " " + finger + " --object-pose 0,0,0 --finger-pose -0.3,0.5,0");
   ASSERT_EQ(apart.status, 0) << apart.err;
   const auto j = nlohmann::json::parse(apart.out);
@@ -113,6 +122,17 @@ TEST_F(CliTest, PenetrationJsonContractAndNegativeNumberOptions) {
   EXPECT_TRUE(j["direction"].is_null());
   EXPECT_EQ(j["depth"].get<double>(), 0.0);
   EXPECT_NEAR(j["signed_distance"].get<double>(), 0.2, 1e-15);
+}
+
+TEST_F(CliTest, DirectoriesAsInputFilesAreNamedAsSuch) {
+  const std::string object = Write("o.json", kSquareWithHole);
+  const std::string dir = fs::path(object).parent_path().string();
+  for (const std::string& args : {"footprint " + dir, "distance " + object + " " + dir, "distance " + dir + " " + dir,
+                                 "penetration " + dir + " " + object}) {
+    const ToolRun r = Exec(args);
+    EXPECT_EQ(r.status, 1) << args;
+    EXPECT_NE(r.err.find("is a directory"), std::string::npos) << args << ": " << r.err;
+  }
 }
 
 TEST_F(CliTest, PenetrationBadPoseIsOneClearLine) {

@@ -4,6 +4,7 @@
 
 #include <pushgraph/geometry/point_query.h>
 
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -18,6 +19,8 @@ std::string Trim(const std::string& s) {
 }
 
 std::vector<geometry::Vec2> ReadPointsCsv(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw CliError(path + ": is a directory, not a points file");
   std::ifstream in(path);
   if (!in) throw CliError(path + ": cannot open file");
   std::string line;

@@ -61,7 +61,7 @@ void Run(const LimitSurfaceOptions& options) {
         {{"twist", v}, {"force", {load.force.x(), load.force.y()}}, {"torque", load.torque}});
   }
   if (options.ellipsoid) {
-    if (options.samples < 1) throw CliError("--samples must be >= 1");
+    if (options.samples < 6) throw CliError("--samples must be >= 6 (the fitted ellipsoid has 6 unknowns)");
     out["ellipsoid"] = {
         {"paper", ToJson(ls::CompareWithExact(support, ls::PaperEllipsoid(summary), options.samples))},
         {"fitted", ToJson(ls::CompareWithExact(support, ls::FitEllipsoid(support, options.samples, 2),

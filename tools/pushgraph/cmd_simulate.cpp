@@ -158,8 +158,8 @@ void Run(const SimulateOptions& o) {
   io::SaveTrajectoryJson(trajectory, o.output);
 
   const ls::SimulationStats& s = result.stats;
-  const auto& gt = *result.trajectory.ground_truth;
-  const geometry::Pose2 end = gt.object_pose.empty() ? plan.object_pose : gt.object_pose.back().pose;
+  // The simulator's own last state (the object stream may be disabled, --rate-object 0).
+  const geometry::Pose2 end = result.states.empty() ? plan.object_pose : result.states.back().object_pose;
   nlohmann::json out;
   out["output"] = o.output;
   out["surface"] = ls::ToString(plan.surface);
