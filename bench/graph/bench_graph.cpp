@@ -5,6 +5,7 @@
 #include <pushgraph/graph/estimator.h>
 #include <pushgraph/graph/incremental.h>
 
+#include "graph/online_feed.h"
 #include "graph/push_generator.h"
 
 #include <benchmark/benchmark.h>
@@ -95,32 +96,20 @@ BENCHMARK(BM_IncrementalQsWithCovariance)->Arg(500)->Arg(2000)->Unit(benchmark::
 // the updates (Add* and UpdateDue), which must not grow with the length either.
 void BM_OnlineQs(benchmark::State& state) {
   const auto& traj = Push(static_cast<int>(state.range(0)));
-  struct Sample { double t; int stream; std::size_t i; };
-  std::vector<Sample> samples;
-  const auto& m = traj.measured;
-  for (std::size_t i = 0; i < m.object_pose.size(); ++i) samples.push_back({m.object_pose[i].t, 0, i});
-  for (std::size_t i = 0; i < m.finger_pose.size(); ++i) samples.push_back({m.finger_pose[i].t, 1, i});
-  for (std::size_t i = 0; i < m.contact_point.size(); ++i) samples.push_back({m.contact_point[i].t, 2, i});
-  for (std::size_t i = 0; i < m.force.size(); ++i) samples.push_back({m.force[i].t, 3, i});
-  std::stable_sort(samples.begin(), samples.end(), [](const Sample& a, const Sample& b) { return a.t < b.t; });
-  limit_surface::Trajectory setup;
-  setup.object = traj.object;
-  setup.finger = traj.finger;
+  const std::vector<graph::testing::Arrival> samples = graph::testing::ArrivalOrder(traj);
+  limit_surface::Trajectory setup = graph::testing::SetupOf(traj);
+  setup.ground_truth.reset();
   graph::EstimatorConfig cfg;
   cfg.covariance = false;
   double mean = 0, worst = 0, per_sample_us = 0;
   for (auto _ : state) {
-    graph::OnlineEstimator online(setup, graph::Model::kQs, cfg, {!m.contact_point.empty(), !m.force.empty()});
+    graph::OnlineEstimator online(setup, graph::Model::kQs, cfg, graph::testing::StreamsOf(traj));
     std::vector<double> times;
     double total = 0;
     const auto start = std::chrono::steady_clock::now();
     for (std::size_t k = 0; k < samples.size(); ++k) {
-      const Sample& e = samples[k];
-      if (e.stream == 0) online.AddObjectPose(e.t, m.object_pose[e.i].pose);
-      if (e.stream == 1) online.AddFingerPose(e.t, m.finger_pose[e.i].pose);
-      if (e.stream == 2) online.AddContactPoint(e.t, m.contact_point[e.i].point);
-      if (e.stream == 3) online.AddForce(e.t, m.force[e.i].force);
-      const bool stamp_complete = k + 1 == samples.size() || samples[k + 1].t > e.t;
+      graph::testing::Deliver(samples[k], traj, online);
+      const bool stamp_complete = k + 1 == samples.size() || samples[k + 1].t > samples[k].t;
       if (stamp_complete && online.UpdateDue()) {
         times.push_back(online.Update());
         total += times.back();

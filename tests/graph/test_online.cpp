@@ -3,6 +3,7 @@
 #include <pushgraph/graph/estimator.h>
 #include <pushgraph/graph/incremental.h>
 
+#include "graph/online_feed.h"
 #include "graph/push_generator.h"
 
 #include <gtest/gtest.h>
@@ -16,8 +17,13 @@
 namespace pushgraph::graph {
 namespace {
 
+using testing::Arrival;
+using testing::ArrivalOrder;
+using testing::Deliver;
 using testing::GeneratePush;
 using testing::PushSpec;
+using testing::SetupOf;
+using testing::StreamsOf;
 
 PushSpec OffsetPush(unsigned seed, double duration) {
   PushSpec s;
@@ -27,32 +33,13 @@ PushSpec OffsetPush(unsigned seed, double duration) {
   return s;
 }
 
-limit_surface::Trajectory SetupOf(const limit_surface::Trajectory& t) {
-  limit_surface::Trajectory setup;
-  setup.object = t.object;
-  setup.finger = t.finger;
-  setup.ground_truth = t.ground_truth;  // for Finish()'s metrics only
-  return setup;
-}
-
 // Every sample of `t` in time order; samples sharing a time stamp are delivered together,
 // then `after_stamp` runs (a robot loop polling UpdateDue).
 void Feed(const limit_surface::Trajectory& t, OnlineEstimator& online, const std::function<void()>& after_stamp) {
-  struct Event { double t; int stream; std::size_t i; };
-  std::vector<Event> events;
-  const auto& m = t.measured;
-  for (std::size_t i = 0; i < m.object_pose.size(); ++i) events.push_back({m.object_pose[i].t, 0, i});
-  for (std::size_t i = 0; i < m.finger_pose.size(); ++i) events.push_back({m.finger_pose[i].t, 1, i});
-  for (std::size_t i = 0; i < m.contact_point.size(); ++i) events.push_back({m.contact_point[i].t, 2, i});
-  for (std::size_t i = 0; i < m.force.size(); ++i) events.push_back({m.force[i].t, 3, i});
-  std::stable_sort(events.begin(), events.end(), [](const Event& a, const Event& b) { return a.t < b.t; });
-  for (std::size_t k = 0; k < events.size(); ++k) {
-    const Event& e = events[k];
-    if (e.stream == 0) online.AddObjectPose(e.t, m.object_pose[e.i].pose);
-    if (e.stream == 1) online.AddFingerPose(e.t, m.finger_pose[e.i].pose);
-    if (e.stream == 2) online.AddContactPoint(e.t, m.contact_point[e.i].point);
-    if (e.stream == 3) online.AddForce(e.t, m.force[e.i].force);
-    if (k + 1 == events.size() || events[k + 1].t > e.t + 1e-9) after_stamp();
+  const std::vector<Arrival> arrivals = ArrivalOrder(t);
+  for (std::size_t k = 0; k < arrivals.size(); ++k) {
+    Deliver(arrivals[k], t, online);
+    if (k + 1 == arrivals.size() || arrivals[k + 1].t > arrivals[k].t + 1e-9) after_stamp();
   }
 }
 
@@ -73,10 +60,7 @@ TEST(Online, SameEstimateAsTheReplayOfTheRecording) {
     while (!replay.Done()) replay.Update();
     const EstimationResult expected = replay.Finish();
 
-    OnlineStreams streams;
-    streams.contact_point = !t.measured.contact_point.empty();
-    streams.force = !t.measured.force.empty();
-    OnlineEstimator online(SetupOf(t), model, {}, streams);
+    OnlineEstimator online(SetupOf(t), model, {}, StreamsOf(t));
     int updates = 0, max_window = 0;
     double last_until = -1.0;
     Feed(t, online, [&] {
@@ -150,23 +134,10 @@ TEST(Online, WaitsForASlowerSensor) {
     const EstimationResult expected = replay.Finish();
 
     const double latency = 0.06;
-    struct Arrival { double at; int stream; std::size_t i; };
-    std::vector<Arrival> arrivals;
-    const auto& m = t.measured;
-    for (std::size_t i = 0; i < m.object_pose.size(); ++i) arrivals.push_back({m.object_pose[i].t + latency, 0, i});
-    for (std::size_t i = 0; i < m.finger_pose.size(); ++i) arrivals.push_back({m.finger_pose[i].t, 1, i});
-    for (std::size_t i = 0; i < m.contact_point.size(); ++i) arrivals.push_back({m.contact_point[i].t, 2, i});
-    for (std::size_t i = 0; i < m.force.size(); ++i) arrivals.push_back({m.force[i].t, 3, i});
-    std::stable_sort(arrivals.begin(), arrivals.end(), [](const Arrival& a, const Arrival& b) { return a.at < b.at; });
     OnlineEstimator online(SetupOf(t), Model::kQs, {}, {true, true});
     int updates = 0;
-    for (const Arrival& a : arrivals) {
-      bool accepted = true;
-      if (a.stream == 0) accepted = online.AddObjectPose(m.object_pose[a.i].t, m.object_pose[a.i].pose);
-      if (a.stream == 1) accepted = online.AddFingerPose(m.finger_pose[a.i].t, m.finger_pose[a.i].pose);
-      if (a.stream == 2) accepted = online.AddContactPoint(m.contact_point[a.i].t, m.contact_point[a.i].point);
-      if (a.stream == 3) accepted = online.AddForce(m.force[a.i].t, m.force[a.i].force);
-      EXPECT_TRUE(accepted) << "stream " << a.stream << " sample " << a.i;
+    for (const Arrival& a : ArrivalOrder(t, latency)) {
+      EXPECT_TRUE(Deliver(a, t, online)) << "stream " << a.stream << " sample " << a.index;
       if (online.UpdateDue()) {
         online.Update();
         ++updates;

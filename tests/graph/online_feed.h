@@ -1,0 +1,64 @@
+#pragma once
+// Delivering a recorded trajectory to graph::OnlineEstimator one sample at a time, as a robot's
+// sensor callbacks would (the online tests and benchmark).
+//
+//   for (const Arrival& a : ArrivalOrder(traj, /*object_delay=*/0.06)) Deliver(a, traj, online);
+#include <pushgraph/graph/incremental.h>
+#include <pushgraph/limit_surface/trajectory.h>
+
+#include <algorithm>
+#include <vector>
+
+namespace pushgraph::graph::testing {
+
+/// One recorded sample: its time stamp t, when it reaches the estimator (at), its stream
+/// (0 object pose, 1 finger pose, 2 contact point, 3 force) and its index in that stream.
+struct Arrival {
+  double t = 0.0, at = 0.0;
+  int stream = 0;
+  std::size_t index = 0;
+};
+
+/// Every measured sample of `t` in arrival order (stable: streams in the order above at equal
+/// times); object poses arrive `object_delay` s after their time stamp, the others at it.
+inline std::vector<Arrival> ArrivalOrder(const limit_surface::Trajectory& t, double object_delay = 0.0) {
+  std::vector<Arrival> out;
+  const auto& m = t.measured;
+  for (std::size_t i = 0; i < m.object_pose.size(); ++i) out.push_back({m.object_pose[i].t, m.object_pose[i].t + object_delay, 0, i});
+  for (std::size_t i = 0; i < m.finger_pose.size(); ++i) out.push_back({m.finger_pose[i].t, m.finger_pose[i].t, 1, i});
+  for (std::size_t i = 0; i < m.contact_point.size(); ++i) out.push_back({m.contact_point[i].t, m.contact_point[i].t, 2, i});
+  for (std::size_t i = 0; i < m.force.size(); ++i) out.push_back({m.force[i].t, m.force[i].t, 3, i});
+  std::stable_sort(out.begin(), out.end(), [](const Arrival& a, const Arrival& b) { return a.at < b.at; });
+  return out;
+}
+
+/// Hands one sample to the estimator; returns what Add* returned (false: dropped as late).
+inline bool Deliver(const Arrival& a, const limit_surface::Trajectory& t, OnlineEstimator& online) {
+  const auto& m = t.measured;
+  switch (a.stream) {
+    case 0: return online.AddObjectPose(a.t, m.object_pose[a.index].pose);
+    case 1: return online.AddFingerPose(a.t, m.finger_pose[a.index].pose);
+    case 2: return online.AddContactPoint(a.t, m.contact_point[a.index].point);
+    default: return online.AddForce(a.t, m.force[a.index].force);
+  }
+}
+
+/// What an OnlineEstimator is built from for a recording: object and finger, no samples, and
+/// the ground truth (only for Finish()'s metrics).
+inline limit_surface::Trajectory SetupOf(const limit_surface::Trajectory& t) {
+  limit_surface::Trajectory setup;
+  setup.object = t.object;
+  setup.finger = t.finger;
+  setup.ground_truth = t.ground_truth;
+  return setup;
+}
+
+/// The streams a recording has, for OnlineStreams.
+inline OnlineStreams StreamsOf(const limit_surface::Trajectory& t) {
+  OnlineStreams s;
+  s.contact_point = !t.measured.contact_point.empty();
+  s.force = !t.measured.force.empty();
+  return s;
+}
+
+}  // namespace pushgraph::graph::testing
