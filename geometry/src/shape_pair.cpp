@@ -373,7 +373,7 @@ ShapePairResult ShapePairQuerier::Query(const Pose2& object_pose, const Pose2& f
   if (!r.intersecting) return r;
   if (!m.point_finger && m.options.method == Method::kVertexSampling) {
     r.depth_exact = false;  // an estimate (header)
-  } else if (m.object.radius() + m.finger.radius() > 0.0) {
+  } else if (m.options.check_rounded_depth && m.object.radius() + m.finger.radius() > 0.0) {
     // The rounded-shape depth (core depth + radii) is exact only if it separates: move the
     // finger by it and look (apart shapes' separations are exact, so this test is sound).
     Pose2 moved = finger_pose;

@@ -211,6 +211,7 @@ void GraphBuilder::SetUpShapes() {
   geometry::ShapePairQuerier::Options pair_options;
   pair_options.angle_cache_resolution = cfg_.finger_angle_resolution;
   pair_options.max_cached_angles = 4096;
+  pair_options.check_rounded_depth = false;  // the factors never read depth_exact: no second query
   querier_ = std::make_shared<geometry::ShapePairQuerier>(traj_.object.shape, traj_.finger.shape, pair_options);
   if (ModelHasForce(model_)) qs_ = QuasiStaticGeometryFor(traj_, cfg_);
   if (traj_.object.mass > 0.0 && traj_.object.mu_surface > 0.0) {
@@ -248,7 +249,7 @@ void GraphBuilder::EnableMuEstimation() {
   if (!(f_max_ > 0.0)) {
     throw GraphError("estimate_mu needs the object's mass and mu_surface in the trajectory");
   }
-  if (traj_.measured.force.empty()) {
+  if (!streams_.force) {
     // Scaling every force and mu together leaves D and the load factor unchanged: only the
     // force priors would decide, and they pull mu down (measured: to its lower bound, with a
     // confident sigma). Refuse rather than report that.

@@ -65,6 +65,14 @@ double MedianObjectPeriod(const std::vector<limit_surface::PoseSample>& obj,
   return periods[periods.size() / 2];
 }
 
+// A time in an error message, to 17 digits (samples can be nanoseconds apart).
+std::string Precise(double t) {
+  std::ostringstream o;
+  o.precision(17);
+  o << t;
+  return o.str();
+}
+
 // The fixed-lag smoother both front ends drive: steps join at updates, the window is re-solved,
 // steps older than the window are marginalized.
 struct FixedLagSmoother {
@@ -359,6 +367,7 @@ struct OnlineEstimator::Impl {
   bool declared[4] = {true, true, false, false};
   double max_latency = 0.2;
   static constexpr std::size_t kRecentPeriods = 64;  // object periods the schedule looks at
+  double object_period = 0.0;  // median of the newest kRecentPeriods; updated per object sample
 
   static const limit_surface::Trajectory& Empty(const limit_surface::Trajectory& setup) {
     const auto& m = setup.measured;
@@ -382,10 +391,7 @@ struct OnlineEstimator::Impl {
   // already solved, so it is dropped.
   bool Accept(int stream, const char* name, std::size_t index, double t, bool finite) {
     auto where = [&] {
-      std::ostringstream o;
-      o.precision(17);
-      o << "OnlineEstimator: streams." << name << "[" << index << "] at t = " << t;
-      return o.str();
+      return "OnlineEstimator: streams." + std::string(name) + "[" + std::to_string(index) + "] at t = " + Precise(t);
     };
     if (finished) throw GraphError(where() + " arrived after Finish()");
     if (!declared[stream]) {
@@ -393,11 +399,8 @@ struct OnlineEstimator::Impl {
     }
     if (!std::isfinite(t) || !finite) throw GraphError(where() + " is not finite");
     if (!(t > last_seen[stream])) {
-      std::ostringstream o;
-      o.precision(17);
-      o << where() << " is not after the previous sample (t = " << last_seen[stream]
-        << "): each stream must arrive in time order";
-      throw GraphError(o.str());
+      throw GraphError(where() + " is not after the previous sample (t = " + Precise(last_seen[stream]) +
+                       "): each stream must arrive in time order");
     }
     last_seen[stream] = t;
     ++seen[stream];
@@ -415,8 +418,7 @@ struct OnlineEstimator::Impl {
   // camera is waited for while an occluded one, or a tactile sensor silent out of contact, does
   // not hold the others back.
   double SettledTime() const {
-    const double period = MedianObjectPeriod(traj.measured.object_pose, kRecentPeriods);
-    const double live = std::max(max_latency, 1.5 * smoother.cfg.incremental_update_every * period);
+    const double live = std::max(max_latency, 1.5 * smoother.cfg.incremental_update_every * object_period);
     double settled = newest_t;
     for (double t : last_seen) {
       if (std::isfinite(t) && newest_t - t <= live) settled = std::min(settled, t);
@@ -442,6 +444,7 @@ OnlineEstimator::~OnlineEstimator() = default;
 bool OnlineEstimator::AddObjectPose(double t, const geometry::Pose2& pose) {
   if (!impl_->Accept(0, "object_pose", impl_->seen[0], t, pose.vector().allFinite())) return false;
   impl_->traj.measured.object_pose.push_back({t, pose});
+  impl_->object_period = MedianObjectPeriod(impl_->traj.measured.object_pose, Impl::kRecentPeriods);
   return true;
 }
 bool OnlineEstimator::AddFingerPose(double t, const geometry::Pose2& pose) {
@@ -469,9 +472,8 @@ bool OnlineEstimator::UpdateDue() const {
   const double settled = m.SettledTime();
   if (m.ObjectSamplesSince(m.last_update_t, settled) >= k) return true;
   // The object stream is silent (occlusion): update on time, as IncrementalEstimator does.
-  const double period = MedianObjectPeriod(m.traj.measured.object_pose, Impl::kRecentPeriods);
   const double since = std::isfinite(m.last_update_t) ? m.last_update_t : m.first_t;
-  return period > 0.0 && settled - since > 1.5 * k * period;
+  return m.object_period > 0.0 && settled - since > 1.5 * k * m.object_period;
 }
 
 double OnlineEstimator::Update(double until) {
@@ -482,20 +484,14 @@ double OnlineEstimator::Update(double until) {
   until = until == INFINITY ? m.SettledTime() : std::min(until, m.newest_t);
   if (!(until > m.last_update_t)) return 0.0;  // nothing new
   const auto& meas = m.traj.measured;
-  auto at = [](double t) {
-    std::ostringstream o;
-    o.precision(17);
-    o << t;
-    return o.str();
-  };
   if (m.smoother.next_step == 0) {
     // The first update needs both poses: nothing else anchors the object and the finger.
     if (meas.object_pose.empty() || meas.object_pose.front().t > until) {
       throw GraphError("OnlineEstimator::Update: no object pose measurement (streams.object_pose) up to t = " +
-                       at(until) + ": the first update needs one to anchor the object");
+                       Precise(until) + ": the first update needs one to anchor the object");
     }
     if (meas.finger_pose.empty() || meas.finger_pose.front().t > until) {
-      throw GraphError("OnlineEstimator::Update: no finger pose measurement (streams.finger_pose) up to t = " + at(until));
+      throw GraphError("OnlineEstimator::Update: no finger pose measurement (streams.finger_pose) up to t = " + Precise(until));
     }
   }
   // Samples within 1e-9 s after `until` join its step now (as batch merges them), so no later
@@ -503,8 +499,7 @@ double OnlineEstimator::Update(double until) {
   m.last_update_t = until;  // later samples must come more than 1e-9 s after it (Accept)
   until += 1e-9;
   m.smoother.builder.AppendSteps(until);
-  const double period = MedianObjectPeriod(meas.object_pose, Impl::kRecentPeriods);
-  if (period > 0.0) m.smoother.window_duration = m.smoother.cfg.incremental_window * period;
+  if (m.object_period > 0.0) m.smoother.window_duration = m.smoother.cfg.incremental_window * m.object_period;
   return m.smoother.Update(until, false);
 }
 

@@ -447,6 +447,14 @@ ls::NoiseModel MakePaperNoise(ls::NoiseKind kind, const PaperNoise& s) {
 }
 
 ls::Trajectory AddNoise(const ls::Trajectory& trajectory, const ls::NoiseModel& noise, std::uint64_t seed) {
+  if (!trajectory.ground_truth && trajectory.measurement_sigmas) {
+    const ls::MeasurementSigmas& m = *trajectory.measurement_sigmas;
+    if (m.object_trans > 0 || m.object_rot > 0 || m.finger_trans > 0 || m.finger_rot > 0 || m.contact > 0 || m.force > 0) {
+      throw IoError("adding noise needs clean streams, but these streams already carry noise (measurement_sigmas) "
+                    "and there is no ground_truth: the noise would be added twice and the metrics scored against "
+                    "noisy streams");
+    }
+  }
   ls::Trajectory t = trajectory;
   const ls::Streams clean = trajectory.ground_truth ? *trajectory.ground_truth : trajectory.measured;
   t.ground_truth = clean;

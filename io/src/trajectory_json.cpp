@@ -75,7 +75,6 @@ class Reader {
     if (!value.is_array()) Fail(path, "must be an array of rows");
     std::vector<Sample> out;
     out.reserve(value.size());
-    std::vector<std::size_t> row_of;  // each sample's row in the file, for messages after sorting
     for (std::size_t i = 0; i < value.size(); ++i) {
       const std::string row_path = path + "[" + std::to_string(i) + "]";
       const json& row = value[i];
@@ -83,14 +82,13 @@ class Reader {
         Fail(row_path, "must be a row of " + std::to_string(width) + " numbers, got " + row.dump());
       std::vector<double> v(width);
       for (std::size_t k = 0; k < width; ++k) v[k] = Number(row[k], row_path + "[" + std::to_string(k) + "]");
-      out.push_back(make(v));
-      row_of.push_back(i);
+      out.push_back(make(v));  // out[i] is row [i] of the file
     }
     if (notes_ != nullptr) {
       std::size_t late = 0, first = 0;
       double latest = out.empty() ? 0.0 : out[0].t;
       for (std::size_t i = 1; i < out.size(); ++i) {
-        if (out[i].t < latest && late++ == 0) first = row_of[i];  // after a later stamp
+        if (out[i].t < latest && late++ == 0) first = i;  // after a later stamp
         latest = std::max(latest, out[i].t);
       }
       if (late > 0) {
@@ -98,7 +96,7 @@ class Reader {
                           std::to_string(first) + "])");
       }
     }
-    std::vector<std::size_t> order(out.size());
+    std::vector<std::size_t> order(out.size());  // rows in time order
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
     std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return out[a].t < out[b].t; });
     std::vector<Sample> sorted;
@@ -107,7 +105,7 @@ class Reader {
       if (i > 0 && out[order[i]].t == out[order[i - 1]].t) {
         std::ostringstream o;
         o.precision(17);
-        o << "rows [" << row_of[order[i - 1]] << "] and [" << row_of[order[i]] << "] have the same time stamp "
+        o << "rows [" << order[i - 1] << "] and [" << order[i] << "] have the same time stamp "
           << out[order[i]].t;
         Fail(path, o.str());
       }

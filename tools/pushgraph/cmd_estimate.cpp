@@ -84,20 +84,16 @@ void RunEstimate(const EstimateOptions& o) {
   if (!o.config.empty()) graph::LoadEstimatorConfig(o.config);
   std::string source;
   limit_surface::Trajectory traj = LoadInput(o, &source);
-  if (!o.add_noise.empty() && !traj.ground_truth && traj.measurement_sigmas) {
-    const auto& m = *traj.measurement_sigmas;
-    if (m.object_trans > 0 || m.object_rot > 0 || m.finger_trans > 0 || m.finger_rot > 0 || m.contact > 0 || m.force > 0) {
-      throw CliError(o.input + ": --add-noise needs clean streams, but this trajectory's streams already carry noise "
-                     "(measurement_sigmas) and it has no ground_truth: the noise would be added twice and the "
-                     "metrics scored against noisy streams");
-    }
-  }
   if (!o.add_noise.empty()) {
     // The paper's Sec. IV noise on the clean streams (the recording, or the file's ground truth);
     // the clean streams stay as ground truth, so metrics are computed.
     const limit_surface::NoiseKind kind =
         o.add_noise == "bimodal" ? limit_surface::NoiseKind::kBimodal : limit_surface::NoiseKind::kGaussian;
-    traj = io::AddNoise(traj, io::MakePaperNoise(kind), o.seed);
+    try {
+      traj = io::AddNoise(traj, io::MakePaperNoise(kind), o.seed);
+    } catch (const io::IoError& e) {
+      throw CliError(o.input + ": --add-noise: " + e.what());
+    }
   }
   // Measurement factors weighted by the known noise (added here, or recorded by the simulator).
   // The data's sigmas first, then the configuration file's keys on top (docs/estimation.md).

@@ -17,7 +17,8 @@
 // finger can leave along the core's normal, but only a lower bound where the rounded obstacle
 // fills a concave corner, a notch or a hole narrower than the finger (moving by it still
 // overlaps): each overlapping rounded query checks its own answer by moving the finger and
-// reports the outcome in depth_exact. Separations of apart shapes are always exact.
+// reports the outcome in depth_exact (Options::check_rounded_depth). Separations of apart
+// shapes are always exact.
 //
 // The fast path (Method::kVertexSampling) takes the deepest vertex of either shape inside the
 // other; it is exact when apart and for point/disk fingers, and an estimate for polygonal
@@ -43,7 +44,8 @@ struct ShapePairResult {
   double depth = 0.0;            ///< max(0, -signed_distance)
   /// False when `depth` is only a lower bound of the penetration depth: rounded shapes whose
   /// obstacle fills a concave corner, notch or hole (moving the finger by depth along normal
-  /// leaves it overlapping), or the vertex-sampling estimate of a polygonal finger.
+  /// leaves it overlapping; checked only with Options::check_rounded_depth), or the
+  /// vertex-sampling estimate of a polygonal finger.
   bool depth_exact = true;
   /// Unit vector, world frame, in which the finger moves to increase the separation fastest
   /// (to separate, when intersecting); object_point - finger_point = -signed_distance * normal.
@@ -72,6 +74,9 @@ class ShapePairQuerier {
     /// fingers; 0 caches exact angles only (bit-identical angles share an obstacle).
     double angle_cache_resolution = 0.0;
     int max_cached_angles = 256;
+    /// Check an overlapping rounded query's depth by a second query (ShapePairResult::
+    /// depth_exact); off, depth_exact is left true and the query costs one point query less.
+    bool check_rounded_depth = true;
   };
 
   ShapePairQuerier(Shape object, Shape finger);

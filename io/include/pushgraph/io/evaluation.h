@@ -59,7 +59,9 @@ limit_surface::NoiseModel MakePaperNoise(limit_surface::NoiseKind kind, const Pa
 
 /// The trajectory with ground truth = its clean streams (its ground truth when it has one, else
 /// its measured streams) and measured = clean + noise (limit_surface::ApplyNoise with `seed`);
-/// measurement_sigmas set to the noise's sigmas.
+/// measurement_sigmas set to the noise's sigmas. Throws IoError for a trajectory without ground
+/// truth whose measurement_sigmas say its streams are already noisy (noise added twice, metrics
+/// scored against noisy streams).
 limit_surface::Trajectory AddNoise(const limit_surface::Trajectory& trajectory, const limit_surface::NoiseModel& noise,
                                    std::uint64_t seed);
 
