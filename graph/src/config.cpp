@@ -153,9 +153,19 @@ EstimatorConfig ParseEstimatorConfig(const std::string& json_text, const std::st
       cfg.covariance_method = ParseChoice<EstimatorConfig::CovarianceMethod>(
           *it, source, key, {{"selected_inversion", EstimatorConfig::CovarianceMethod::kSelectedInversion},
                              {"ceres", EstimatorConfig::CovarianceMethod::kCeres}});
-    } else if (key == "covariance" || key == "estimate_c" || key == "estimate_mu") {
+    } else if (key == "align_shape") {
+      cfg.align_shape = ParseChoice<EstimatorConfig::AlignShape>(
+          *it, source, key, {{"auto", EstimatorConfig::AlignShape::kAuto},
+                             {"on", EstimatorConfig::AlignShape::kOn},
+                             {"off", EstimatorConfig::AlignShape::kOff}});
+    } else if (key == "covariance" || key == "estimate_c" || key == "estimate_mu" || key == "align_scale" ||
+               key == "diagnostics") {
       if (!it->is_boolean()) Fail(source, key, "expected true or false");
-      (key == "covariance" ? cfg.covariance : key == "estimate_c" ? cfg.estimate_c : cfg.estimate_mu) = it->get<bool>();
+      (key == "covariance"    ? cfg.covariance
+       : key == "estimate_c"  ? cfg.estimate_c
+       : key == "estimate_mu" ? cfg.estimate_mu
+       : key == "diagnostics" ? cfg.diagnostics
+                              : cfg.align_scale) = it->get<bool>();
     } else if (key == "losses") {
       if (!it->is_object()) Fail(source, key, "expected an object");
       for (auto l = it->begin(); l != it->end(); ++l) {

@@ -5,12 +5,14 @@
 #include <pushgraph/geometry/point_query.h>
 #include <pushgraph/graph/incremental.h>
 #include <pushgraph/graph/marginals.h>
+#include <pushgraph/graph/shape_frame.h>
 #include <pushgraph/limit_surface/limit_surface.h>
 #include <pushgraph/limit_surface/support.h>
 
 #include <Eigen/Cholesky>
 
 #include <algorithm>
+#include <cstdio>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -233,16 +235,45 @@ void GraphBuilder::EnableCEstimation() {
 namespace {
 // A shared scalar parameter (c, mu): a Gaussian prior of relative sigma around its nominal
 // value and bounds [0.2, 5] times it.
-void AddSharedParameterPrior(ceres::Problem& problem, double* parameter, double nominal, double relative_sigma) {
+void AddSharedParameterPrior(GraphBuilder& builder, ceres::Problem& problem, double* parameter, double nominal,
+                             double relative_sigma) {
   ceres::Matrix A(1, 1);
   ceres::Vector b(1);
   A(0, 0) = 1.0 / (relative_sigma * nominal);
   b(0) = nominal;
-  problem.AddResidualBlock(new ceres::NormalPrior(A, b), nullptr, parameter);
+  builder.Add(problem, FactorType::kPrior, new ceres::NormalPrior(A, b), nullptr, {parameter});
   problem.SetParameterLowerBound(parameter, 0, 0.2 * nominal);
   problem.SetParameterUpperBound(parameter, 0, 5.0 * nominal);
 }
 }  // namespace
+
+void GraphBuilder::EnableShapeFrame(const Vec2& centroid, double sigma_centroid, double sigma_theta, bool rotation) {
+  shape_frame_ = true;
+  frame_centroid_ = centroid;
+  frame_sigma_centroid_ = sigma_centroid;
+  frame_sigma_theta_ = sigma_theta;
+  frame_rotation_ = rotation;
+}
+
+ceres::ResidualBlockId GraphBuilder::Add(ceres::Problem& problem, FactorType type, ceres::CostFunction* cost,
+                                         ceres::LossFunction* loss, std::vector<double*> blocks,
+                                         std::vector<int> object_pose_blocks) {
+  if (shape_frame_ && !object_pose_blocks.empty()) {
+    blocks.push_back(frame_);
+    cost = new ShapeFrameFactor(cost, std::move(object_pose_blocks));
+    if (!frame_in_problem_) {
+      frame_in_problem_ = true;
+      // A circular outline's angle is unobservable: a stiff prior holds it (SparseMarginals takes
+      // no manifolds), and its sigma is not reported.
+      const double sigma_theta = frame_rotation_ ? frame_sigma_theta_ : 1e-6;
+      Add(problem, FactorType::kPrior, new ShapeFramePrior(frame_centroid_, frame_sigma_centroid_, sigma_theta), nullptr,
+          {frame_});
+    }
+  }
+  const ceres::ResidualBlockId id = problem.AddResidualBlock(cost, loss, blocks);
+  if (tags_ != nullptr) tags_->push_back({type, id});
+  return id;
+}
 
 void GraphBuilder::EnableMuEstimation() {
   if (model_ != Model::kQs) return;
@@ -373,34 +404,37 @@ void GraphBuilder::AddKinematicFactors(ceres::Problem& problem, int i) {
   AddPoseMeasurementFactors(problem, i);  // M
   if (s.in_contact) {
     if (s.contact >= 0) {
-      problem.AddResidualBlock(new VectorMeasurementFactor(m.contact_point[s.contact].point, cfg_.contact_sigma),
-                               MakeLoss(cfg_.contact_loss), v.p);
+      Add(problem, FactorType::kContactPoint, new VectorMeasurementFactor(m.contact_point[s.contact].point, cfg_.contact_sigma),
+          MakeLoss(cfg_.contact_loss), {v.p});
     }
     // C: contact point on both boundaries, finger touching the object.
-    problem.AddResidualBlock(new BoundaryPointFactor(traj_.object.shape, cfg_.contact_object_sigma), nullptr, v.x, v.p);
+    Add(problem, FactorType::kContactOnObject, new BoundaryPointFactor(traj_.object.shape, cfg_.contact_object_sigma), nullptr,
+        {v.x, v.p}, {0});
     if (cfg_.contact_finger == EstimatorConfig::ContactFinger::kWitness) {
-      problem.AddResidualBlock(new ContactWitnessFactor(querier_, cfg_.contact_finger_sigma), nullptr, v.x, v.e, v.p);
+      Add(problem, FactorType::kContactOnFinger, new ContactWitnessFactor(querier_, cfg_.contact_finger_sigma), nullptr,
+          {v.x, v.e, v.p}, {0});
     } else {
-      problem.AddResidualBlock(new BoundaryPointFactor(traj_.finger.shape, cfg_.contact_finger_sigma), nullptr, v.e, v.p);
+      Add(problem, FactorType::kContactOnFinger, new BoundaryPointFactor(traj_.finger.shape, cfg_.contact_finger_sigma), nullptr,
+          {v.e, v.p});
     }
     // The finger touches the object (signed separation 0): in QS and the baseline (Yu and
     // Rodriguez's contact factor). CP and SDF link finger and object through p only (Fig. 2a-b).
     if (model_ == Model::kQs || model_ == Model::kYu) {
-      problem.AddResidualBlock(new TouchingFactor(querier_, cfg_.touching_sigma), nullptr, v.x, v.e);
+      Add(problem, FactorType::kTouching, new TouchingFactor(querier_, cfg_.touching_sigma), nullptr, {v.x, v.e}, {0});
     }
   }
   // S
   if (model_ == Model::kSdf || model_ == Model::kQs) {
-    problem.AddResidualBlock(new IntersectionFactor(querier_, cfg_.intersection_sigma), nullptr, v.x, v.e);
+    Add(problem, FactorType::kIntersection, new IntersectionFactor(querier_, cfg_.intersection_sigma), nullptr, {v.x, v.e}, {0});
   }
   // V or the baseline's zero-velocity priors.
   if (model_ == Model::kYu) {
     if (i >= 1) {
       const double dt = s.t - steps_[i - 1].t;
-      problem.AddResidualBlock(new RandomWalkFactor(dt, cfg_.random_walk_trans, cfg_.random_walk_rot), nullptr,
-                               vars_[i - 1].x, v.x);
-      problem.AddResidualBlock(new RandomWalkFactor(dt, cfg_.random_walk_trans, cfg_.random_walk_rot), nullptr,
-                               vars_[i - 1].e, v.e);
+      Add(problem, FactorType::kZeroVelocity, new RandomWalkFactor(dt, cfg_.random_walk_trans, cfg_.random_walk_rot), nullptr,
+          {vars_[i - 1].x, v.x});
+      Add(problem, FactorType::kZeroVelocity, new RandomWalkFactor(dt, cfg_.random_walk_trans, cfg_.random_walk_rot), nullptr,
+          {vars_[i - 1].e, v.e});
     }
   } else {
     AddConstantVelocityFactors(problem, i);
@@ -412,14 +446,14 @@ void GraphBuilder::AddPoseMeasurementFactors(ceres::Problem& problem, int i) {
   const Step& s = steps_[i];
   StepVars& v = vars_[i];
   if (s.object >= 0) {
-    problem.AddResidualBlock(new PoseMeasurementFactor(m.object_pose[s.object].pose, cfg_.object_pose_sigma_trans,
-                                                       cfg_.object_pose_sigma_rot),
-                             MakeLoss(cfg_.object_pose_loss), v.x);
+    Add(problem, FactorType::kObjectPose,
+        new PoseMeasurementFactor(m.object_pose[s.object].pose, cfg_.object_pose_sigma_trans, cfg_.object_pose_sigma_rot),
+        MakeLoss(cfg_.object_pose_loss), {v.x});
   }
   if (s.finger >= 0) {
-    problem.AddResidualBlock(new PoseMeasurementFactor(m.finger_pose[s.finger].pose, cfg_.finger_pose_sigma_trans,
-                                                       cfg_.finger_pose_sigma_rot),
-                             MakeLoss(cfg_.finger_pose_loss), v.e);
+    Add(problem, FactorType::kFingerPose,
+        new PoseMeasurementFactor(m.finger_pose[s.finger].pose, cfg_.finger_pose_sigma_trans, cfg_.finger_pose_sigma_rot),
+        MakeLoss(cfg_.finger_pose_loss), {v.e});
   }
 }
 
@@ -428,10 +462,10 @@ void GraphBuilder::AddConstantVelocityFactors(ceres::Problem& problem, int i) {
   const double dt1 = steps_[i - 1].t - steps_[i - 2].t, dt2 = steps_[i].t - steps_[i - 1].t;
   const double st = ConstantVelocitySigma(cfg_.accel_trans, dt1, dt2);
   const double sr = ConstantVelocitySigma(cfg_.accel_rot, dt1, dt2);
-  problem.AddResidualBlock(new ConstantVelocityFactor(dt1, dt2, st, sr), nullptr, vars_[i - 2].x, vars_[i - 1].x,
-                           vars_[i].x);
-  problem.AddResidualBlock(new ConstantVelocityFactor(dt1, dt2, st, sr), nullptr, vars_[i - 2].e, vars_[i - 1].e,
-                           vars_[i].e);
+  Add(problem, FactorType::kConstantVelocity, new ConstantVelocityFactor(dt1, dt2, st, sr), nullptr,
+      {vars_[i - 2].x, vars_[i - 1].x, vars_[i].x});
+  Add(problem, FactorType::kConstantVelocity, new ConstantVelocityFactor(dt1, dt2, st, sr), nullptr,
+      {vars_[i - 2].e, vars_[i - 1].e, vars_[i].e});
 }
 
 void GraphBuilder::AddDynamicFactors(ceres::Problem& problem, int i) {
@@ -441,13 +475,13 @@ void GraphBuilder::AddDynamicFactors(ceres::Problem& problem, int i) {
   // Force: measurement, weak prior, quasi-static factor.
   {
     if (s.force >= 0) {
-      problem.AddResidualBlock(new VectorMeasurementFactor(m.force[s.force].force, cfg_.force_sigma),
-                               MakeLoss(cfg_.force_loss), v.f);
+      Add(problem, FactorType::kForce, new VectorMeasurementFactor(m.force[s.force].force, cfg_.force_sigma),
+          MakeLoss(cfg_.force_loss), {v.f});
     }
-    problem.AddResidualBlock(new VectorMeasurementFactor(Vec2::Zero(), cfg_.force_prior_sigma), nullptr, v.f);
+    Add(problem, FactorType::kForcePrior, new VectorMeasurementFactor(Vec2::Zero(), cfg_.force_prior_sigma), nullptr, {v.f});
     if (i >= 1 && HasForceVars(i - 1)) {
-      problem.AddResidualBlock(new VectorRandomWalkFactor(s.t - steps_[i - 1].t, cfg_.force_random_walk), nullptr,
-                               vars_[i - 1].f, v.f);
+      Add(problem, FactorType::kForceContinuity, new VectorRandomWalkFactor(s.t - steps_[i - 1].t, cfg_.force_random_walk),
+          nullptr, {vars_[i - 1].f, v.f});
     }
     if (i >= 1) {
       QuasiStaticGeometry g = qs_;
@@ -455,38 +489,39 @@ void GraphBuilder::AddDynamicFactors(ceres::Problem& problem, int i) {
       const double rate_scale = std::sqrt(0.01 / g.dt);  // per-10-ms sigmas (config.h)
       if (model_ == Model::kQs) {
         if (estimate_c_) {
-          problem.AddResidualBlock(new QuasiStaticFactorWithC(g, cfg_.eps_velocity, cfg_.eps_force,
-                                                              cfg_.quasi_static_sigma * rate_scale),
-                                   nullptr, vars_[i - 1].x, v.x, v.p, v.f, c_var_);
+          Add(problem, FactorType::kQuasiStatic,
+                         new QuasiStaticFactorWithC(g, cfg_.eps_velocity, cfg_.eps_force, cfg_.quasi_static_sigma * rate_scale),
+                         nullptr, {vars_[i - 1].x, v.x, v.p, v.f, c_var_}, {0, 1});
           // Prior around the geometric value; bounds keep c physical (tau / c in D).
-          if (!c_in_problem_) AddSharedParameterPrior(problem, c_var_, qs_.c, cfg_.c_prior_sigma);
+          if (!c_in_problem_) AddSharedParameterPrior(*this, problem, c_var_, qs_.c, cfg_.c_prior_sigma);
           c_in_problem_ = true;
         } else {
-          problem.AddResidualBlock(new QuasiStaticFactor(g, cfg_.eps_velocity, cfg_.eps_force,
-                                                         cfg_.quasi_static_sigma * rate_scale),
-                                   nullptr, vars_[i - 1].x, v.x, v.p, v.f);
+          Add(problem, FactorType::kQuasiStatic,
+                         new QuasiStaticFactor(g, cfg_.eps_velocity, cfg_.eps_force, cfg_.quasi_static_sigma * rate_scale),
+                         nullptr, {vars_[i - 1].x, v.x, v.p, v.f}, {0, 1});
         }
         if (use_load_factor_ && (estimate_c_ || estimate_mu_)) {
           // The same c as D's (estimated) and/or mu as variables.
           std::vector<double*> blocks{vars_[i - 1].x, v.x, v.p, v.f};
           if (estimate_c_) blocks.push_back(c_var_);
           if (estimate_mu_) blocks.push_back(mu_var_);
-          problem.AddResidualBlock(
-              new LimitSurfaceLoadFactorWithParameters(g, normal_load_, mu_surface_, {estimate_c_, estimate_mu_},
-                                                       cfg_.eps_velocity, cfg_.eps_force,
-                                                       cfg_.limit_surface_sigma * rate_scale),
-              nullptr, blocks);
+          Add(problem, FactorType::kLimitSurfaceLoad,
+                         new LimitSurfaceLoadFactorWithParameters(g, normal_load_, mu_surface_, {estimate_c_, estimate_mu_},
+                                                                  cfg_.eps_velocity, cfg_.eps_force,
+                                                                  cfg_.limit_surface_sigma * rate_scale),
+                         nullptr, blocks, {0, 1});
           // Prior around the trajectory's mu; bounds keep f_max physical.
-          if (estimate_mu_ && !mu_in_problem_) AddSharedParameterPrior(problem, mu_var_, mu_surface_, cfg_.mu_prior_sigma);
+          if (estimate_mu_ && !mu_in_problem_) AddSharedParameterPrior(*this, problem, mu_var_, mu_surface_, cfg_.mu_prior_sigma);
           mu_in_problem_ = mu_in_problem_ || estimate_mu_;
         } else if (use_load_factor_) {
-          problem.AddResidualBlock(new LimitSurfaceLoadFactor(g, f_max_, cfg_.eps_velocity, cfg_.eps_force,
-                                                              cfg_.limit_surface_sigma * rate_scale),
-                                   nullptr, vars_[i - 1].x, v.x, v.p, v.f);
+          Add(problem, FactorType::kLimitSurfaceLoad,
+                         new LimitSurfaceLoadFactor(g, f_max_, cfg_.eps_velocity, cfg_.eps_force,
+                                                    cfg_.limit_surface_sigma * rate_scale),
+                         nullptr, {vars_[i - 1].x, v.x, v.p, v.f}, {0, 1});
         }
       } else {
-        problem.AddResidualBlock(new CrossMultipliedQuasiStaticFactor(g, cfg_.yu_quasi_static_sigma * rate_scale), nullptr,
-                                 vars_[i - 1].x, v.x, v.p, v.f);
+        Add(problem, FactorType::kQuasiStatic, new CrossMultipliedQuasiStaticFactor(g, cfg_.yu_quasi_static_sigma * rate_scale), nullptr,
+                       {vars_[i - 1].x, v.x, v.p, v.f}, {0, 1});
       }
     }
   }
@@ -513,6 +548,25 @@ void GraphBuilder::DropUnobservableForces(EstimationResult& result) const {
                             ", so nothing fixes their size (the quasi-static factor fixes only their direction)");
 }
 
+void GraphBuilder::SetState(int i, const StateEstimate& st) {
+  StepVars& v = vars_[i];
+  v.x[0] = st.object_pose.x; v.x[1] = st.object_pose.y; v.x[2] = st.object_pose.theta;
+  v.e[0] = st.finger_pose.x; v.e[1] = st.finger_pose.y; v.e[2] = st.finger_pose.theta;
+  if (st.contact) {
+    v.p[0] = st.contact->x(); v.p[1] = st.contact->y();
+  } else if (HasContactVars(i)) {
+    const auto q = geometry::QueryPoint(traj_.object.shape, Pose2{v.x[0], v.x[1], v.x[2]}, Vec2(v.e[0], v.e[1]));
+    v.p[0] = q.closest_point.x(); v.p[1] = q.closest_point.y();
+  }
+  v.f[0] = st.force ? st.force->x() : 0.0;
+  v.f[1] = st.force ? st.force->y() : 0.0;
+}
+
+void GraphBuilder::SetSharedParameters(std::optional<double> c, std::optional<double> mu) {
+  if (c && estimate_c_) c_var_[0] = *c;
+  if (mu && estimate_mu_) mu_var_[0] = *mu;
+}
+
 StateEstimate GraphBuilder::State(int i) const {
   StateEstimate s;
   const StepVars& v = vars_[i];
@@ -526,7 +580,7 @@ StateEstimate GraphBuilder::State(int i) const {
 
 std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder, const std::vector<int>& steps,
                                std::vector<StateEstimate>& states, EstimatorConfig::CovarianceMethod method,
-                               EstimationResult* parameters) {
+                               EstimationResult* parameters, Eigen::Matrix3d* frame_cov) {
   // The shared parameters (c, mu) whose sigmas are wanted.
   std::vector<std::pair<double*, std::optional<double>*>> shared;
   if (parameters != nullptr) {
@@ -584,6 +638,7 @@ std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder, c
       for (double* b : builder.Blocks(i)) pairs.emplace_back(b, b);
     }
     for (const auto& sh : shared) pairs.emplace_back(sh.first, sh.first);
+    if (frame_cov != nullptr && builder.frame_block() != nullptr) pairs.emplace_back(builder.frame_block(), builder.frame_block());
     if (!covariance->Compute(pairs, &problem)) {
       return "failed (" + (marginals_error.empty() ? std::string("rank-deficient Jacobian") : marginals_error) + ")";
     }
@@ -591,6 +646,10 @@ std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder, c
   }
   for (const auto& [block, sigma] : shared) {
     if (double var = 0.0; get(block, &var)) *sigma = std::sqrt(var);
+  }
+  if (frame_cov != nullptr && builder.frame_block() != nullptr) {
+    Eigen::Matrix<double, 3, 3, Eigen::RowMajor> c3;
+    if (get(builder.frame_block(), c3.data())) *frame_cov = c3;
   }
   for (std::size_t k = 0; k < steps.size(); ++k) {
     const int i = steps[k];
@@ -647,8 +706,19 @@ ceres::Solver::Options SolverOptions(int max_iterations, double function_toleran
 
 namespace {
 
-EstimationResult EstimateBatch(const limit_surface::Trajectory& traj, Model model, const EstimatorConfig& cfg) {
+// The shape frame as a static variable of the batch graph (shape_frame.h).
+struct FrameSetup {
+  Vec2 centroid = Vec2::Zero();  // of the aligned shape, object frame
+  double sigma_centroid = 0.01, sigma_theta = 0.2;
+  bool rotation = true;
+  Pose2 frame;                   // out: the estimate
+  std::optional<Eigen::Matrix3d> covariance;  // out
+};
+
+EstimationResult EstimateBatch(const limit_surface::Trajectory& traj, Model model, const EstimatorConfig& cfg,
+                               FrameSetup* frame = nullptr) {
   internal::GraphBuilder builder(traj, model, cfg);
+  if (frame) builder.EnableShapeFrame(frame->centroid, frame->sigma_centroid, frame->sigma_theta, frame->rotation);
   if (cfg.estimate_c) builder.EnableCEstimation();
   if (cfg.estimate_mu) builder.EnableMuEstimation();
   const int n = static_cast<int>(builder.steps().size());
@@ -693,9 +763,12 @@ EstimationResult EstimateBatch(const limit_surface::Trajectory& traj, Model mode
     r.states.push_back(builder.State(i));
   }
   if (cfg.covariance) {
+    Eigen::Matrix3d frame_cov = Eigen::Matrix3d::Zero();
     r.solver.covariance_status =
-        internal::ComputeCovariances(problem, builder, idx, r.states, cfg.covariance_method, &r);
+        internal::ComputeCovariances(problem, builder, idx, r.states, cfg.covariance_method, &r, frame ? &frame_cov : nullptr);
+    if (frame && r.solver.covariance_status == "ok") frame->covariance = frame_cov;
   }
+  if (frame) frame->frame = builder.frame();
   if (ModelHasForce(model)) r.c = builder.c();
   r.c_estimated = builder.c_block() != nullptr;
   if (model == Model::kQs && builder.uses_load_factor()) r.mu = builder.mu();
@@ -819,12 +892,153 @@ std::map<std::string, double> ComputeMetrics(const limit_surface::Trajectory& tr
   return m;
 }
 
+namespace {
+
+std::string TransformText(const ShapeTransform& t) {
+  char buf[128];
+  std::snprintf(buf, sizeof buf, "%.6g,%.6g,%.6g", t.pose.x, t.pose.y, t.pose.theta);
+  std::string s = std::string("--transform ") + buf;
+  if (t.scale != 1.0) {
+    std::snprintf(buf, sizeof buf, "%.6g", t.scale);
+    s = std::string("--scale ") + buf + " " + s;
+  }
+  if (t.mirrored) s = "--mirror " + s;
+  return s;
+}
+
+}  // namespace
+
 EstimationResult Estimate(const limit_surface::Trajectory& trajectory, Model model, Mode mode,
                           const EstimatorConfig& config) {
-  if (mode == Mode::kBatch) return EstimateBatch(trajectory, model, config);
-  IncrementalEstimator inc(trajectory, model, config);
-  while (!inc.Done()) inc.Update();
-  return inc.Finish();
+  ValidateConfig(config);
+  using Align = EstimatorConfig::AlignShape;
+  // The shape against the recording: the check, then registration where asked or needed.
+  ShapeAlignment alignment;
+  std::vector<std::string> warnings;
+  RegistrationOptions options = RegistrationOptionsFor(config);
+  options.estimate_scale = config.align_scale;
+  std::optional<RegistrationResult> registration;
+  try {
+    alignment.check = CheckShapeFit(trajectory, options);
+    alignment.checked = true;
+    if (config.align_shape == Align::kOn || !alignment.check.fits) registration = RegisterShape(trajectory, options);
+  } catch (const GraphError& e) {
+    // Too few contacts with object poses near them to say anything about the shape.
+    alignment.notes.push_back(std::string("shape not checked: ") + e.what());
+    if (config.align_shape == Align::kOn) throw GraphError(std::string("align_shape \"on\": ") + e.what());
+  }
+  // A misfit has two explanations: a wrong frame (the registration's placement) or a wrong
+  // finger size (the shape as given with the finger size_offset larger). From contacts alone a
+  // push along one side cannot tell them apart; the whole graph can (dynamics, smoothing): when
+  // both are plausible, each is estimated (batch, no covariances) and the lower final cost wins.
+  const bool misfit = registration && !registration->fits_as_given;
+  const geometry::Shape& finger = trajectory.finger.shape;
+  const double sized_radius = finger.radius() + (registration ? registration->size_offset : 0.0);
+  const bool size_candidate = misfit && sized_radius > 0.0 &&
+                              std::abs(registration->size_offset) <= std::max(5e-3, 3.0 * finger.radius());
+  bool size_wins = false;
+  if (misfit && size_candidate) {
+    EstimatorConfig quick = config;
+    quick.covariance = false;
+    quick.diagnostics = false;
+    limit_surface::Trajectory framed = trajectory, sized = trajectory;
+    framed.object.shape = registration->Apply(trajectory.object.shape);
+    sized.finger.shape = finger.WithRadius(sized_radius);
+    FrameSetup frame;
+    frame.centroid = geometry::CoreCentroid(framed.object.shape);
+    frame.sigma_centroid = options.centroid_prior * geometry::RadiusAbout(framed.object.shape, frame.centroid);
+    frame.rotation = registration->rotation_observable;
+    const double framed_cost = EstimateBatch(framed, model, quick, &frame).solver.final_cost;
+    const double sized_cost = EstimateBatch(sized, model, quick).solver.final_cost;
+    size_wins = sized_cost < framed_cost;
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "frame or size: the graph's final cost is %.1f with the shape aligned and %.1f with the finger %.1f mm %s",
+                  framed_cost, sized_cost, std::abs(registration->size_offset) * 1e3,
+                  registration->size_offset > 0 ? "larger" : "smaller");
+    alignment.notes.push_back(text);
+  }
+  const bool align = registration && (config.align_shape == Align::kOn ||
+                                      (config.align_shape == Align::kAuto && misfit && !size_wins));
+  limit_surface::Trajectory aligned_trajectory;
+  const limit_surface::Trajectory* working = &trajectory;
+  if (registration) {
+    alignment.suggested = true;
+    alignment.transform = registration->transform;
+    alignment.sigma = registration->sigma;
+    alignment.rotation_observable = registration->rotation_observable;
+    alignment.notes.insert(alignment.notes.end(), registration->notes.begin(), registration->notes.end());
+    if (registration->ambiguous) alignment.notes.push_back("ambiguous: " + registration->ambiguity);
+  }
+  if (align) {
+    aligned_trajectory = trajectory;
+    aligned_trajectory.object.shape = registration->Apply(trajectory.object.shape);
+    working = &aligned_trajectory;
+    alignment.aligned = true;
+  }
+  EstimationResult result;
+  std::optional<internal::FrameState> frame_state;
+  if (mode == Mode::kBatch) {
+    if (align) {
+      // The frame refined as a static variable: the centroid prior of the registration.
+      FrameSetup frame;
+      const geometry::Shape& shape = working->object.shape;
+      frame.centroid = geometry::CoreCentroid(shape);
+      frame.sigma_centroid = options.centroid_prior * geometry::RadiusAbout(shape, frame.centroid);
+      frame.rotation = registration->rotation_observable;
+      result = EstimateBatch(*working, model, config, &frame);
+      frame_state = internal::FrameState{frame.centroid, frame.sigma_centroid, frame.sigma_theta, frame.rotation, frame.frame};
+      // Final transform F * T, then its equivalent closest to angle 0 (F * T * C, C constant).
+      Eigen::Matrix3d J_refined_frame, J_final_refined;
+      ShapeTransform refined = registration->transform;
+      refined.pose = geometry::Compose(frame.frame, registration->transform.pose, &J_refined_frame);
+      alignment.transform = CanonicalTransform(refined, trajectory.object.shape, registration->symmetry_order);
+      geometry::Compose(refined.pose, geometry::Between(refined.pose, alignment.transform.pose), &J_final_refined);
+      alignment.refined = true;
+      if (frame.covariance) {
+        const Eigen::Matrix3d J = J_final_refined * J_refined_frame;
+        const Eigen::Matrix3d cov = J * *frame.covariance * J.transpose();
+        alignment.sigma = cov.diagonal().cwiseMax(0.0).cwiseSqrt();
+        if (!frame.rotation) alignment.sigma.z() = 0.0;
+      }
+    } else {
+      result = EstimateBatch(*working, model, config);
+    }
+  } else {
+    // Fixed-lag smoothing keeps the registered frame fixed (no static variable in the window).
+    IncrementalEstimator inc(*working, model, config);
+    while (!inc.Done()) inc.Update();
+    result = inc.Finish();
+  }
+  if (alignment.checked && !alignment.check.fits) {
+    const std::string what = "the object's shape does not fit this recording as given (" + alignment.check.Describe() + ")";
+    if (size_wins) {
+      char size[160];
+      std::snprintf(size, sizeof size, "the finger %.1f mm %s than given (radius %.1f mm instead of %.1f mm)",
+                    std::abs(registration->size_offset) * 1e3, registration->size_offset > 0 ? "larger" : "smaller",
+                    sized_radius * 1e3, finger.radius() * 1e3);
+      warnings.push_back(what + "; it fits as given with " + size +
+                         ": a wrong probe radius or object size? (the estimate uses the finger as given)");
+    } else if (align) {
+      RegistrationResult final_transform = *registration;
+      final_transform.transform = alignment.transform;
+      warnings.push_back(what + "; aligned it: " + final_transform.Describe() +
+                         " (to save it: pushgraph footprint SHAPE_FILE " + TransformText(alignment.transform) + ")");
+    } else if (misfit) {
+      warnings.push_back(what + "; estimates may be worse than the raw measurements. The contacts suggest " +
+                         registration->Describe() + ": --align-shape auto or on aligns it");
+    } else {
+      warnings.push_back(what + ", and no rigid placement fits it better: a wrong probe radius or object size?");
+    }
+  }
+
+  if (alignment.checked || !alignment.notes.empty()) result.shape_alignment = alignment;
+  if (config.diagnostics) {
+    result.diagnostics = internal::Diagnose(*working, model, config, result, frame_state ? &*frame_state : nullptr);
+    for (const std::string& cause : result.diagnostics->causes) warnings.push_back("diagnostics: " + cause);
+  }
+  result.warnings.insert(result.warnings.begin(), warnings.begin(), warnings.end());
+  return result;
 }
 
 }  // namespace pushgraph::graph

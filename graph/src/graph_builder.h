@@ -58,8 +58,29 @@ struct StepVars {
   double f[2] = {0, 0};
 };
 
+/// What a residual block is, for the per-type diagnostics (diagnostics.h).
+enum class FactorType {
+  kObjectPose, kFingerPose, kContactPoint, kForce,                 // M
+  kContactOnObject, kContactOnFinger, kTouching, kIntersection,    // C, S
+  kConstantVelocity, kZeroVelocity, kForceContinuity, kForcePrior, // motion priors
+  kQuasiStatic, kLimitSurfaceLoad,                                 // D
+  kPrior,                                                          // c, mu, shape frame, marginal
+};
+struct TaggedBlock {
+  FactorType type;
+  ceres::ResidualBlockId id;
+};
+
 class GraphBuilder {
  public:
+  /// Adds a residual block, records its type when RecordFactorTypes is on, and, for a factor
+  /// that places the object's shape (`object_pose_blocks` non-empty) while the shape frame is a
+  /// variable, wraps it in ShapeFrameFactor with those blocks composed with F.
+  ceres::ResidualBlockId Add(ceres::Problem& problem, FactorType type, ceres::CostFunction* cost,
+                             ceres::LossFunction* loss, std::vector<double*> blocks,
+                             std::vector<int> object_pose_blocks = {});
+  /// Every block Add()s from now on is appended to `tags` (nullptr: stop).
+  void RecordFactorTypes(std::vector<TaggedBlock>* tags) { tags_ = tags; }
   GraphBuilder(const limit_surface::Trajectory& trajectory, Model model, const EstimatorConfig& config);
   /// Online use (OnlineEstimator): `trajectory` starts with empty streams and grows as the
   /// caller appends measurements; steps come from AppendSteps. `streams` says which streams will
@@ -123,11 +144,26 @@ class GraphBuilder {
     return std::abs(value - 0.2 * start) <= 1e-6 * start || std::abs(value - 5.0 * start) <= 1e-6 * start;
   }
   double c_initial() const { return qs_.c; }
+  /// Makes the shape frame F (shape_frame.h) a static variable of every factor that places the
+  /// object's shape, with ShapeFramePrior(centroid, sigma_centroid, sigma_theta); `rotation`
+  /// false keeps F's angle at 0 (a circular outline: unobservable). frame_block() is then
+  /// non-null once such a factor was added.
+  void EnableShapeFrame(const Vec2& centroid, double sigma_centroid, double sigma_theta, bool rotation);
+  double* frame_block() { return frame_in_problem_ ? frame_ : nullptr; }
+  Pose2 frame() const { return {frame_[0], frame_[1], frame_[2]}; }
+  /// Sets variables to an estimate (diagnostics rebuild the graph there): step i's blocks from
+  /// `state` (a missing contact point from the object's closest boundary point, a missing force
+  /// 0), the shared c and mu (when estimated), the shape frame.
+  void SetState(int i, const StateEstimate& state);
+  void SetSharedParameters(std::optional<double> c, std::optional<double> mu);
+  void SetFrame(const Pose2& frame) { frame_[0] = frame.x; frame_[1] = frame.y; frame_[2] = frame.theta; }
+  const geometry::ShapePairQuerier& querier() const { return *querier_; }
   /// The estimate of step i (no covariances).
   StateEstimate State(int i) const;
 
  private:
   ceres::LossFunction* MakeLoss(const LossConfig& loss) const;
+
   void AddKinematicFactors(ceres::Problem& problem, int i);
   void AddPoseMeasurementFactors(ceres::Problem& problem, int i);   ///< M of both poses
   void AddConstantVelocityFactors(ceres::Problem& problem, int i);  ///< V on steps i-2, i-1, i
@@ -152,6 +188,11 @@ class GraphBuilder {
   bool mu_in_problem_ = false;
   double mu_var_[1] = {0.0};
   bool use_load_factor_ = false;  ///< LimitSurfaceLoadFactor on (config + force stream)
+  bool shape_frame_ = false, frame_in_problem_ = false, frame_rotation_ = true;
+  double frame_[3] = {0.0, 0.0, 0.0};
+  Vec2 frame_centroid_ = Vec2::Zero();
+  std::vector<TaggedBlock>* tags_ = nullptr;
+  double frame_sigma_centroid_ = 0.01, frame_sigma_theta_ = 0.2;
 };
 
 /// Fills the covariances of `states` (indices `steps` into builder steps) by `method`
@@ -161,7 +202,19 @@ class GraphBuilder {
 std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder,
                                const std::vector<int>& steps, std::vector<StateEstimate>& states,
                                EstimatorConfig::CovarianceMethod method,
-                               EstimationResult* parameters = nullptr);
+                               EstimationResult* parameters = nullptr, Eigen::Matrix3d* frame_cov = nullptr);
+
+/// The shape frame of an estimate, for Diagnose.
+struct FrameState {
+  Vec2 centroid = Vec2::Zero();
+  double sigma_centroid = 0.01, sigma_theta = 0.2;
+  bool rotation = true;
+  Pose2 frame;
+};
+/// The self-diagnosis of `result` (diagnostics.h), estimated on `trajectory` (the shape used)
+/// with `model` and `config`; `frame` when the shape frame was a variable.
+Diagnostics Diagnose(const limit_surface::Trajectory& trajectory, Model model, const EstimatorConfig& config,
+                     const EstimationResult& result, const FrameState* frame);
 
 ceres::Solver::Options SolverOptions(int max_iterations, double function_tolerance);
 /// Diagnostics level from the environment, read once: PUSHGRAPH_SOLVER_LOG=1 prints every solve's

@@ -124,6 +124,24 @@ void FindContactPhase(MitRecording* rec, const MitReadOptions& o) {
   rec->contact_found = true;
   rec->contact_start = times.front();
   rec->contact_end = times.back();
+  if (rec->force_frozen && !s.object_pose.empty()) {
+    // Speed over 20 ms windows sees mocap jitter as motion, so a finger that slid past the end
+    // of a side kept "pushing" for up to 0.4 s in the rect1 files. The object comes to rest at
+    // its final pose when contact ends: the last sample farther from it than rest_tolerance
+    // (translation plus 0.05 m times the rotation) ends the contact phase.
+    const geometry::Pose2 last = s.object_pose.back().pose;
+    double rest_from = rec->contact_start;
+    for (const auto& p : s.object_pose) {
+      const double away = (p.pose.translation() - last.translation()).norm() + 0.05 * std::abs(Wrap(p.pose.theta - last.theta));
+      if (away > o.rest_tolerance) rest_from = p.t;
+    }
+    if (rest_from < rec->contact_end && rest_from > rec->contact_start) {
+      rec->notes.push_back("contact phase ends at " + std::to_string(rest_from - rec->contact_start) +
+                           " s, where the object comes to rest (the speed test alone: " +
+                           std::to_string(rec->contact_end - rec->contact_start) + " s)");
+      rec->contact_end = rest_from;
+    }
+  }
 }
 
 template <typename Sample>

@@ -66,6 +66,61 @@ std::string ResultToJson(const graph::EstimationResult& r, int indent) {
     if (r.mu_sigma) parameters["mu_sigma"] = *r.mu_sigma;
     if (r.mu_at_bound) parameters["mu_at_bound"] = true;
   }
+  if (r.shape_alignment) {
+    const graph::ShapeAlignment& a = *r.shape_alignment;
+    // The shape check and, when aligned, the transform used (shape file -> object frame).
+    Json shape = Json::object();
+    shape["checked"] = a.checked;
+    if (a.checked) {
+      shape["fits_as_given"] = a.check.fits;
+      shape["gap_median"] = a.check.gap_median;
+      shape["penetration_share"] = a.check.penetration_share;
+      shape["tolerance"] = a.check.tolerance;
+      shape["samples"] = a.check.samples;
+    }
+    shape["aligned"] = a.aligned;
+    if (a.suggested) {
+      Json t = {a.transform.pose.x, a.transform.pose.y, a.transform.pose.theta};
+      Json sigma = {a.sigma.x(), a.sigma.y(), a.rotation_observable ? Json(a.sigma.z()) : Json(nullptr)};
+      if (a.aligned) {
+        parameters["shape_transform"] = t;
+        parameters["shape_transform_sigma"] = sigma;
+        parameters["shape_scale"] = a.transform.scale;
+        parameters["shape_mirrored"] = a.transform.mirrored;
+      } else {
+        shape["suggested_transform"] = t;
+        shape["suggested_transform_sigma"] = sigma;
+        shape["suggested_scale"] = a.transform.scale;
+        shape["suggested_mirrored"] = a.transform.mirrored;
+      }
+      shape["rotation_observable"] = a.rotation_observable;
+      shape["refined_in_graph"] = a.refined;
+    }
+    if (!a.notes.empty()) shape["notes"] = a.notes;
+    j["shape"] = std::move(shape);
+  }
+  if (r.diagnostics) {
+    const graph::Diagnostics& d = *r.diagnostics;
+    Json factors = Json::object();
+    for (const graph::FactorStatistics& f : d.factors) {
+      factors[f.type] = {{"count", f.count},   {"dof", f.dof},      {"chi2", f.chi2},        {"expected", f.expected},
+                         {"ratio", f.Ratio()}, {"worst", f.worst}, {"worst_t", f.worst_t}};
+    }
+    Json faults = Json::array();
+    for (const graph::SensorFault& f : d.faults) faults.push_back({{"stream", f.stream}, {"kind", f.kind}, {"detail", f.detail}});
+    j["diagnostics"] = {{"factors", std::move(factors)},
+                        {"expected_from_covariance", d.expected_from_covariance},
+                        {"score", d.score},
+                        {"worst_factor", d.worst_factor},
+                        {"contact_steps", d.contact_steps},
+                        {"contact_gap", {{"median", d.gap_median}, {"rms", d.gap_rms}, {"p95", d.gap_p95}}},
+                        {"penetration_share", d.penetration_share},
+                        {"penetration_tolerance", d.penetration_tolerance},
+                        {"measured_contact_gap",
+                         {{"median", d.measured_gap_median}, {"mad", d.measured_gap_mad}, {"samples", d.measured_samples}}},
+                        {"sensor_faults", std::move(faults)},
+                        {"causes", d.causes}};
+  }
   if (!parameters.empty()) j["parameters"] = std::move(parameters);
   if (!r.warnings.empty()) j["warnings"] = r.warnings;
   if (!r.metrics.empty()) {

@@ -91,6 +91,21 @@ std::vector<std::string> JoinNegativeValues(const std::vector<std::string>& args
   return out;
 }
 
+void AddAlignShapeOption(CLI::App* sub, std::string* value) {
+  sub->add_option("--align-shape", *value,
+                  "Shape registration: auto (check the shape against the data, align it when it does not fit), "
+                  "on (always align), off (never; the check still warns). Default: the config's align_shape, auto")
+      ->check(CLI::IsMember({"auto", "on", "off"}));
+}
+
+graph::EstimatorConfig::AlignShape ParseAlignShape(const std::string& value) {
+  using A = graph::EstimatorConfig::AlignShape;
+  if (value == "on") return A::kOn;
+  if (value == "off") return A::kOff;
+  if (value == "auto") return A::kAuto;
+  throw CliError("--align-shape: expected auto, on or off, got " + value);
+}
+
 CLI::Validator FiniteNumber(double min, bool inclusive, const std::string& rule) {
   return CLI::Validator(
       [min, inclusive, rule](std::string& text) -> std::string {

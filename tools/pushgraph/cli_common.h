@@ -3,6 +3,7 @@
 // cmd_*.cpp and registers itself on the app; errors are thrown as CliError (or any
 // std::exception) and reported by main() as one line on stderr with exit status 1.
 #include <pushgraph/geometry/pose.h>
+#include <pushgraph/graph/config.h>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -40,6 +41,10 @@ std::vector<double> ParseNumbers(const std::string& text, std::size_t count, con
 /// NaN and infinities, which CLI11's range checks let through, with a short message ("must be a
 /// finite number > 0 (kg), got nan"). `rule` is shown in the message and the help.
 CLI::Validator FiniteNumber(double min, bool inclusive, const std::string& rule);
+/// The --align-shape option of estimate and evaluate: auto, on or off (empty: not given, the
+/// configuration's value stands).
+void AddAlignShapeOption(CLI::App* sub, std::string* value);
+graph::EstimatorConfig::AlignShape ParseAlignShape(const std::string& value);
 /// Formats a double with 17 significant digits (round-trips exactly).
 std::string FormatDouble(double value);
 /// Writes JSON with doubles printed to 17 significant digits.

@@ -30,6 +30,7 @@ struct EstimateOptions {
   std::string add_noise;
   std::uint64_t seed = 1;
   std::string svg;
+  std::string align_shape;  // empty: the configuration's (default auto)
 };
 
 geometry::Shape LoadShape(const std::string& path, const std::string& what) {
@@ -100,6 +101,7 @@ void RunEstimate(const EstimateOptions& o) {
   graph::EstimatorConfig config;
   if (traj.measurement_sigmas) config = graph::ApplyMeasurementSigmas(config, *traj.measurement_sigmas);
   if (!o.config.empty()) config = graph::LoadEstimatorConfig(o.config, config);
+  if (!o.align_shape.empty()) config.align_shape = ParseAlignShape(o.align_shape);
   if (mode == graph::Mode::kIncremental && (config.estimate_c || config.estimate_mu)) {
     throw CliError(o.config + ": estimate_c and estimate_mu are batch only (the incremental mode keeps c and mu "
                    "fixed): use --mode batch or drop them");
@@ -139,6 +141,12 @@ void RunEstimate(const EstimateOptions& o) {
     summary["mu"] = *result.mu;
     if (result.mu_sigma) summary["mu_sigma"] = *result.mu_sigma;
   }
+  if (result.shape_alignment && result.shape_alignment->aligned) {
+    const auto& t = result.shape_alignment->transform;
+    summary["shape_transform"] = {t.pose.x, t.pose.y, t.pose.theta};
+    if (t.scale != 1.0) summary["shape_scale"] = t.scale;
+    if (t.mirrored) summary["shape_mirrored"] = true;
+  }
   std::cout << DumpJson(summary, -1) << "\n";
 }
 
@@ -168,6 +176,7 @@ void RegisterEstimate(CLI::App& app) {
       ->check(CLI::IsMember({"gaussian", "bimodal"}));
   sub->add_option("--seed", opts->seed, "Seed of --add-noise")->capture_default_str();
   sub->add_option("--svg", opts->svg, "Also write a picture of the estimate (SVG)");
+  AddAlignShapeOption(sub, &opts->align_shape);
   sub->callback([opts]() { RunEstimate(*opts); });
 }
 

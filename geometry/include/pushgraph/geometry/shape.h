@@ -22,6 +22,7 @@
 
 namespace pushgraph::geometry {
 
+struct Pose2;  // pose.h
 using Ring = std::vector<Vec2>;
 
 struct Polygon {
@@ -84,5 +85,21 @@ Shape LoadShapeJson(const std::string& path);
 Shape ParseShapeJson(const std::string& json_text, const std::string& source_name = "<string>");
 std::string ShapeToJson(const Shape& shape, int indent = 2);
 void SaveShapeJson(const Shape& shape, const std::string& path);
+
+/// The shape mirrored (optionally), scaled about its frame's origin, then placed at `pose`:
+/// every point p becomes pose * (scale * M p), M = diag(1, -1) when `mirror` (a footprint seen
+/// from below) and the identity otherwise; the rounding radius becomes scale * radius. Moves a
+/// shape file into the frame a tracker reports (graph::RegisterShape) or changes its units
+/// (scale 0.001: millimetres to metres). Throws GeometryError for a non-finite pose or a scale
+/// that is not finite and > 0.
+Shape TransformShape(const Shape& shape, const Pose2& pose, double scale = 1.0, bool mirror = false);
+
+/// Area centroid of the core polygons (holes subtracted); the mean of the vertices for a point
+/// or segment core.
+Vec2 CoreCentroid(const Shape& shape);
+
+/// Largest distance from `centre` to the shape (rounding included): the radius of the smallest
+/// disk about `centre` that holds it.
+double RadiusAbout(const Shape& shape, const Vec2& centre);
 
 }  // namespace pushgraph::geometry

@@ -104,6 +104,9 @@ struct EstimatorConfig {
   int max_iterations = 100;
   double function_tolerance = 1e-6;
   bool covariance = true;  ///< marginal covariances of every state
+  /// Self-diagnosis of the estimate (diagnostics.h): rebuilds the graph at the estimate and
+  /// factorizes it once more for the expected chi-squares (about 10% of a QS batch solve).
+  bool diagnostics = true;
   /// How they are computed: kSelectedInversion (SparseMarginals: sparse Cholesky of J^T J and
   /// Takahashi's recursion, linear in the trajectory length; the default, falling back to
   /// ceres::Covariance when J^T J is too ill-conditioned) or kCeres (ceres::Covariance with
@@ -111,6 +114,16 @@ struct EstimatorConfig {
   /// JSON "covariance_method": "selected_inversion" | "ceres".
   enum class CovarianceMethod { kSelectedInversion, kCeres };
   CovarianceMethod covariance_method = CovarianceMethod::kSelectedInversion;
+  // Shape registration (registration.h): the object's shape file against the recording's frame.
+  /// kAuto (the default): check the shape as given against the contacts (graph::CheckShapeFit);
+  /// when it does not fit, align it (graph::RegisterShape, then the shape frame refined as a
+  /// static variable of the batch graph) and say so in the warnings. kOn: always align. kOff:
+  /// never (the check still warns). JSON "align_shape": "auto" | "on" | "off".
+  enum class AlignShape { kAuto, kOn, kOff };
+  AlignShape align_shape = AlignShape::kAuto;
+  /// Also estimate a continuous scale factor (disk fingers) when aligning; the units (m, cm, mm,
+  /// inch) and a mirrored file are always detected.
+  bool align_scale = false;
   // Incremental (fixed-lag smoothing).
   int incremental_window = 20;        ///< object measurement periods kept in the window
   int incremental_update_every = 5;   ///< object measurements between updates (k)

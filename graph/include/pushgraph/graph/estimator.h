@@ -21,7 +21,9 @@
 // SparseMarginals, marginals.h);
 // kIncremental is a fixed-lag smoother (incremental.h).
 #include <pushgraph/graph/config.h>
+#include <pushgraph/graph/diagnostics.h>
 #include <pushgraph/graph/factors.h>
+#include <pushgraph/graph/registration.h>
 #include <pushgraph/limit_surface/trajectory.h>
 
 #include <Eigen/Core>
@@ -64,6 +66,21 @@ struct SolverStats {
   std::string covariance_status = "not computed";
 };
 
+/// What the estimator did about the object's shape frame (EstimatorConfig::align_shape).
+struct ShapeAlignment {
+  bool checked = false;  ///< the check ran (it needs 8 contact samples with object poses)
+  ShapeFitCheck check;   ///< the shape as given against the recording
+  bool aligned = false;  ///< the estimate used the transformed shape
+  /// Shape file to object frame (geometry::TransformShape); with `aligned`, the one used (batch:
+  /// refined in the graph), else what the contacts suggest (when the shape did not fit).
+  ShapeTransform transform;
+  bool suggested = false;  ///< `transform` was computed (aligned, or suggested for a misfit)
+  Eigen::Vector3d sigma = Eigen::Vector3d::Zero();  ///< of (x, y, theta); theta 0 when unobservable
+  bool rotation_observable = true;
+  bool refined = false;  ///< refined as a static variable of the factor graph (batch)
+  std::vector<std::string> notes;  ///< registration's notes: symmetry, weak directions, ambiguity
+};
+
 struct EstimationResult {
   Model model = Model::kQs;
   Mode mode = Mode::kBatch;
@@ -86,6 +103,11 @@ struct EstimationResult {
   /// force_rms (N); the same of the raw measurements as measured_*; and the mean normalized
   /// estimation error squared object_pose_nees (dimension 3) etc. where covariances exist.
   std::map<std::string, double> metrics;
+  /// The shape check and alignment (RESULT.json parameters.shape_transform and "shape").
+  std::optional<ShapeAlignment> shape_alignment;
+  /// Self-diagnosis (config.diagnostics; RESULT.json "diagnostics"); its causes are also in
+  /// the warnings.
+  std::optional<Diagnostics> diagnostics;
   /// What the caller should know about the result, one sentence each (RESULT.json "warnings",
   /// printed by the tool): e.g. forces left out because nothing in the graph fixes their size.
   std::vector<std::string> warnings;

@@ -13,7 +13,8 @@
 // - a frozen force sensor (the rect1 files: 2 to 4 distinct values with spikes) is detected and
 //   the force stream dropped, with the reason in `force_fault`;
 // - the contact phase (files start and end without contact) is found from the force magnitude,
-//   or, when the force sensor is frozen, from the object's motion (it moves only while pushed).
+//   or, when the force sensor is frozen, from the object's motion (it moves only while pushed,
+//   and comes to rest at its final pose when the finger leaves it).
 //   Not from the shapes' separation: with time-interpolated poses the probe stays 1 to 2 mm from
 //   the ellip1 block throughout its pushes (stream latencies, calibration), so a distance test
 //   is unreliable on this data.
@@ -33,6 +34,9 @@ namespace pushgraph::io {
 struct MitReadOptions {
   double contact_force = 0.3;         ///< force magnitude that means contact (N)
   double moving_speed = 2e-3;         ///< object speed that means it is pushed, without force (m/s)
+  /// Without force: the contact phase ends where the object stays within this of its final pose
+  /// (m, translation plus 0.05 m times the rotation).
+  double rest_tolerance = 1e-3;
   double max_yaw_step = 0.5;          ///< larger steps between samples are tracker jumps (rad)
   int frozen_max_distinct = 8;        ///< at most this many distinct force values: frozen
   bool trim_to_contact = false;       ///< keep only samples within the contact phase

@@ -1,0 +1,289 @@
+// Self-diagnosis of an estimate (diagnostics.h): the graph rebuilt at the estimate, chi-square
+// per factor type against its leverage-corrected expectation, contact gaps, sensor faults and
+// the probable causes.
+#include "graph_builder.h"
+
+#include <pushgraph/geometry/point_query.h>
+#include <pushgraph/graph/diagnostics.h>
+#include <pushgraph/graph/marginals.h>
+#include <pushgraph/graph/registration.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <set>
+
+namespace pushgraph::graph::internal {
+namespace {
+
+using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+const char* TypeName(FactorType t) {
+  switch (t) {
+    case FactorType::kObjectPose: return "object_pose";
+    case FactorType::kFingerPose: return "finger_pose";
+    case FactorType::kContactPoint: return "contact_point";
+    case FactorType::kForce: return "force";
+    case FactorType::kContactOnObject: return "contact_on_object";
+    case FactorType::kContactOnFinger: return "contact_on_finger";
+    case FactorType::kTouching: return "touching";
+    case FactorType::kIntersection: return "intersection";
+    case FactorType::kConstantVelocity: return "constant_velocity";
+    case FactorType::kZeroVelocity: return "zero_velocity";
+    case FactorType::kForceContinuity: return "force_continuity";
+    case FactorType::kForcePrior: return "force_prior";
+    case FactorType::kQuasiStatic: return "quasi_static";
+    case FactorType::kLimitSurfaceLoad: return "limit_surface_load";
+    case FactorType::kPrior: return "priors";
+  }
+  return "?";
+}
+
+template <class... Args>
+std::string Format(const char* fmt, Args... args) {
+  char buf[320];
+  std::snprintf(buf, sizeof buf, fmt, args...);
+  return buf;
+}
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const std::size_t m = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + m, v.end());
+  return v[m];
+}
+
+// A stream that repeats its values: the share of samples equal to the previous one and the
+// number of distinct values (the MIT reader's frozen-sensor rule: few distinct values).
+template <class Sample, class Value>
+void CheckFrozen(const std::vector<Sample>& stream, const char* name, Value value, std::vector<SensorFault>* faults) {
+  if (stream.size() < 20) return;
+  int repeats = 0, longest = 0, run = 0;
+  std::set<std::vector<double>> distinct;
+  for (std::size_t i = 0; i < stream.size(); ++i) {
+    const std::vector<double> v = value(stream[i]);
+    if (i > 0 && v == value(stream[i - 1])) {
+      ++repeats;
+      longest = std::max(longest, ++run);
+    } else {
+      run = 0;
+    }
+    if (distinct.size() <= 64) distinct.insert(v);
+  }
+  const double share = static_cast<double>(repeats) / (stream.size() - 1);
+  const std::size_t few = std::max<std::size_t>(8, stream.size() / 50);
+  if (share >= 0.5 && distinct.size() <= few) {
+    faults->push_back({name, "frozen",
+                       Format("the %s stream repeats its previous value in %.0f%% of its %zu samples (%zu distinct values, "
+                              "longest run %d): a frozen sensor",
+                              name, share * 100.0, stream.size(), distinct.size(), longest)});
+  }
+}
+
+}  // namespace
+
+Diagnostics Diagnose(const limit_surface::Trajectory& traj, Model model, const EstimatorConfig& cfg,
+                     const EstimationResult& result, const FrameState* frame) {
+  Diagnostics d;
+  GraphBuilder builder(traj, model, cfg);
+  const int n = static_cast<int>(builder.steps().size());
+  if (n != static_cast<int>(result.states.size())) {
+    d.causes.push_back("diagnostics not computed: the estimate's steps do not match the trajectory's");
+    return d;
+  }
+  if (frame) builder.EnableShapeFrame(frame->centroid, frame->sigma_centroid, frame->sigma_theta, frame->rotation);
+  if (frame) builder.SetFrame(frame->frame);
+  if (result.c_estimated) builder.EnableCEstimation();
+  if (result.mu_estimated) builder.EnableMuEstimation();
+  builder.SetSharedParameters(result.c, result.mu);
+  for (int i = 0; i < n; ++i) builder.SetState(i, result.states[i]);
+  std::vector<TaggedBlock> tags;
+  builder.RecordFactorTypes(&tags);
+  ceres::Problem::Options po;
+  ceres::Problem problem(po);
+  for (int i = 0; i < n; ++i) builder.AddFactors(problem, i);
+  builder.RecordFactorTypes(nullptr);
+
+  // The step each residual block belongs to: its newest variable block's step.
+  std::map<const double*, int> step_of;
+  for (int i = 0; i < n; ++i) {
+    for (double* b : builder.Blocks(i)) step_of[b] = i;
+  }
+  // Leverages need the joint marginal covariance of each factor's blocks.
+  SparseMarginals marginals;
+  d.expected_from_covariance = cfg.covariance && marginals.Compute(problem);
+  long residual_dims = 0;
+  std::map<FactorType, FactorStatistics> stats;
+  std::vector<std::pair<FactorType, double>> block_norms;
+  for (const TaggedBlock& tag : tags) {
+    const ceres::CostFunction* cost = problem.GetCostFunctionForResidualBlock(tag.id);
+    const int m = cost->num_residuals();
+    std::vector<double*> blocks;
+    problem.GetParameterBlocksForResidualBlock(tag.id, &blocks);
+    std::vector<double> r(m);
+    std::vector<RowMatrix> J(blocks.size());
+    std::vector<double*> jac(blocks.size());
+    for (std::size_t k = 0; k < blocks.size(); ++k) {
+      J[k].resize(m, cost->parameter_block_sizes()[k]);
+      jac[k] = J[k].data();
+    }
+    double c = 0.0;
+    if (!problem.EvaluateResidualBlock(tag.id, false, &c, r.data(), d.expected_from_covariance ? jac.data() : nullptr)) continue;
+    FactorStatistics& f = stats[tag.type];
+    f.type = TypeName(tag.type);
+    ++f.count;
+    f.dof += m;
+    residual_dims += m;
+    const double norm2 = Eigen::Map<const Eigen::VectorXd>(r.data(), m).squaredNorm();
+    f.chi2 += norm2;
+    int step = 0;
+    for (double* b : blocks) {
+      auto it = step_of.find(b);
+      if (it != step_of.end()) step = std::max(step, it->second);
+    }
+    if (std::sqrt(norm2) > f.worst) {
+      f.worst = std::sqrt(norm2);
+      f.worst_t = builder.steps()[step].t;
+    }
+    block_norms.emplace_back(tag.type, std::sqrt(norm2));
+    if (d.expected_from_covariance) {
+      // Leverage tr(J Sigma J^T) over the blocks' joint covariance; pairs the factorization does
+      // not hold cannot occur (the blocks share this factor).
+      double lev = 0.0;
+      for (std::size_t a = 0; a < blocks.size(); ++a) {
+        for (std::size_t b = 0; b < blocks.size(); ++b) {
+          if (problem.IsParameterBlockConstant(blocks[a]) || problem.IsParameterBlockConstant(blocks[b])) continue;
+          const Eigen::MatrixXd S = a == b ? marginals.Covariance(blocks[a]) : marginals.CrossCovariance(blocks[a], blocks[b]);
+          lev += (J[a] * S * J[b].transpose()).trace();
+        }
+      }
+      f.expected += lev;  // subtracted from dof below
+    }
+  }
+  const double unknowns = [&] {
+    double total = 0.0;
+    std::vector<double*> all;
+    problem.GetParameterBlocks(&all);
+    for (double* b : all) total += problem.IsParameterBlockConstant(b) ? 0 : problem.ParameterBlockSize(b);
+    return total;
+  }();
+  for (auto& [type, f] : stats) {
+    f.expected = d.expected_from_covariance ? f.dof - f.expected
+                                            : f.dof * std::max(0.0, 1.0 - unknowns / std::max<long>(1, residual_dims));
+    f.expected = std::max(f.expected, 1e-3 * f.dof);
+    d.factors.push_back(f);
+  }
+
+  // Contact gaps at the estimate, and penetration over all steps.
+  std::vector<double> gaps;
+  int penetrating = 0;
+  const Pose2 F = frame ? frame->frame : Pose2{};
+  for (int i = 0; i < n; ++i) {
+    const StateEstimate& s = result.states[i];
+    const double sd = builder.querier().Query(geometry::Compose(s.object_pose, F), s.finger_pose).signed_distance;
+    penetrating += sd < -d.penetration_tolerance ? 1 : 0;
+    if (builder.steps()[i].in_contact) gaps.push_back(sd);
+  }
+  d.penetration_share = n > 0 ? static_cast<double>(penetrating) / n : 0.0;
+  d.contact_steps = static_cast<int>(gaps.size());
+  if (!gaps.empty()) {
+    d.gap_median = Median(gaps);
+    double sum = 0.0;
+    std::vector<double> mags;
+    for (double g : gaps) { sum += g * g; mags.push_back(std::abs(g)); }
+    d.gap_rms = std::sqrt(sum / gaps.size());
+    std::sort(mags.begin(), mags.end());
+    d.gap_p95 = mags[static_cast<std::size_t>(0.95 * (mags.size() - 1))];
+  }
+  // The measured gap: the (smoothed) measured finger against the shape as estimated with.
+  try {
+    RegistrationOptions ro = RegistrationOptionsFor(cfg);
+    const ContactPath path = MeasuredContactPath(traj, ro);
+    std::vector<double> mg;
+    for (const Pose2& rel : path.relative) {
+      mg.push_back(builder.querier().Query(F, rel).signed_distance);
+    }
+    d.measured_samples = static_cast<int>(mg.size());
+    if (!mg.empty()) {
+      d.measured_gap_median = Median(mg);
+      std::vector<double> dev;
+      for (double g : mg) dev.push_back(std::abs(g - d.measured_gap_median));
+      d.measured_gap_mad = Median(dev);
+    }
+  } catch (const GraphError&) {
+    // Fewer than a handful of contact samples: no measured gap.
+  }
+
+  // Sensor faults: frozen streams, and spikes (isolated residuals beyond 6 sigma).
+  const auto& m = traj.measured;
+  auto pose_value = [](const limit_surface::PoseSample& s) { return std::vector<double>{s.pose.x, s.pose.y, s.pose.theta}; };
+  CheckFrozen(m.object_pose, "object_pose", pose_value, &d.faults);
+  CheckFrozen(m.finger_pose, "finger_pose", pose_value, &d.faults);
+  CheckFrozen(m.contact_point, "contact_point", [](const limit_surface::PointSample& s) { return std::vector<double>{s.point.x(), s.point.y()}; }, &d.faults);
+  CheckFrozen(m.force, "force", [](const limit_surface::ForceSample& s) { return std::vector<double>{s.force.x(), s.force.y()}; }, &d.faults);
+  for (FactorType t : {FactorType::kObjectPose, FactorType::kFingerPose, FactorType::kContactPoint, FactorType::kForce}) {
+    int count = 0, spikes = 0;
+    double worst = 0.0;
+    for (const auto& [type, norm] : block_norms) {
+      if (type != t) continue;
+      ++count;
+      if (norm > 6.0) { ++spikes; worst = std::max(worst, norm); }
+    }
+    // Isolated: at most 2% of the samples; and not one unlucky 6-sigma draw: two or more of
+    // them, or one beyond 10 sigma.
+    if (spikes > 0 && spikes <= std::max(1, count / 50) && (spikes >= 2 || worst > 10.0)) {
+      double at = 0.0;
+      for (const FactorStatistics& f : d.factors) if (f.type == TypeName(t)) at = f.worst_t;
+      d.faults.push_back({TypeName(t), "spikes",
+                          Format("the %s stream has %d of %d samples more than 6 sigma from the estimate (worst %.1f "
+                                 "sigma at t = %.3f s): spikes",
+                                 TypeName(t), spikes, count, worst, at)});
+    }
+  }
+
+  // The health figure and the probable causes.
+  static const std::set<std::string> kJudged = {"object_pose", "finger_pose",  "contact_point",     "force",
+                                                "touching",    "intersection", "contact_on_object", "contact_on_finger",
+                                                "quasi_static"};
+  for (const FactorStatistics& f : d.factors) {
+    if (kJudged.count(f.type) && f.dof >= 20 && f.Ratio() > d.score) {
+      d.score = f.Ratio();
+      d.worst_factor = f.type;
+    }
+  }
+  for (const SensorFault& fault : d.faults) {
+    d.causes.push_back(fault.kind == "frozen" ? "frozen sensor: " + fault.detail : "spiking sensor: " + fault.detail);
+  }
+  const double radius_tolerance = 1.5e-3;
+  if (d.measured_samples >= 20 && std::abs(d.measured_gap_median) > radius_tolerance &&
+      std::abs(d.measured_gap_median) > 3.0 * d.measured_gap_mad / std::sqrt(std::max(1.0, d.measured_samples / 10.0))) {
+    d.causes.push_back(Format("wrong probe radius or object size: during contact the measured finger stays %.1f mm %s the "
+                              "object's surface (median over %d samples); a finger radius %.1f mm %s would touch",
+                              std::abs(d.measured_gap_median) * 1e3, d.measured_gap_median > 0 ? "off" : "inside",
+                              d.measured_samples, std::abs(d.measured_gap_median) * 1e3,
+                              d.measured_gap_median > 0 ? "larger" : "smaller"));
+  }
+  if (d.penetration_share > 0.2) {
+    d.causes.push_back(Format("the finger is inside the object in %.0f%% of the steps (by more than %.1f mm): shape frame, "
+                              "units or probe radius?",
+                              d.penetration_share * 100.0, d.penetration_tolerance * 1e3));
+  }
+  for (const FactorStatistics& f : d.factors) {
+    if (f.dof < 20 || f.Ratio() <= 3.0) continue;
+    std::string why;
+    if (f.type == "object_pose" || f.type == "finger_pose") why = "the tracker's noise is larger than its sigma, or it jumps";
+    else if (f.type == "force") why = "the force sensor's noise is larger than its sigma, or it is frozen or spiking";
+    else if (f.type == "contact_point") why = "the contact sensor's noise is larger than its sigma";
+    else if (f.type == "quasi_static" || f.type == "limit_surface_load")
+      why = "the pushing model does not hold (c, friction, several contacts) or the shape's centre of pressure is off";
+    else if (f.type == "touching" || f.type == "contact_on_object" || f.type == "contact_on_finger" || f.type == "intersection")
+      why = "the finger cannot touch the object where the data put it: shape frame, units or probe radius";
+    else continue;
+    d.causes.push_back(Format("%s residuals are %.1f times their expected size (chi-square %.0f for %.0f expected): %s",
+                              f.type.c_str(), f.Ratio(), f.chi2, f.expected, why.c_str()));
+  }
+  return d;
+}
+
+}  // namespace pushgraph::graph::internal

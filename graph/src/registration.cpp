@@ -1,0 +1,848 @@
+// Shape registration from recorded pushes (registration.h): smoothing, units and mirror
+// candidates, a global search over rotations with robust Gauss-Newton over the translation,
+// exact refinement with a calibration gap per recording, symmetry and observability, and the
+// "does the shape fit as given" check.
+#include <pushgraph/geometry/point_query.h>
+#include <pushgraph/geometry/shape_pair.h>
+#include <pushgraph/graph/factors.h>
+#include <pushgraph/graph/registration.h>
+
+#include <ceres/ceres.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+namespace pushgraph::graph {
+namespace {
+
+using geometry::Pose2;
+using geometry::Shape;
+using geometry::Vec2;
+
+constexpr double kPi = 3.14159265358979323846;
+
+template <class... Args>
+std::string Format(const char* fmt, Args... args) {
+  char buf[320];
+  std::snprintf(buf, sizeof buf, fmt, args...);
+  return buf;
+}
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const std::size_t m = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + m, v.end());
+  return v[m];
+}
+
+Vec2 Rotate(const Vec2& p, double angle) {
+  const double c = std::cos(angle), s = std::sin(angle);
+  return {c * p.x() - s * p.y(), s * p.x() + c * p.y()};
+}
+
+const char* UnitName(double scale) {
+  if (scale == 0.001) return "millimetres";
+  if (scale == 0.01) return "centimetres";
+  if (scale == 0.0254) return "inches";
+  return "metres";
+}
+
+// The outer rings of the core polygons as one shape without holes: what a finger can touch
+// from outside, and what symmetry is judged on.
+Shape OutlineOf(const Shape& shape) {
+  std::vector<geometry::Polygon> outers;
+  for (const geometry::Polygon& p : shape.polygons()) outers.push_back({p.outer, {}});
+  return Shape::FromPolygons(std::move(outers), shape.radius());
+}
+
+// Points on the outline: vertices and edge midpoints of the outer rings (at most 400).
+std::vector<Vec2> OutlineSamples(const Shape& shape) {
+  std::vector<Vec2> pts;
+  for (const geometry::Polygon& p : shape.polygons()) {
+    const int n = static_cast<int>(p.outer.size());
+    for (int i = 0; i < n; ++i) {
+      pts.push_back(p.outer[i]);
+      if (n > 1) pts.push_back(0.5 * (p.outer[i] + p.outer[(i + 1) % n]));
+    }
+  }
+  if (pts.size() > 400) {
+    std::vector<Vec2> fewer;
+    const double step = static_cast<double>(pts.size()) / 400.0;
+    for (int i = 0; i < 400; ++i) fewer.push_back(pts[static_cast<std::size_t>(i * step)]);
+    pts = std::move(fewer);
+  }
+  return pts;
+}
+
+// Contact samples of one or more recordings: the finger's reference point and pose in the
+// object frame, the recording each comes from, and its weight (1 / samples per correlation time).
+struct Contacts {
+  std::vector<Vec2> q;
+  std::vector<Pose2> relative;
+  std::vector<int> recording;
+  std::vector<double> weight;
+  int recordings = 0;
+  double raw_noise = 0.0;  // of q from the measurement sigmas (0: unknown)
+
+  std::size_t size() const { return q.size(); }
+  // At most `count` samples, evenly spaced, with the weights of their recordings rescaled so
+  // that each recording still counts as (its span / correlation time) independent samples.
+  Contacts Subsampled(int count, const std::vector<double>& spans, double correlation_time) const {
+    Contacts out;
+    out.recordings = recordings;
+    out.raw_noise = raw_noise;
+    const double step = std::max(1.0, static_cast<double>(q.size()) / count);
+    for (double k = 0.0; static_cast<std::size_t>(k) < q.size(); k += step) {
+      const std::size_t i = static_cast<std::size_t>(k);
+      out.q.push_back(q[i]);
+      out.relative.push_back(relative[i]);
+      out.recording.push_back(recording[i]);
+    }
+    std::vector<int> per(recordings, 0);
+    for (int r : out.recording) ++per[r];
+    for (int r : out.recording) {
+      const double independent = std::max(1.0, spans[r] / correlation_time);
+      out.weight.push_back(std::min(1.0, independent / per[r]));
+    }
+    return out;
+  }
+};
+
+// One placement of the candidate shape in the object frame, and each recording's gap.
+struct Placement {
+  Eigen::Vector3d x = Eigen::Vector3d::Zero();  // tx, ty, theta
+  double log_scale = 0.0;                       // relative to the candidate's units
+  Eigen::VectorXd gap;                          // per recording (m)
+  double cost = INFINITY;
+};
+
+// Which parameters a minimization moves.
+struct Active {
+  bool translation = true, rotation = true, scale = false, gaps = true;
+};
+
+// Robust negative log-likelihood of a placement:
+//   sum_i w_i a log(1 + (d_i / c)^2) + |centroid prior|^2 / 2 + sum_k (gap_k / gap_sigma)^2 / 2,
+// d_i = sd(placed shape, q_i) - r - gap_{rec(i)}, Cauchy scale c = max(1 mm, 2 noise) and
+// a = c^2 / (2 noise^2) (d^2 / (2 noise^2) for small d). Its Gauss-Newton information is the
+// inverse covariance of the parameters.
+class ContactFit {
+ public:
+  ContactFit(const Shape& shape, const Contacts& contacts, const Shape& finger, const FingerDisk& disk, double noise,
+             double prior_sigma, double gap_sigma)
+      : shape_(shape), c_(contacts), finger_(finger), disk_(disk), centroid_(geometry::CoreCentroid(shape)),
+        prior_sigma_(prior_sigma), gap_sigma_(gap_sigma) {
+    set_noise(noise);
+  }
+
+  void UseExactFinger() {
+    if (disk_.exact || querier_) return;
+    geometry::ShapePairQuerier::Options o;
+    o.angle_cache_resolution = 5e-3;
+    o.max_cached_angles = 2048;
+    o.check_rounded_depth = false;
+    querier_ = std::make_unique<geometry::ShapePairQuerier>(shape_, finger_, o);
+  }
+  void set_noise(double noise) {
+    noise_ = noise;
+    cauchy_ = std::max(1e-3, 2.0 * noise);
+    a_ = cauchy_ * cauchy_ / (2.0 * noise * noise);
+  }
+  std::size_t size() const { return c_.size(); }
+  Placement Start() const {
+    Placement p;
+    p.gap = Eigen::VectorXd::Zero(c_.recordings);
+    return p;
+  }
+
+  // The gap of sample i without the recording's calibration gap (sd - r, or the exact
+  // separation), and its gradient with respect to (tx, ty, theta, log s).
+  double RawGap(std::size_t i, const Placement& p, Eigen::Vector4d* J) const {
+    const Pose2 T{p.x.x(), p.x.y(), p.x.z()};
+    if (querier_) {
+      geometry::ShapePairJacobians Js;
+      const auto r = querier_->Query(T, c_.relative[i], &Js);
+      if (J) *J << Js.J_sd_object_pose.transpose(), 0.0;
+      return r.signed_distance;
+    }
+    const double s = std::exp(p.log_scale);
+    Eigen::Matrix<double, 2, 3> J_local_T;
+    const Vec2 local = geometry::InverseAct(T, c_.q[i], J ? &J_local_T : nullptr);
+    // The shape scaled by s: s * sd(S, local / s).
+    const geometry::PointQuery pq = geometry::QueryPoint(shape_, Vec2(local / s));
+    const double sd = s * pq.signed_distance;
+    if (J) {
+      J->head<3>() = (pq.normal.transpose() * J_local_T).transpose();
+      (*J)(3) = sd - pq.normal.dot(local);
+    }
+    return sd - disk_.radius;
+  }
+  double Gap(std::size_t i, const Placement& p) const { return RawGap(i, p, nullptr) - p.gap(c_.recording[i]); }
+
+  // The scaled centroid placed by T, over the prior sigma, with its Jacobian (tx, ty, theta, log s).
+  Vec2 Prior(const Placement& p, Eigen::Matrix<double, 2, 4>* J) const {
+    const Vec2 sc = std::exp(p.log_scale) * centroid_;
+    if (J) {
+      J->setZero();
+      J->block<2, 2>(0, 0) = Eigen::Matrix2d::Identity();
+      J->col(2) = Rotate(sc, p.x.z() + 0.5 * kPi);
+      J->col(3) = Rotate(sc, p.x.z());
+      *J /= prior_sigma_;
+    }
+    return (Rotate(sc, p.x.z()) + p.x.head<2>()) / prior_sigma_;
+  }
+
+  double Cost(const Placement& p, bool gap_prior = true) const {
+    double f = 0.0;
+    for (std::size_t i = 0; i < size(); ++i) {
+      const double z = Gap(i, p) / cauchy_;
+      f += c_.weight[i] * a_ * std::log1p(z * z);
+    }
+    f += 0.5 * Prior(p, nullptr).squaredNorm();
+    if (gap_prior && gap_sigma_ > 0.0) f += 0.5 * (p.gap / gap_sigma_).squaredNorm();
+    return f;
+  }
+
+  // Levenberg-Marquardt over the active parameters; returns the final cost. `info`: the
+  // Gauss-Newton information in the order (active of tx, ty, theta, log s), then the gaps.
+  double Minimize(Placement* p, const Active& act, int max_iterations, Eigen::MatrixXd* info = nullptr) const {
+    std::vector<int> idx;  // indices into (tx, ty, theta, log s)
+    if (act.translation) { idx.push_back(0); idx.push_back(1); }
+    if (act.rotation) idx.push_back(2);
+    if (act.scale) idx.push_back(3);
+    const int np = static_cast<int>(idx.size());
+    const int ng = act.gaps && gap_sigma_ > 0.0 ? c_.recordings : 0;
+    const int n = np + ng;
+    auto normal_equations = [&](const Placement& pl, Eigen::MatrixXd* H, Eigen::VectorXd* g) {
+      H->setZero(n, n);
+      g->setZero(n);
+      double f = 0.0;
+      Eigen::Vector4d J4;
+      Eigen::VectorXd J(n);
+      for (std::size_t i = 0; i < size(); ++i) {
+        const double d = RawGap(i, pl, &J4) - pl.gap(c_.recording[i]);
+        const double z2 = (d / cauchy_) * (d / cauchy_);
+        f += c_.weight[i] * a_ * std::log1p(z2);
+        const double w = c_.weight[i] / (noise_ * noise_ * (1.0 + z2));  // IRLS weight of the Cauchy loss
+        J.setZero();
+        for (int k = 0; k < np; ++k) J(k) = J4(idx[k]);
+        if (ng > 0) J(np + c_.recording[i]) = -1.0;
+        H->noalias() += w * J * J.transpose();
+        *g += w * d * J;
+      }
+      Eigen::Matrix<double, 2, 4> Jp;
+      const Vec2 rp = Prior(pl, &Jp);
+      f += 0.5 * rp.squaredNorm();
+      for (int a = 0; a < np; ++a) {
+        (*g)(a) += Jp.col(idx[a]).dot(rp);
+        for (int b = 0; b < np; ++b) (*H)(a, b) += Jp.col(idx[a]).dot(Jp.col(idx[b]));
+      }
+      if (gap_sigma_ > 0.0) f += 0.5 * (pl.gap / gap_sigma_).squaredNorm();
+      for (int k = 0; k < ng; ++k) {
+        (*H)(np + k, np + k) += 1.0 / (gap_sigma_ * gap_sigma_);
+        (*g)(np + k) += pl.gap(k) / (gap_sigma_ * gap_sigma_);
+      }
+      return f;
+    };
+    auto apply = [&](const Placement& pl, const Eigen::VectorXd& step) {
+      Placement out = pl;
+      Eigen::Vector4d v;
+      v << pl.x, pl.log_scale;
+      for (int k = 0; k < np; ++k) v(idx[k]) += step(k);
+      out.x = v.head<3>();
+      out.log_scale = v(3);
+      for (int k = 0; k < ng; ++k) out.gap(k) += step(np + k);
+      return out;
+    };
+    Eigen::MatrixXd H;
+    Eigen::VectorXd g;
+    double f = normal_equations(*p, &H, &g);
+    double lambda = 1e-4;
+    for (int it = 0; it < max_iterations && n > 0; ++it) {
+      Eigen::MatrixXd A = H;
+      A.diagonal() += lambda * (H.diagonal().array() + 1e-12).matrix();
+      const Eigen::VectorXd step = -A.ldlt().solve(g);
+      if (!step.allFinite()) break;
+      const Placement trial = apply(*p, step);
+      Eigen::MatrixXd Ht;
+      Eigen::VectorXd gt;
+      const double ft = normal_equations(trial, &Ht, &gt);
+      if (ft < f) {
+        const bool converged = f - ft < 1e-10 * (1.0 + f);
+        *p = trial;
+        f = ft;
+        H = Ht;
+        g = gt;
+        lambda = std::max(lambda * 0.3, 1e-9);
+        if (converged) break;
+      } else {
+        lambda *= 10.0;
+        if (lambda > 1e8) break;
+      }
+    }
+    p->cost = f;
+    if (info) *info = H;
+    return f;
+  }
+
+ private:
+  const Shape& shape_;
+  const Contacts& c_;
+  const Shape& finger_;
+  FingerDisk disk_;
+  Vec2 centroid_;
+  double prior_sigma_, gap_sigma_;
+  double noise_ = 1e-3, cauchy_ = 2e-3, a_ = 2.0;
+  std::unique_ptr<geometry::ShapePairQuerier> querier_;
+};
+
+// Whether placements a and b of a shape coincide on its outline within tolerance.
+bool SamePlacement(const Shape& outline, const std::vector<Vec2>& samples, const Placement& a, const Placement& b,
+                   double tolerance) {
+  const Pose2 Ta{a.x.x(), a.x.y(), a.x.z()}, Tb{b.x.x(), b.x.y(), b.x.z()};
+  const Pose2 rel = geometry::Between(Tb, Ta);  // Tb^-1 Ta
+  const double sa = std::exp(a.log_scale), sb = std::exp(b.log_scale);
+  for (const Vec2& p : samples) {
+    const Vec2 w = geometry::Act(rel, Vec2(sa * p)) / sb;
+    if (std::abs(sb * geometry::QueryPoint(outline, w).signed_distance) > tolerance) return false;
+  }
+  return true;
+}
+
+// A pose stream smoothed by the estimator's motion-only prior: pose measurements and the
+// white-noise-acceleration constant-velocity factor (factors.h), solved with Ceres.
+std::vector<limit_surface::PoseSample> Smoothed(const std::vector<limit_surface::PoseSample>& in, double sigma_t,
+                                                double sigma_r, double accel_t, double accel_r) {
+  const int n = static_cast<int>(in.size());
+  if (n < 3) return in;
+  std::vector<double> x(3 * n);
+  for (int i = 0; i < n; ++i) {
+    x[3 * i] = in[i].pose.x;
+    x[3 * i + 1] = in[i].pose.y;
+    // Continuous angles: the chart coordinate must not jump by 2 pi between samples.
+    x[3 * i + 2] = i == 0 ? in[0].pose.theta : x[3 * i - 1] + geometry::WrapAngle(in[i].pose.theta - x[3 * i - 1]);
+  }
+  ceres::Problem problem;
+  for (int i = 0; i < n; ++i) {
+    problem.AddResidualBlock(new PoseMeasurementFactor(in[i].pose, sigma_t, sigma_r), nullptr, &x[3 * i]);
+    if (i < 2) continue;
+    const double dt1 = in[i - 1].t - in[i - 2].t, dt2 = in[i].t - in[i - 1].t;
+    if (!(dt1 > 0.0 && dt2 > 0.0)) continue;
+    problem.AddResidualBlock(new ConstantVelocityFactor(dt1, dt2, ConstantVelocitySigma(accel_t, dt1, dt2),
+                                                        ConstantVelocitySigma(accel_r, dt1, dt2)),
+                             nullptr, &x[3 * i - 6], &x[3 * i - 3], &x[3 * i]);
+  }
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  options.max_num_iterations = 10;
+  options.function_tolerance = 1e-4;
+  options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  std::vector<limit_surface::PoseSample> out = in;
+  for (int i = 0; i < n; ++i) out[i].pose = {x[3 * i], x[3 * i + 1], x[3 * i + 2]};
+  return out;
+}
+
+// Every recording's contacts, pooled, with each recording's span (s).
+Contacts PoolContacts(const std::vector<const limit_surface::Trajectory*>& recordings, const RegistrationOptions& o,
+                      std::vector<double>* spans) {
+  if (recordings.empty() || recordings.front() == nullptr) throw GraphError("registration: no recording");
+  const limit_surface::Trajectory& first = *recordings.front();
+  if (first.object.shape.empty()) throw GraphError("registration: the object shape is empty");
+  Contacts pooled;
+  pooled.recordings = static_cast<int>(recordings.size());
+  spans->clear();
+  for (std::size_t k = 0; k < recordings.size(); ++k) {
+    const limit_surface::Trajectory& traj = *recordings[k];
+    if (traj.measured.object_pose.empty() || traj.measured.finger_pose.empty()) {
+      throw GraphError("registration: recording " + std::to_string(k) + " has no object or no finger pose measurements");
+    }
+    if (k > 0 && (traj.object.shape.num_vertices() != first.object.shape.num_vertices() ||
+                  traj.finger.shape.num_vertices() != first.finger.shape.num_vertices())) {
+      throw GraphError("registration: recording " + std::to_string(k) + " has another object or finger shape than the first");
+    }
+    const ContactPath path = MeasuredContactPath(traj, o);
+    pooled.q.insert(pooled.q.end(), path.q.begin(), path.q.end());
+    pooled.relative.insert(pooled.relative.end(), path.relative.begin(), path.relative.end());
+    pooled.recording.insert(pooled.recording.end(), path.q.size(), static_cast<int>(k));
+    spans->push_back(path.t.empty() ? 0.0 : path.t.back() - path.t.front());
+    if (traj.measurement_sigmas && !path.q.empty()) {
+      const auto& sg = *traj.measurement_sigmas;
+      std::vector<double> radii;
+      for (const Vec2& q : path.q) radii.push_back(q.norm());
+      const double r = Median(radii);
+      pooled.raw_noise = std::max(pooled.raw_noise, std::sqrt(sg.finger_trans * sg.finger_trans + sg.object_trans * sg.object_trans +
+                                                              std::pow(sg.object_rot * r, 2)));
+    }
+  }
+  if (pooled.q.size() < 8) {
+    throw GraphError("registration: only " + std::to_string(pooled.q.size()) +
+                     " finger samples in contact with an object pose near them (at least 8 needed)");
+  }
+  pooled.weight.assign(pooled.q.size(), 1.0);
+  return pooled;
+}
+
+// The shape as given against the contacts: median |gap| and the share penetrating beyond the
+// tolerance max(fit_tolerance, raw_noise / 2) (smoothing takes the raw noise down about 4x).
+ShapeFitCheck CheckContacts(const Shape& shape, const Shape& finger, const Contacts& c, const RegistrationOptions& o) {
+  ShapeFitCheck check;
+  check.tolerance = std::max(o.fit_tolerance, 0.5 * c.raw_noise);
+  ContactFit fit(shape, c, finger, FingerAsDisk(finger), 1e-3, 1.0, 0.0);
+  fit.UseExactFinger();
+  const Placement identity = fit.Start();
+  std::vector<double> gaps;
+  int penetrating = 0;
+  for (std::size_t i = 0; i < fit.size(); ++i) {
+    const double g = fit.Gap(i, identity);
+    gaps.push_back(std::abs(g));
+    penetrating += g < -check.tolerance ? 1 : 0;
+  }
+  check.samples = static_cast<int>(gaps.size());
+  check.gap_median = Median(gaps);
+  check.penetration_share = static_cast<double>(penetrating) / std::max<std::size_t>(1, gaps.size());
+  check.fits = check.gap_median <= check.tolerance && check.penetration_share <= 0.1;
+  return check;
+}
+
+}  // namespace
+
+RegistrationOptions RegistrationOptionsFor(const EstimatorConfig& config) {
+  RegistrationOptions o;
+  o.contact_max_gap = config.contact_max_gap;
+  o.contact_force_threshold = config.contact_force_threshold;
+  o.pose_sigma_trans = config.object_pose_sigma_trans;
+  o.pose_sigma_rot = config.object_pose_sigma_rot;
+  o.accel_trans = config.accel_trans;
+  o.accel_rot = config.accel_rot;
+  return o;
+}
+
+geometry::Shape RegistrationResult::Apply(const geometry::Shape& shape) const {
+  if (transform.IsIdentity()) return shape;
+  return geometry::TransformShape(shape, transform.pose, transform.scale, transform.mirrored);
+}
+
+std::string RegistrationResult::Describe() const {
+  std::string s = Format("turned by %.1f deg, shifted by (%.1f, %.1f) mm", transform.pose.theta * 180.0 / kPi,
+                         transform.pose.x * 1e3, transform.pose.y * 1e3);
+  if (transform.mirrored) s = "mirrored (y -> -y), " + s;
+  if (transform.scale != 1.0) {
+    s += Format(", scale %.6g", transform.scale);
+    const std::string unit = UnitName(transform.scale);
+    if (unit != "metres") s += " (the file is in " + unit + ")";
+  }
+  if (!rotation_observable) s += "; rotation unobservable (circular outline)";
+  return s;
+}
+
+std::string ShapeFitCheck::Describe() const {
+  return Format("median contact gap %.1f mm, %.0f%% of the contact samples inside the shape by more than %.1f mm (%d samples)",
+                gap_median * 1e3, penetration_share * 100.0, tolerance * 1e3, samples);
+}
+
+ShapeTransform CanonicalTransform(const ShapeTransform& transform, const geometry::Shape& file_shape, int symmetry_order) {
+  ShapeTransform out = transform;
+  out.pose.theta = geometry::WrapAngle(out.pose.theta);
+  if (symmetry_order < 2) return out;
+  // Turning the shape by m 2 pi / k about its centroid c leaves it unchanged:
+  // T' = T * Rot_c(-m 2 pi / k), Rot_c(phi) = (c - R(phi) c, phi), c in scaled (mirrored) units.
+  const double step = 2.0 * kPi / symmetry_order;
+  const double turn = std::round(out.pose.theta / step) * step;
+  Vec2 c = geometry::CoreCentroid(file_shape) * transform.scale;
+  if (transform.mirrored) c.y() = -c.y();
+  const Vec2 shift = Rotate(c - Rotate(c, -turn), out.pose.theta);
+  out.pose = {out.pose.x + shift.x(), out.pose.y + shift.y(), geometry::WrapAngle(out.pose.theta - turn)};
+  return out;
+}
+
+FingerDisk FingerAsDisk(const geometry::Shape& finger) {
+  if (finger.empty()) throw GraphError("registration: the finger shape is empty");
+  FingerDisk d;
+  const auto& polys = finger.polygons();
+  if (finger.is_degenerate_core() && polys.size() == 1 && polys[0].outer.size() == 1) {
+    d.centre = polys[0].outer[0];
+    d.radius = finger.radius();
+    d.exact = true;
+    return d;
+  }
+  d.centre = geometry::CoreCentroid(finger);
+  const double outer = geometry::RadiusAbout(finger, d.centre);
+  const double inner = finger.is_degenerate_core()
+                           ? finger.radius()
+                           : std::max(0.0, -geometry::QueryPoint(finger, d.centre).signed_distance);
+  d.radius = 0.5 * (outer + inner);
+  return d;
+}
+
+int OutlineSymmetryOrder(const geometry::Shape& shape, const geometry::Vec2& centre, double tolerance) {
+  const Shape outline = OutlineOf(shape);
+  const std::vector<Vec2> samples = OutlineSamples(shape);
+  double rmin = INFINITY, rmax = 0.0;
+  for (const Vec2& p : samples) {
+    rmin = std::min(rmin, (p - centre).norm());
+    rmax = std::max(rmax, (p - centre).norm());
+  }
+  if (rmax - rmin <= tolerance) return 0;
+  for (int k = 12; k >= 2; --k) {
+    bool symmetric = true;
+    for (const Vec2& p : samples) {
+      const Vec2 turned = centre + Rotate(p - centre, 2.0 * kPi / k);
+      // Compare cores: the rounding radius is the same everywhere.
+      if (std::abs(geometry::QueryPoint(outline, turned).signed_distance + outline.radius()) > tolerance) {
+        symmetric = false;
+        break;
+      }
+    }
+    if (symmetric) return k;
+  }
+  return 1;
+}
+
+ContactPath MeasuredContactPath(const limit_surface::Trajectory& traj, const RegistrationOptions& o) {
+  const auto& m = traj.measured;
+  const FingerDisk disk = FingerAsDisk(traj.finger.shape);
+  std::vector<limit_surface::PoseSample> objects = m.object_pose, fingers = m.finger_pose;
+  if (o.smooth) {
+    double st = o.pose_sigma_trans, sr = o.pose_sigma_rot, ft = o.pose_sigma_trans;
+    if (traj.measurement_sigmas) {
+      // Noise-free streams still need a finite weight (ApplyMeasurementSigmas' floors).
+      st = std::max(traj.measurement_sigmas->object_trans, 1e-4);
+      sr = std::max(traj.measurement_sigmas->object_rot, 1e-3);
+      ft = std::max(traj.measurement_sigmas->finger_trans, 1e-4);
+    }
+    objects = Smoothed(objects, st, sr, o.accel_trans, o.accel_rot);
+    fingers = Smoothed(fingers, ft, 1.0, o.accel_trans, o.accel_rot);
+  }
+  auto nearest = [](const auto& stream, double t, int* index) {
+    auto it = std::lower_bound(stream.begin(), stream.end(), t, [](const auto& a, double tt) { return a.t < tt; });
+    double best = INFINITY;
+    *index = -1;
+    if (it != stream.end()) { best = it->t - t; *index = static_cast<int>(it - stream.begin()); }
+    if (it != stream.begin() && t - (it - 1)->t < best) { best = t - (it - 1)->t; *index = static_cast<int>(it - stream.begin()) - 1; }
+    return best;
+  };
+  ContactPath path;
+  for (const limit_surface::PoseSample& f : fingers) {
+    int k = -1;
+    if (!m.contact_point.empty()) {
+      if (nearest(m.contact_point, f.t, &k) > o.contact_max_gap) continue;
+    } else if (!m.force.empty()) {
+      if (nearest(m.force, f.t, &k) > o.contact_max_gap || m.force[k].force.norm() < o.contact_force_threshold) continue;
+    }
+    // The object pose at f.t, interpolated across gaps of at most max_object_gap.
+    auto it = std::lower_bound(objects.begin(), objects.end(), f.t - 1e-9, [](const auto& a, double tt) { return a.t < tt; });
+    if (it == objects.end()) continue;
+    Pose2 x;
+    if (std::abs(it->t - f.t) <= 1e-9) {
+      x = it->pose;
+    } else {
+      if (it == objects.begin() || it->t - (it - 1)->t > o.max_object_gap) continue;
+      x = limit_surface::PoseAtClamped(it - 1, it + 1, f.t);
+    }
+    const Pose2 rel = geometry::Between(x, f.pose);
+    path.t.push_back(f.t);
+    path.relative.push_back(rel);
+    path.q.push_back(geometry::Act(rel, disk.centre));
+  }
+  return path;
+}
+
+ShapeFitCheck CheckShapeFit(const limit_surface::Trajectory& trajectory, const RegistrationOptions& options) {
+  std::vector<double> spans;
+  const Contacts c = PoolContacts({&trajectory}, options, &spans);
+  return CheckContacts(trajectory.object.shape, trajectory.finger.shape,
+                       c.Subsampled(options.max_refine_samples, spans, options.correlation_time), options);
+}
+
+RegistrationResult RegisterShape(const limit_surface::Trajectory& trajectory, const RegistrationOptions& options) {
+  return RegisterShape(std::vector<const limit_surface::Trajectory*>{&trajectory}, options);
+}
+
+RegistrationResult RegisterShape(const std::vector<const limit_surface::Trajectory*>& recordings,
+                                 const RegistrationOptions& o) {
+  std::vector<double> spans;
+  const Contacts all = PoolContacts(recordings, o, &spans);
+  const Shape& file_shape = recordings.front()->object.shape;
+  const Shape& finger = recordings.front()->finger.shape;
+  const FingerDisk disk = FingerAsDisk(finger);
+  const Contacts search = all.Subsampled(o.max_search_samples, spans, o.correlation_time);
+  const Contacts refine = all.Subsampled(o.max_refine_samples, spans, o.correlation_time);
+  RegistrationResult result;
+  std::vector<double> radii;
+  for (const Vec2& q : all.q) radii.push_back(q.norm());
+  const double path_radius = Median(radii);
+  // Smoothing leaves about 0.4 of the raw noise, correlated over the correlation time; a fit of
+  // a few parameters absorbs part of that, so the residuals' spread alone underestimates it.
+  const double min_noise = std::max(3e-4, 0.4 * all.raw_noise);
+  // The smoothed path's noise: given, else estimated from the best fit's residuals below.
+  const double start_noise = o.noise > 0.0 ? o.noise : std::max(2e-3, 0.25 * all.raw_noise);
+  const Vec2 q_mid(Median([&] { std::vector<double> v; for (auto& q : search.q) v.push_back(q.x()); return v; }()),
+                   Median([&] { std::vector<double> v; for (auto& q : search.q) v.push_back(q.y()); return v; }()));
+
+  // Candidate files: units whose size matches the finger path, each as given and mirrored.
+  std::vector<double> scales{1.0};
+  if (o.detect_units) scales = {1.0, 0.01, 0.001, 0.0254};
+  const Vec2 file_centroid = geometry::CoreCentroid(file_shape);
+  const double file_radius = geometry::RadiusAbout(file_shape, file_centroid);
+  std::vector<double> plausible;
+  for (double s : scales) {
+    const double ratio = s * file_radius / std::max(path_radius, 1e-6);
+    if (ratio >= 0.25 && ratio <= 4.0) plausible.push_back(s);
+  }
+  if (plausible.empty()) {
+    plausible = scales;
+    result.notes.push_back(Format("no unit makes the shape (radius %.4g in file units) the size of the finger's path "
+                                  "(%.4g m from the object origin): every unit tried",
+                                  file_radius, path_radius));
+  }
+
+  struct FileCandidate {
+    double scale = 1.0;
+    bool mirrored = false;
+    std::shared_ptr<Shape> shape;      // the file's shape scaled (and mirrored): placed by T only
+    std::vector<Placement> placements;  // refined, best first
+    int symmetry = 1;
+    double radius = 0.0;
+    double noise = 0.0;
+  };
+  auto by_cost = [](const Placement& a, const Placement& b) { return a.cost < b.cost; };
+  std::vector<FileCandidate> files;
+  for (double s : plausible) {
+    for (bool mirror : {false, true}) {
+      if (mirror && !o.detect_mirror) continue;
+      FileCandidate f;
+      f.scale = s;
+      f.mirrored = mirror;
+      f.shape = std::make_shared<Shape>(s == 1.0 && !mirror ? file_shape
+                                                            : geometry::TransformShape(file_shape, Pose2{}, s, mirror));
+      const Vec2 centroid = geometry::CoreCentroid(*f.shape);
+      f.radius = geometry::RadiusAbout(*f.shape, centroid);
+      f.symmetry = OutlineSymmetryOrder(*f.shape, centroid, std::max(2.5e-4, 3e-3 * f.radius));
+      if (mirror && f.symmetry == 0) continue;  // a mirrored circle is the same circle
+      const double prior_sigma = o.centroid_prior * f.radius;
+      ContactFit coarse(*f.shape, search, finger, disk, start_noise, prior_sigma, o.gap_sigma);
+      // Global search over theta (one turn of the symmetry); translation and gaps by robust GN
+      // from the centroid-at-origin start and from a start that puts the nearest side under
+      // the middle of the path.
+      std::vector<Placement> grid;
+      const double span = f.symmetry == 0 ? 0.0 : 2.0 * kPi / f.symmetry;
+      const int count = f.symmetry == 0 ? 1 : std::max(1, static_cast<int>(std::ceil(span / o.rotation_step)));
+      Active translation_only;
+      translation_only.rotation = false;
+      for (int k = 0; k < count; ++k) {
+        const double theta = f.symmetry == 0 ? 0.0 : -0.5 * span + (k + 0.5) * span / count;
+        Placement a = coarse.Start();
+        a.x << -Rotate(centroid, theta), theta;
+        Placement b = a;
+        const geometry::PointQuery pq = geometry::QueryPoint(*f.shape, Pose2{a.x.x(), a.x.y(), theta}, q_mid);
+        b.x.head<2>() += q_mid - disk.radius * pq.normal - pq.closest_point;
+        coarse.Minimize(&a, translation_only, 12);
+        coarse.Minimize(&b, translation_only, 12);
+        grid.push_back(a.cost <= b.cost ? a : b);
+      }
+      // Local minima over the (cyclic) theta grid, best first, at most 4.
+      std::vector<Placement> minima;
+      const int n = static_cast<int>(grid.size());
+      for (int k = 0; k < n; ++k) {
+        if (n <= 2 || (grid[k].cost <= grid[(k + n - 1) % n].cost && grid[k].cost <= grid[(k + 1) % n].cost)) {
+          minima.push_back(grid[k]);
+        }
+      }
+      std::sort(minima.begin(), minima.end(), by_cost);
+      if (minima.size() > 4) minima.resize(4);
+      // Refinement with exact queries; the noise from the best fit's residuals unless given.
+      ContactFit fine(*f.shape, refine, finger, disk, start_noise, prior_sigma, o.gap_sigma);
+      fine.UseExactFinger();
+      Active all_active;
+      all_active.rotation = f.symmetry != 0;
+      for (Placement& c : minima) fine.Minimize(&c, all_active, 30);
+      std::sort(minima.begin(), minima.end(), by_cost);
+      f.noise = start_noise;
+      if (o.noise <= 0.0 && !minima.empty()) {
+        std::vector<double> gaps;
+        for (std::size_t i = 0; i < fine.size(); ++i) gaps.push_back(std::abs(fine.Gap(i, minima[0])));
+        f.noise = std::max(min_noise, 1.4826 * Median(gaps));
+        fine.set_noise(f.noise);
+        for (Placement& c : minima) fine.Minimize(&c, all_active, 30);
+        std::sort(minima.begin(), minima.end(), by_cost);
+      }
+      f.placements = minima;
+      if (!minima.empty()) files.push_back(std::move(f));
+    }
+  }
+  if (files.empty()) throw GraphError("registration: no placement of the shape could be fitted");
+  // The best file candidate at a common noise scale (each may have estimated its own); a
+  // mirrored file must fit clearly better than the file as given (6 in log-likelihood).
+  std::vector<double> costs;
+  for (const FileCandidate& f : files) {
+    ContactFit c(*f.shape, refine, finger, disk, files.front().noise, o.centroid_prior * f.radius, o.gap_sigma);
+    c.UseExactFinger();
+    costs.push_back(c.Cost(f.placements[0]) + (f.mirrored ? 6.0 : 0.0));
+  }
+  const std::size_t best_file = static_cast<std::size_t>(std::min_element(costs.begin(), costs.end()) - costs.begin());
+  const FileCandidate& f = files[best_file];
+  const double noise = f.noise;
+  ContactFit fit(*f.shape, refine, finger, disk, noise, o.centroid_prior * f.radius, o.gap_sigma);
+  fit.UseExactFinger();
+  Placement best = f.placements[0];
+  result.symmetry_order = f.symmetry;
+  result.rotation_observable = f.symmetry != 0;
+  result.noise = noise;
+  result.samples = static_cast<int>(fit.size());
+
+  // Continuous scale (disk fingers), then the information at the solution.
+  Active act;
+  act.rotation = f.symmetry != 0;
+  act.scale = o.estimate_scale && disk.exact;
+  Eigen::MatrixXd info;
+  fit.Minimize(&best, act, 30, &info);
+  const Eigen::MatrixXd cov = info.inverse();
+  {
+    int k = 0;
+    result.sigma.x() = std::sqrt(std::max(0.0, cov(k, k)));
+    result.sigma.y() = std::sqrt(std::max(0.0, cov(k + 1, k + 1)));
+    k = 2;
+    if (act.rotation) result.sigma.z() = std::sqrt(std::max(0.0, cov(k, k))), ++k;
+    if (act.scale) result.scale_sigma = std::sqrt(std::max(0.0, cov(k, k))) * f.scale * std::exp(best.log_scale);
+  }
+  result.transform.pose = {best.x.x(), best.x.y(), geometry::WrapAngle(best.x.z())};
+  result.transform.scale = f.scale * std::exp(best.log_scale);
+  result.transform.mirrored = f.mirrored;
+  // Of the equivalent turns of a symmetric outline, report the one closest to 0.
+  result.transform = CanonicalTransform(result.transform, file_shape, f.symmetry);
+  result.aligned_cost = best.cost;
+  result.gaps.assign(best.gap.data(), best.gap.data() + best.gap.size());
+
+  // The shape as given, scored by the same fit, and the gap statistics.
+  {
+    ContactFit as_given(file_shape, refine, finger, disk, noise, o.centroid_prior * file_radius, o.gap_sigma);
+    as_given.UseExactFinger();
+    Placement identity = as_given.Start();
+    as_given.Minimize(&identity, Active{false, false, false, true}, 20);  // its own calibration gaps
+    result.identity_cost = identity.cost;
+    std::vector<double> gaps;
+    for (std::size_t i = 0; i < as_given.size(); ++i) gaps.push_back(std::abs(as_given.Gap(i, as_given.Start())));
+    result.identity_gap_rms = 1.4826 * Median(gaps);
+    gaps.clear();
+    for (std::size_t i = 0; i < fit.size(); ++i) gaps.push_back(std::abs(fit.Gap(i, best)));
+    result.aligned_gap_rms = 1.4826 * Median(gaps);
+  }
+
+  // How far the transform moves the outline of the file's shape.
+  for (const Vec2& p : OutlineSamples(file_shape)) {
+    const Vec2 file_point(result.transform.scale * p.x(), (f.mirrored ? -1.0 : 1.0) * result.transform.scale * p.y());
+    result.displacement = std::max(result.displacement, (geometry::Act(result.transform.pose, file_point) - p).norm());
+  }
+  // The verdict rests on the shape as given alone, not on how much better the best fit is:
+  // a better fit can come from samples that were never in contact (a finger sliding past the
+  // end of a side makes the side look longer).
+  result.check = CheckContacts(file_shape, finger, refine, o);
+  const bool equivalent = result.displacement <= o.min_displacement;  // e.g. a quarter turn of a square
+  result.fits_as_given = (result.check.fits || equivalent) && result.transform.scale == 1.0 && !f.mirrored;
+  if (result.check.fits && !result.fits_as_given) {
+    result.notes.push_back("the contacts lie on the shape as given, but they fit it better in other units or mirrored");
+  }
+  // Another explanation of a misfit: the shape as given with the finger larger or smaller (a
+  // wrong probe radius or object size), each recording's gap free. Compared with the best
+  // placement on the data and the centroid prior (gap priors left out of both).
+  if (!result.fits_as_given) {
+    ContactFit sized(file_shape, refine, finger, disk, noise, o.centroid_prior * file_radius, 1.0);
+    sized.UseExactFinger();
+    // From the shape as given, the gaps first, then a local refinement of the placement.
+    Placement identity = sized.Start();
+    sized.Minimize(&identity, Active{false, false, false, true}, 30);
+    const double sized_cost = sized.Cost(identity, false);
+    const double placed_cost = fit.Cost(best, false);
+    result.size_offset = identity.gap.size() > 0 ? identity.gap.mean() : 0.0;
+    // A finger more than 3 times its radius (at least 5 mm) off is a frame error, not a size one.
+    const double plausible = std::max(5e-3, 3.0 * disk.radius);
+    // The placement has two more parameters (x, y, theta against the size): a BIC-like margin
+    // of log(independent samples) for them.
+    double independent = 0.0;
+    for (double w : refine.weight) independent += w;
+    result.size_explains = sized_cost <= placed_cost + std::log(std::max(2.0, independent)) &&
+                           std::abs(result.size_offset) <= plausible;
+    if (result.size_explains) {
+      result.notes.push_back(Format("the shape as given fits as well with the finger %.1f mm %s (cost %.1f against %.1f for the "
+                                    "best placement): a wrong probe radius or object size rather than a wrong frame",
+                                    std::abs(result.size_offset) * 1e3, result.size_offset > 0 ? "larger" : "smaller",
+                                    sized_cost, placed_cost));
+    }
+  }
+
+  // Directions the contacts leave to the prior: the data's information (the priors removed)
+  // below the centroid prior's 1 / sigma^2.
+  {
+    const double prior_sigma = o.centroid_prior * f.radius;
+    Eigen::Matrix<double, 2, 4> Jp;
+    fit.Prior(best, &Jp);
+    const int np = 2 + (act.rotation ? 1 : 0) + (act.scale ? 1 : 0);
+    Eigen::MatrixXd data = info;
+    std::vector<int> idx{0, 1};
+    if (act.rotation) idx.push_back(2);
+    if (act.scale) idx.push_back(3);
+    for (int a = 0; a < np; ++a) {
+      for (int b = 0; b < np; ++b) data(a, b) -= Jp.col(idx[a]).dot(Jp.col(idx[b]));
+    }
+    for (int k = np; k < data.rows(); ++k) data(k, k) -= 1.0 / (o.gap_sigma * o.gap_sigma);
+    // The translation's information with the rotation, scale and gaps eliminated.
+    Eigen::Matrix2d translation = data.topLeftCorner<2, 2>();
+    if (data.rows() > 2) {
+      const Eigen::MatrixXd B = data.topRightCorner(2, data.cols() - 2);
+      Eigen::MatrixXd C = data.bottomRightCorner(data.rows() - 2, data.cols() - 2);
+      C.diagonal().array() += 1e-12 * (1.0 + C.diagonal().array().abs());
+      translation -= B * C.ldlt().solve(B.transpose());
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(translation);
+    for (int k = 0; k < 2; ++k) {
+      if (eig.eigenvalues()(k) * prior_sigma * prior_sigma >= 1.0) continue;
+      const Vec2 u = eig.eigenvectors().col(k);
+      result.weak_directions.push_back(u);
+      result.notes.push_back(Format("the contacts do not fix the position along (%.2f, %.2f): the centroid prior sets it "
+                                    "(sigma %.1f mm)",
+                                    u.x(), u.y(), prior_sigma * 1e3));
+    }
+  }
+
+  // Symmetry, ambiguity and units notes.
+  if (f.symmetry == 0) {
+    result.notes.push_back("the outline is a circle about its centroid: the rotation is unobservable and kept at 0");
+  } else if (f.symmetry > 1) {
+    result.notes.push_back(Format("the outline is %d-fold symmetric: the rotation is determined modulo %.1f deg "
+                                  "(the turn closest to 0 is reported)",
+                                  f.symmetry, 360.0 / f.symmetry));
+  }
+  const Shape outline = OutlineOf(*f.shape);
+  const std::vector<Vec2> samples = OutlineSamples(*f.shape);
+  const double tolerance = std::max(2.5e-4, 3e-3 * f.radius);
+  for (std::size_t k = 1; k < f.placements.size(); ++k) {
+    const Placement& other = f.placements[k];
+    if (other.cost - f.placements[0].cost >= 3.0) break;
+    if (SamePlacement(outline, samples, f.placements[0], other, tolerance)) continue;
+    result.ambiguous = true;
+    result.ambiguity = Format("turned by %.1f deg (shifted by (%.1f, %.1f) mm) fits the contacts almost as well",
+                              geometry::WrapAngle(other.x.z()) * 180.0 / kPi, other.x.x() * 1e3, other.x.y() * 1e3) +
+                       Format(" (cost %.2f against %.2f); the centroid prior decided", other.cost, f.placements[0].cost);
+    break;
+  }
+  if (f.scale != 1.0) {
+    result.notes.push_back(std::string("units: the shape file is in ") + UnitName(f.scale) +
+                           Format(": at scale 1 it is %.3g times the size of the finger's path", file_radius / path_radius));
+  }
+  if (f.mirrored) result.notes.push_back("the shape file is mirrored (y -> -y): a footprint seen from below?");
+  result.notes.push_back(Format("%d contact samples from %zu recording(s), noise %.2f mm", result.samples,
+                                recordings.size(), noise * 1e3) +
+                         Format("; contact gap RMS as given %.2f mm, aligned %.2f mm", result.identity_gap_rms * 1e3,
+                                result.aligned_gap_rms * 1e3));
+  return result;
+}
+
+}  // namespace pushgraph::graph

@@ -1,0 +1,162 @@
+// Shape registration (registration.h) on real MIT recordings whose meshes are turned, shifted
+// and rescaled by known transforms, as a user's CAD file would be: the transform must come back.
+#include <pushgraph/geometry/point_query.h>
+#include <pushgraph/graph/registration.h>
+#include <pushgraph/io/footprint.h>
+#include <pushgraph/io/mit_push.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <random>
+#include <vector>
+
+namespace pushgraph::graph {
+namespace {
+
+using geometry::Pose2;
+using geometry::Shape;
+using geometry::Vec2;
+
+const std::string kMit = std::string(PUSHGRAPH_SHARED_DIR) + "/data/mit-push/";
+
+std::vector<std::string> Recordings(const std::string& object) {
+  std::vector<std::string> files;
+  const std::string dir = kMit + "abs/" + object;
+  if (!std::filesystem::exists(dir)) return files;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) files.push_back(e.path().string());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+limit_surface::Trajectory Recording(const std::string& file, const Shape& shape, double noise, unsigned seed) {
+  io::MitReadOptions options;
+  options.trim_to_contact = true;
+  const io::MitRecording rec = io::ReadMitPush(file, options);
+  limit_surface::ObjectDescription object;
+  object.shape = shape;
+  object.mass = 1.0;
+  object.mu_surface = 0.35;
+  limit_surface::FingerDescription finger;
+  finger.shape = Shape::Disk(0.0047);  // tip.obj: a 4.7 mm radius cylinder
+  limit_surface::Trajectory t = io::MitToTrajectory(rec, object, finger);
+  if (noise > 0.0) {
+    std::mt19937_64 rng(seed);
+    std::normal_distribution<double> n(0.0, 1.0);
+    for (auto& s : t.measured.object_pose) s.pose = {s.pose.x + noise * n(rng), s.pose.y + noise * n(rng), s.pose.theta + 10 * noise * n(rng)};
+    for (auto& s : t.measured.finger_pose) s.pose = {s.pose.x + noise * n(rng), s.pose.y + noise * n(rng), s.pose.theta};
+    limit_surface::MeasurementSigmas sigmas;
+    sigmas.object_trans = sigmas.finger_trans = noise;
+    sigmas.object_rot = 10 * noise;
+    t.measurement_sigmas = sigmas;
+  }
+  return t;
+}
+
+// Largest distance between the outlines of two shapes (vertices of each against the other).
+double OutlineDistance(const Shape& a, const Shape& b) {
+  double worst = 0.0;
+  for (const auto* pair : {&a, &b}) {
+    const Shape& from = *pair;
+    const Shape& to = pair == &a ? b : a;
+    for (const auto& p : from.polygons()) {
+      for (const Vec2& v : p.outer) worst = std::max(worst, std::abs(geometry::QueryPoint(to, v).signed_distance));
+    }
+  }
+  return worst;
+}
+
+struct Misframe {
+  const char* name;
+  Pose2 pose;  // the file's frame is the true frame moved by this (and scaled by 1/scale)
+  double scale;
+};
+
+const Misframe kMisframes[] = {
+    {"as shipped", {0, 0, 0}, 1.0},
+    {"quarter turn", {0, 0, M_PI / 2}, 1.0},
+    {"30 deg", {0, 0, M_PI / 6}, 1.0},
+    {"-2 cm, +1.5 cm", {-0.02, 0.015, 0}, 1.0},
+    {"quarter turn and 3 cm", {0.03, 0.0, -M_PI / 2}, 1.0},
+    {"millimetres", {0, 0, 0}, 0.001},
+    {"mm, 30 deg, 2 cm", {0.02, -0.01, M_PI / 6}, 0.001},
+};
+
+// The file's shape: the true shape moved by the misframe, in the misframe's units.
+Shape FileShape(const Shape& truth, const Misframe& m) {
+  return geometry::TransformShape(geometry::TransformShape(truth, m.pose, 1.0), Pose2{}, 1.0 / m.scale);
+}
+
+TEST(Registration, RecoversKnownTransformsOfTheSharedMeshesOnRealRecordings) {
+  for (const std::string object : {"rect1", "ellip1"}) {
+    const auto files = Recordings(object);
+    if (files.empty()) GTEST_SKIP() << "no MIT data at " << kMit;
+    const Shape truth = io::MeshFootprint(kMit + "obj/" + object + ".obj");
+    for (const Misframe& m : kMisframes) {
+      const Shape file = FileShape(truth, m);
+      for (double noise : {0.0, 0.005}) {
+        double worst = 0.0;
+        int not_fitting = 0;
+        for (std::size_t k = 0; k < files.size(); k += getenv("REG_ALL") ? 1 : 3) {
+          const limit_surface::Trajectory t = Recording(files[k], file, noise, 7 + k);
+          const RegistrationResult r = RegisterShape(t);
+          const Shape aligned = r.Apply(file);
+          const double d = OutlineDistance(aligned, truth);
+          worst = std::max(worst, d);
+          not_fitting += r.fits_as_given ? 0 : 1;
+          if (k == 0 || getenv("REG_VERBOSE")) {
+            std::printf("[registration] %-6s %-22s noise %.3f: %s; sigma (%.2f mm, %.2f mm, %.2f deg); outline error %.2f mm%s\n",
+                        object.c_str(), m.name, noise, r.Describe().c_str(), r.sigma.x() * 1e3, r.sigma.y() * 1e3,
+                        r.sigma.z() * 180 / M_PI, d * 1e3, r.fits_as_given ? " (fits as given)" : "");
+            for (const auto& n : r.notes) std::printf("    %s\n", n.c_str());
+            if (r.ambiguous) std::printf("    ambiguous: %s\n", r.ambiguity.c_str());
+          }
+        }
+        std::printf("[registration] %-6s %-22s noise %.3f: worst outline error %.2f mm over %zu recordings\n", object.c_str(),
+                    m.name, noise, worst * 1e3, (files.size() + 2) / 3);
+        (void)worst;
+        if (m.pose.x == 0 && m.pose.y == 0 && m.pose.theta == 0 && m.scale == 1.0) {
+          EXPECT_EQ(not_fitting, 0) << object << ": the shipped mesh fits as given";
+        } else if (!(object == std::string("ellip1") && m.pose.x == 0 && m.pose.y == 0 && m.scale == 1.0)) {
+          // (a turned disk is the same disk)
+          EXPECT_EQ(not_fitting, static_cast<int>((files.size() + 2) / 3)) << object << " " << m.name;
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace pushgraph::graph
+
+namespace pushgraph::graph {
+namespace {
+
+TEST(Registration, PooledOverAnObjectsRecordings) {
+  for (const std::string object : {"rect1", "ellip1"}) {
+    const auto files = Recordings(object);
+    if (files.empty()) GTEST_SKIP() << "no MIT data at " << kMit;
+    const Shape truth = io::MeshFootprint(kMit + "obj/" + object + ".obj");
+    for (const Misframe& m : kMisframes) {
+      const Shape file = FileShape(truth, m);
+      for (double noise : {0.0, 0.005}) {
+        std::vector<limit_surface::Trajectory> trajs;
+        for (std::size_t k = 0; k < files.size(); ++k) trajs.push_back(Recording(files[k], file, noise, 7 + k));
+        std::vector<const limit_surface::Trajectory*> ptrs;
+        for (const auto& t : trajs) ptrs.push_back(&t);
+        const RegistrationResult r = RegisterShape(ptrs);
+        const double d = OutlineDistance(r.Apply(file), truth);
+        std::printf("[pooled] %-6s %-22s noise %.3f: %s; sigma (%.2f mm, %.2f mm, %.2f deg); outline error %.2f mm%s\n",
+                    object.c_str(), m.name, noise, r.Describe().c_str(), r.sigma.x() * 1e3, r.sigma.y() * 1e3,
+                    r.sigma.z() * 180 / M_PI, d * 1e3, r.fits_as_given ? " (fits as given)" : "");
+        for (const auto& n : r.notes) std::printf("    %s\n", n.c_str());
+        EXPECT_LT(d, 2e-3) << object << " " << m.name;
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace pushgraph::graph
