@@ -918,48 +918,102 @@ EstimationResult Estimate(const limit_surface::Trajectory& trajectory, Model mod
   RegistrationOptions options = RegistrationOptionsFor(config);
   options.estimate_scale = config.align_scale;
   std::optional<RegistrationResult> registration;
+  bool gaps_fit = true;
+  internal::ValidateTrajectory(trajectory);
   try {
     alignment.check = CheckShapeFit(trajectory, options);
     alignment.checked = true;
-    if (config.align_shape == Align::kOn || !alignment.check.fits) registration = RegisterShape(trajectory, options);
-  } catch (const GraphError& e) {
+    // Always: the check's gaps miss a turn that the noise hides, the likelihood ratio does not.
+    registration = RegisterShape(trajectory, options);
+    gaps_fit = alignment.check.fits;
+    alignment.check.fits = registration->fits_as_given;
+  } catch (const std::exception& e) {
     // Too few contacts with object poses near them to say anything about the shape.
     alignment.notes.push_back(std::string("shape not checked: ") + e.what());
     if (config.align_shape == Align::kOn) throw GraphError(std::string("align_shape \"on\": ") + e.what());
   }
-  // A misfit has two explanations: a wrong frame (the registration's placement) or a wrong
-  // finger size (the shape as given with the finger size_offset larger). From contacts alone a
-  // push along one side cannot tell them apart; the whole graph can (dynamics, smoothing): when
-  // both are plausible, each is estimated (batch, no covariances) and the lower final cost wins.
+  // A misfit has several explanations: the registration's best placement, its alternatives
+  // (other rotations the contacts of one push leave open), or a wrong finger size (the shape as
+  // given with the finger size_offset larger). Contacts alone cannot always tell them apart;
+  // the whole graph can (dynamics, smoothing): each is estimated (batch, no covariances) and
+  // the lowest final cost wins.
   const bool misfit = registration && !registration->fits_as_given;
   const geometry::Shape& finger = trajectory.finger.shape;
   const double sized_radius = finger.radius() + (registration ? registration->size_offset : 0.0);
   const bool size_candidate = misfit && sized_radius > 0.0 &&
                               std::abs(registration->size_offset) <= std::max(5e-3, 3.0 * finger.radius());
-  bool size_wins = false;
-  if (misfit && size_candidate) {
+  bool size_wins = false, identity_wins = false;
+  const bool will_align = registration && (config.align_shape == Align::kOn || (config.align_shape == Align::kAuto && misfit));
+  if (registration && (misfit || config.align_shape == Align::kOn) &&
+      (size_candidate || !registration->alternatives.empty() || (will_align && mode == Mode::kIncremental) ||
+       (gaps_fit && misfit))) {
     EstimatorConfig quick = config;
     quick.covariance = false;
     quick.diagnostics = false;
-    limit_surface::Trajectory framed = trajectory, sized = trajectory;
-    framed.object.shape = registration->Apply(trajectory.object.shape);
-    sized.finger.shape = finger.WithRadius(sized_radius);
-    FrameSetup frame;
-    frame.centroid = geometry::CoreCentroid(framed.object.shape);
-    frame.sigma_centroid = options.centroid_prior * geometry::RadiusAbout(framed.object.shape, frame.centroid);
-    frame.rotation = registration->rotation_observable;
-    const double framed_cost = EstimateBatch(framed, model, quick, &frame).solver.final_cost;
-    const double sized_cost = EstimateBatch(sized, model, quick).solver.final_cost;
-    size_wins = sized_cost < framed_cost;
-    char text[200];
-    std::snprintf(text, sizeof text,
-                  "frame or size: the graph's final cost is %.1f with the shape aligned and %.1f with the finger %.1f mm %s",
-                  framed_cost, sized_cost, std::abs(registration->size_offset) * 1e3,
-                  registration->size_offset > 0 ? "larger" : "smaller");
-    alignment.notes.push_back(text);
+    quick.max_iterations = std::min(quick.max_iterations, 25);  // ranking, not the final solve
+    // Each placement's graph cost and its transform refined by the graph (the shape frame).
+    auto framed_cost = [&](const ShapeTransform& t, ShapeTransform* refined) {
+      RegistrationResult r = *registration;
+      r.transform = t;
+      limit_surface::Trajectory framed = trajectory;
+      framed.object.shape = r.Apply(trajectory.object.shape);
+      FrameSetup frame;
+      frame.centroid = geometry::CoreCentroid(framed.object.shape);
+      frame.sigma_centroid = options.centroid_prior * geometry::RadiusAbout(framed.object.shape, frame.centroid);
+      frame.rotation = registration->rotation_observable;
+      const double cost = EstimateBatch(framed, model, quick, &frame).solver.final_cost;
+      *refined = t;
+      refined->pose = geometry::Compose(frame.frame, t.pose);
+      return cost;
+    };
+    ShapeTransform best, refined;
+    double best_cost = framed_cost(registration->transform, &best);
+    // When only the likelihood ratio (not the gaps) says misfit, the shape as given competes too.
+    if (gaps_fit && misfit) {
+      ShapeTransform as_given;
+      const double cost = framed_cost(as_given, &refined);
+      char text[200];
+      std::snprintf(text, sizeof text, "the shape as given: graph cost %.1f against %.1f for the best placement", cost, best_cost);
+      alignment.notes.push_back(text);
+      // Ties between placements the data cannot tell apart keep the shape as given: a placement
+      // must do better by more than 2 in cost (a log-likelihood).
+      if (cost <= best_cost + 2.0) {
+        identity_wins = true;
+        best_cost = cost - 2.0;
+      }
+    }
+    char text[240];
+    for (const ShapeTransform& alt : registration->alternatives) {
+      const double cost = framed_cost(alt, &refined);
+      std::snprintf(text, sizeof text, "alternative placement turned by %.1f deg, shifted by (%.1f, %.1f) mm: graph cost %.1f "
+                    "against %.1f", alt.pose.theta * 180.0 / M_PI, alt.pose.x * 1e3, alt.pose.y * 1e3, cost, best_cost);
+      alignment.notes.push_back(text);
+      if (cost < best_cost) {
+        best_cost = cost;
+        best = refined;
+        identity_wins = false;
+      }
+    }
+    // The graph-refined placement: the start of the final batch solve, or (incremental) the
+    // frame kept fixed while smoothing.
+    registration->transform = CanonicalTransform(best, trajectory.object.shape, registration->symmetry_order);
+    if (identity_wins) {
+      registration->fits_as_given = true;
+      alignment.check.fits = true;
+    }
+    if (size_candidate) {
+      limit_surface::Trajectory sized = trajectory;
+      sized.finger.shape = finger.WithRadius(sized_radius);
+      const double sized_cost = EstimateBatch(sized, model, quick).solver.final_cost;
+      size_wins = sized_cost < best_cost;
+      std::snprintf(text, sizeof text, "frame or size: graph cost %.1f with the shape aligned, %.1f with the finger %.1f mm %s",
+                    best_cost, sized_cost, std::abs(registration->size_offset) * 1e3,
+                    registration->size_offset > 0 ? "larger" : "smaller");
+      alignment.notes.push_back(text);
+    }
   }
   const bool align = registration && (config.align_shape == Align::kOn ||
-                                      (config.align_shape == Align::kAuto && misfit && !size_wins));
+                                      (config.align_shape == Align::kAuto && misfit && !size_wins && !identity_wins));
   limit_surface::Trajectory aligned_trajectory;
   const limit_surface::Trajectory* working = &trajectory;
   if (registration) {
@@ -1011,7 +1065,14 @@ EstimationResult Estimate(const limit_surface::Trajectory& trajectory, Model mod
     result = inc.Finish();
   }
   if (alignment.checked && !alignment.check.fits) {
-    const std::string what = "the object's shape does not fit this recording as given (" + alignment.check.Describe() + ")";
+    std::string what = "the object's shape does not fit this recording as given (" + alignment.check.Describe();
+    if (gaps_fit && registration) {
+      char lr[160];
+      std::snprintf(lr, sizeof lr, "; a placement that moves it by %.1f mm fits the contacts better by %.1f in log-likelihood",
+                    registration->displacement * 1e3, registration->identity_cost - registration->aligned_cost);
+      what += lr;
+    }
+    what += ")";
     if (size_wins) {
       char size[160];
       std::snprintf(size, sizeof size, "the finger %.1f mm %s than given (radius %.1f mm instead of %.1f mm)",

@@ -2,6 +2,7 @@
 // with its kink detector) over many seeded random configurations, including contact at a
 // vertex, pure translation, pure rotation and near-zero rotation; plus the semantics of D.
 #include <pushgraph/graph/factors.h>
+#include <pushgraph/graph/shape_frame.h>
 
 #include <pushgraph/geometry/point_query.h>
 
@@ -365,6 +366,64 @@ TEST(FactorJacobians, QuasiStaticBothForms) {
   EXPECT_TRUE(ty.MostlyChecked(0.95));
 }
 
+
+// The shape frame F as a variable (shape registration): the wrapper composes the object-pose
+// blocks with F, so its Jacobians with respect to those blocks and to F are chained through
+// Compose; checked on wrapped C, touching, S and D, near contact and at vertices, and on its
+// prior. The wrapped value must equal the inner factor's at x * F.
+TEST(FactorJacobians, ShapeFrame) {
+  Rng rng;
+  JacobianTally tally("shape frame");
+  WorstError worst{"shape frame (wrapped C, S, D)"};
+  const Shape object = Shape::Box(0.09, 0.06);
+  auto querier = std::make_shared<const geometry::ShapePairQuerier>(object, Shape::Disk(0.005));
+  QuasiStaticGeometry g;
+  g.c = 0.03;
+  g.centre_of_pressure = Vec2(0.002, -0.001);
+  g.dt = 0.01;
+  const ShapeFrameFactor boundary(new BoundaryPointFactor(object, 1e-3), {0});
+  const ShapeFrameFactor touching(new TouchingFactor(querier, 1e-3), {0});
+  const ShapeFrameFactor intersection(new IntersectionFactor(querier, 1e-3), {0});
+  const ShapeFrameFactor quasi_static(new QuasiStaticFactor(g, 1e-3, 0.05, 0.1), {0, 1});
+  for (int i = 0; i < 150; ++i) {
+    const Pose2 x = rng.P(0.1);
+    const Pose2 F = i % 10 == 0 ? Pose2{} : Pose2{rng.U(-0.02, 0.02), rng.U(-0.02, 0.02), rng.U(-0.6, 0.6)};
+    const Pose2 placed = geometry::Compose(x, F);
+    // A finger near the placed shape's boundary (edges, and vertices every 4th case).
+    const auto& ring = object.polygons()[0].outer;
+    const Vec2 a = ring[i % 4], b = ring[(i + 1) % 4];
+    const double s = i % 4 == 0 ? 0.0 : rng.U(0.1, 0.9);
+    const Vec2 on = a + s * (b - a);
+    const Vec2 n_out = s == 0.0 ? on.normalized() : Vec2((b - a).y(), -(b - a).x()).normalized();
+    const Vec2 c_local = on + n_out * (0.005 + rng.U(-0.003, 0.003));
+    const Pose2 e = geometry::Compose(placed, Pose2{c_local.x(), c_local.y(), rng.U(-0.3, 0.3)});
+    const Vec2 p = geometry::Act(placed, on) + Vec2(rng.U(-1e-3, 1e-3), rng.U(-1e-3, 1e-3));
+    const std::string ctx = "case " + std::to_string(i);
+    CheckCost(boundary, {V(x), V(p), V(F)}, tally, worst, ctx + " C");
+    CheckCost(touching, {V(x), V(e), V(F)}, tally, worst, ctx + " touching");
+    CheckCost(intersection, {V(x), V(e), V(F)}, tally, worst, ctx + " S");
+    const Pose2 x_prev = geometry::Compose(x, Pose2{rng.U(-2e-4, 2e-4), rng.U(-2e-4, 2e-4), rng.U(-5e-3, 5e-3)});
+    const Vec2 f(rng.U(-2, 2), rng.U(-2, 2));
+    CheckCost(quasi_static, {V(x_prev), V(x), V(p), V(f), V(F)}, tally, worst, ctx + " D");
+    // The wrapper's value is the inner factor's at x * F.
+    const TouchingFactor inner(querier, 1e-3);
+    const Eigen::Vector3d xv = x.vector(), ev = e.vector(), Fv = F.vector(), pv = placed.vector();
+    const double* wrapped_params[] = {xv.data(), ev.data(), Fv.data()};
+    const double* inner_params[] = {pv.data(), ev.data()};
+    double r_wrapped = 0.0, r_inner = 0.0;
+    ASSERT_TRUE(touching.Evaluate(wrapped_params, &r_wrapped, nullptr));
+    ASSERT_TRUE(inner.Evaluate(inner_params, &r_inner, nullptr));
+    EXPECT_EQ(r_wrapped, r_inner) << ctx;
+  }
+  EXPECT_TRUE(tally.MostlyChecked(0.9));
+  // The prior: the centroid placed by F over its sigma, and F's angle over its sigma.
+  JacobianTally prior_tally("shape frame prior");
+  WorstError prior_worst{"shape frame prior"};
+  const ShapeFramePrior prior(Vec2(0.01, -0.02), 0.005, 0.2);
+  for (int i = 0; i < 50; ++i) CheckCost(prior, {V(rng.P(0.05))}, prior_tally, prior_worst, "prior " + std::to_string(i));
+  EXPECT_TRUE(prior_tally.MostlyChecked(0.99));
+  EXPECT_THROW(ShapeFrameFactor(new TouchingFactor(querier, 1e-3), {2}), GraphError);
+}
 
 // A consistent quasi-static step: for a load (f_b, tau) the ellipsoid's twist is parallel to
 // (f_b, tau / c^2) (paper Eq. 4), so D must vanish; rotating the motion must not.

@@ -9,9 +9,8 @@
 //   A ratio far above 1 says that factor's sigma or model is wrong for this data;
 // - the signed finger-object separation during contact at the estimate, and the share of steps
 //   where the finger is inside the object;
-// - the measured contact gap: the finger's measured (smoothed) reference point against the
-//   object's surface at the finger's radius, over the contact samples (registration.h's
-//   ContactPath). A consistent offset means a wrong probe radius or object size;
+// - the measured contact gap: every measured finger pose during contact against the object at
+//   its estimated pose. A consistent offset means a wrong probe radius or object size;
 // - sensor faults: a stream that repeats its values (frozen) or has isolated residuals beyond
 //   6 sigma (spikes);
 // - the probable causes, one sentence each, when these are far off (also in the warnings).
@@ -53,11 +52,12 @@ struct Diagnostics {
   double gap_median = 0.0, gap_rms = 0.0, gap_p95 = 0.0;
   /// Share of all steps whose finger is inside the object by more than penetration_tolerance.
   double penetration_share = 0.0;
-  double penetration_tolerance = 5e-4;
-  /// The measured contact gap (m): median and median absolute deviation of (distance of the
-  /// finger's measured reference point to the surface) - radius over the contact samples.
+  double penetration_tolerance = 1e-3;  ///< m: twice the default sigma of S
+  /// The measured contact gap (m): median and median absolute deviation of the separation of
+  /// each measured finger pose (in contact) from the object at its estimated pose.
   double measured_gap_median = 0.0, measured_gap_mad = 0.0;
   int measured_samples = 0;
+  double measured_noise = 0.0;  ///< 1.4826 MAD: the per-sample noise of that separation
   std::vector<SensorFault> faults;
   /// Probable causes when something is far off, one sentence each (also in the warnings).
   std::vector<std::string> causes;

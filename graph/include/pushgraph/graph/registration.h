@@ -79,9 +79,17 @@ struct RegistrationOptions {
   /// block), where the fit would otherwise drift to whatever corner fits the noise best.
   double centroid_prior = 0.15;
   /// The shape as given fits (RegistrationResult::fits_as_given) when the median |contact gap|
-  /// is at most max(fit_tolerance, 2.5 noise) and at most 10% of the samples penetrate it by
-  /// more than that. 3 mm: the MIT recordings' probe stays 0.2 to 2.5 mm off the blocks.
+  /// is at most max(fit_tolerance, 2.5 noise of the smoothed path) and at most 10% of the
+  /// samples penetrate it by more than that. 3 mm: the MIT recordings' probe stays 0.2 to 2.5 mm off the blocks.
   double fit_tolerance = 3e-3;
+  /// Alternatives (RegistrationResult::alternatives): the local minima over the rotation within
+  /// this of the best cost (log-likelihood), and the best placement of each of `sectors` equal
+  /// sectors of the full turn (fewer for a symmetric outline).
+  double alternative_margin = 10.0;
+  int sectors = 8;
+  /// The shape as given does not fit either when the best placement's log-likelihood is higher
+  /// by this much and moves the outline by more than fit_tolerance.
+  double misfit_evidence = 5.0;
   /// A best fit that moves no outline point further than this (m) is the shape as given.
   double min_displacement = 1e-3;
   /// Contact gating as the estimator's (EstimatorConfig: contact_max_gap, contact_force_threshold).
@@ -136,6 +144,11 @@ struct RegistrationResult {
   /// Unit directions (object frame) of translations the contacts do not fix (the prior does).
   std::vector<geometry::Vec2> weak_directions;
   bool ambiguous = false;      ///< another, non-equivalent placement fits about as well
+  /// Other placements, not equivalent to the best or each other (RegistrationOptions::
+  /// alternative_margin and sectors), and their cost differences to the best:
+  /// the contacts of one push often leave a few; the estimator judges them with its whole graph.
+  std::vector<ShapeTransform> alternatives;
+  std::vector<double> alternative_costs;
   /// When the shape does not fit as given: the contacts fit the shape as given about as well
   /// with the finger size_offset (m) larger (negative: smaller) as with the best placement
   /// (data and centroid prior): a wrong probe radius or object size, not a wrong frame.
@@ -179,6 +192,9 @@ struct ContactPath {
   std::vector<double> t;
   std::vector<geometry::Vec2> q;          ///< finger reference point, object frame
   std::vector<geometry::Pose2> relative;  ///< finger pose in the object frame
+  /// Standard deviation (m, per axis) of q's error: a parametric bootstrap of the smoothing with
+  /// the raw noise (the measurement sigmas, else the streams' own second differences).
+  double noise = 0.0;
 };
 ContactPath MeasuredContactPath(const limit_surface::Trajectory& trajectory, const RegistrationOptions& options);
 
