@@ -2,6 +2,7 @@
 // per factor type against its leverage-corrected expectation, contact gaps, sensor faults and
 // the probable causes.
 #include "graph_builder.h"
+#include "text.h"
 
 #include <pushgraph/geometry/point_query.h>
 #include <pushgraph/graph/diagnostics.h>
@@ -39,19 +40,7 @@ const char* TypeName(FactorType t) {
   return "?";
 }
 
-template <class... Args>
-std::string Format(const char* fmt, Args... args) {
-  char buf[320];
-  std::snprintf(buf, sizeof buf, fmt, args...);
-  return buf;
-}
 
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const std::size_t m = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + m, v.end());
-  return v[m];
-}
 
 // A stream that repeats its values: a run of identical samples that no live sensor gives,
 // at least max(20, 10% of the stream) long, or half of all samples repeating. `counts(i, j)`

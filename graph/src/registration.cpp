@@ -7,6 +7,8 @@
 #include <pushgraph/graph/factors.h>
 #include <pushgraph/graph/registration.h>
 
+#include "text.h"
+
 #include <ceres/ceres.h>
 
 #include <Eigen/Cholesky>
@@ -22,25 +24,16 @@
 namespace pushgraph::graph {
 namespace {
 
+using internal::Format;
+using internal::Median;
+
 using geometry::Pose2;
 using geometry::Shape;
 using geometry::Vec2;
 
 constexpr double kPi = 3.14159265358979323846;
 
-template <class... Args>
-std::string Format(const char* fmt, Args... args) {
-  char buf[320];
-  std::snprintf(buf, sizeof buf, fmt, args...);
-  return buf;
-}
 
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const std::size_t m = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + m, v.end());
-  return v[m];
-}
 
 Vec2 Rotate(const Vec2& p, double angle) {
   const double c = std::cos(angle), s = std::sin(angle);

@@ -496,9 +496,9 @@ InputKind DetectInputKind(const std::string& path) {
 }
 
 std::optional<double> MitObjectMass(const std::string& name) {
-  static const std::map<std::string, double> kMass = {{"rect1", 0.8374}, {"rect2", 1.045},  {"rect3", 1.2508},
-                                                      {"ellip1", 0.8937}, {"ellip2", 1.1104}, {"tri1", 0.8028},
-                                                      {"tri2", 0.9826},  {"tri3", 1.1326}};
+  static const std::map<std::string, double> kMass = {
+      {"rect1", 0.8374},  {"rect2", 1.045},  {"rect3", 1.2508}, {"ellip1", 0.8937}, {"ellip2", 1.1104}, {"ellip3", 1.3338},
+      {"tri1", 0.8028},   {"tri2", 0.9826},  {"tri3", 1.1326},  {"hex", 0.9827},    {"butter", 1.1974}};
   auto it = kMass.find(name);
   if (it == kMass.end()) return std::nullopt;
   return it->second;
@@ -506,7 +506,10 @@ std::optional<double> MitObjectMass(const std::string& name) {
 
 ObjectModel MitObjectModel(const std::string& name, const std::string& mesh_dir) {
   const std::optional<double> mass = MitObjectMass(name);
-  if (!mass) throw IoError("unknown MIT object '" + name + "' (known: rect1-3, ellip1-2, tri1-3); give its shape and mass");
+  if (!mass) {
+    throw IoError("unknown MIT object '" + name +
+                  "' (known: rect1-3, ellip1-3, tri1-3, hex, butter); give its shape and mass");
+  }
   ObjectModel m;
   m.shape = CachedFootprint((fs::path(mesh_dir) / (name + ".obj")).string(), UpAxis::kZ);
   // The probe is a cylinder: a disk of the mesh's radius (its footprint's vertices lie on the
@@ -560,6 +563,8 @@ std::string EvaluationOptions::SettingsJson() const {
   j["mit_rate_hz"] = mit_rate;
   j["occlusion_fraction"] = occlusion_fraction;
   j["occlusion_mode"] = graph::ModeName(occlusion_mode);
+  const char* align[] = {"auto", "on", "off"};
+  j["align_shape"] = align[static_cast<int>(estimator.align_shape)];
   j["simulate"] = {{"count", simulation.count},          {"name", simulation.name},
                    {"push_distance", simulation.push_distance}, {"speed", simulation.speed},
                    {"offset_fraction", simulation.offset_fraction}, {"mass", simulation.object.mass},
@@ -631,6 +636,50 @@ std::vector<EvaluationItem> PlanEvaluation(const std::vector<std::string>& files
   return items;
 }
 
+std::vector<std::string> RegisterGroups(std::vector<EvaluationItem>& items, const EvaluationOptions& options) {
+  using Align = graph::EstimatorConfig::AlignShape;
+  std::vector<std::string> lines;
+  if (options.estimator.align_shape == Align::kOff) return lines;
+  std::map<std::string, std::vector<std::size_t>> groups;
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    if (items[i].source == EvaluationItem::Source::kFile) groups[items[i].group].push_back(i);
+  }
+  for (const auto& [group, members] : groups) {
+    std::vector<ls::Trajectory> clean;
+    for (std::size_t i : members) {
+      try {
+        clean.push_back(LoadCleanTrajectory(items[i], options));
+      } catch (const std::exception&) {
+        // Unreadable: its own row will say so.
+      }
+    }
+    if (clean.empty()) continue;
+    std::vector<const ls::Trajectory*> pooled;
+    for (const ls::Trajectory& t : clean) pooled.push_back(&t);
+    graph::RegistrationOptions ro = graph::RegistrationOptionsFor(options.estimator);
+    ro.estimate_scale = options.estimator.align_scale;
+    try {
+      const graph::RegistrationResult r = graph::RegisterShape(pooled, ro);
+      const bool align = options.estimator.align_shape == Align::kOn || !r.fits_as_given;
+      char head[160];
+      std::snprintf(head, sizeof head, "%s: shape checked against %zu recordings together: ", group.c_str(), pooled.size());
+      if (align) {
+        for (std::size_t i : members) items[i].shape_transform = r.transform;
+        lines.push_back(head + std::string(r.fits_as_given ? "fits as given; aligned anyway (align_shape on): "
+                                                           : "does not fit as given (" + r.check.Describe() + "); aligned: ") +
+                        r.Describe());
+      } else {
+        lines.push_back(head + std::string("fits as given (") + r.check.Describe() + ")");
+      }
+    } catch (const std::exception& e) {
+      // Different shapes in one group (trajectory files), or too few contacts: each estimate
+      // still checks its own shape.
+      lines.push_back(group + ": no group registration (" + e.what() + "); each trajectory is checked on its own");
+    }
+  }
+  return lines;
+}
+
 std::pair<int, int> ParseShard(const std::string& text) {
   static const std::regex re("^([0-9]+)/([0-9]+)$");
   std::smatch m;
@@ -697,7 +746,12 @@ EvaluationRow EvaluateItem(const EvaluationItem& item, const EvaluationOptions& 
   const std::string where = item.path.empty() ? item.name : item.path;
   std::string stage = "reading";
   try {
-    const ls::Trajectory clean = LoadCleanTrajectory(item, o);
+    ls::Trajectory clean = LoadCleanTrajectory(item, o);
+    if (item.shape_transform) {
+      const graph::ShapeTransform& t = *item.shape_transform;
+      clean.object.shape = geometry::TransformShape(clean.object.shape, t.pose, t.scale, t.mirrored);
+      row.stats["shape/group_aligned/sum"] = 1.0;
+    }
     const std::uint64_t item_seed = SplitMix(o.seed ^ Fnv1a(item.name));
     const std::vector<RunSpec> runs = RunsFor(o.protocols, o.occlusion_mode);
     StatSink sink(&row.stats);
@@ -726,7 +780,21 @@ EvaluationRow EvaluateItem(const EvaluationItem& item, const EvaluationOptions& 
       graph::EstimatorConfig cfg = graph::ApplyMeasurementSigmas(o.estimator, *t.measurement_sigmas);
       cfg.covariance = run.covariance;
       if (run.mode == graph::Mode::kIncremental) cfg.estimate_c = cfg.estimate_mu = false;  // batch only
+      // One self-diagnosis per trajectory: of the QS batch Gaussian run, else of the first run.
+      const bool diagnosed = run.Prefix() == "gauss.qs.batch" ||
+                             (&run == &runs.front() && std::none_of(runs.begin(), runs.end(), [](const RunSpec& x) {
+                                return x.Prefix() == "gauss.qs.batch";
+                              }));
+      cfg.diagnostics = diagnosed;
       graph::EstimationResult r = graph::Estimate(t, run.model, run.mode, cfg);
+      if (diagnosed) {
+        if (r.diagnostics) {
+          row.health = r.diagnostics->score;
+          row.worst_factor = r.diagnostics->worst_factor;
+        }
+        row.notes = r.warnings;
+        if (r.shape_alignment && r.shape_alignment->aligned) row.stats["shape/run_aligned/sum"] = 1.0;
+      }
       AccumulateRun(t, r, run.Prefix(), run.noise == "occluded" ? window : Window{}, sink);
       if (row.steps == 0) row.steps = static_cast<int>(r.states.size());
       if (plot && run.mode == graph::Mode::kBatch) kept.emplace(run.Prefix(), std::move(r));
@@ -786,6 +854,9 @@ void WriteRows(const std::string& path, const RowsHeader& header, const std::vec
     nlohmann::json j = {{"index", r.index}, {"name", r.name}, {"group", r.group}, {"steps", r.steps}};
     if (!r.error.empty()) j["error"] = r.error;
     j["stats"] = r.stats;
+    if (r.health > 0.0) j["health"] = r.health;
+    if (!r.worst_factor.empty()) j["worst_factor"] = r.worst_factor;
+    if (!r.notes.empty()) j["notes"] = r.notes;
     out << j.dump() << "\n";
   }
   if (!out) throw IoError(path + ": write failed");
@@ -818,6 +889,9 @@ std::vector<EvaluationRow> ReadRows(const std::string& path, RowsHeader* header)
       r.steps = j.at("steps").get<int>();
       if (j.contains("error")) r.error = j["error"].get<std::string>();
       r.stats = j.at("stats").get<std::map<std::string, double>>();
+      if (j.contains("health")) r.health = j["health"].get<double>();
+      if (j.contains("worst_factor")) r.worst_factor = j["worst_factor"].get<std::string>();
+      if (j.contains("notes")) r.notes = j["notes"].get<std::vector<std::string>>();
       rows.push_back(std::move(r));
     } catch (const nlohmann::json::exception& e) {
       throw IoError(at + e.what());
@@ -1095,6 +1169,42 @@ std::vector<Table> MakeTables(std::vector<EvaluationRow> rows, const std::string
     t.notes.push_back("Wall time of each graph::Estimate call (single-threaded; trajectories run in parallel, so "
                       "times include contention for cores and memory), covariances included where computed "
                       "(gauss.*.batch with table1/consistency). Run names: NOISE.MODEL.MODE. Times differ from run to run.");
+    tables.push_back(t);
+  }
+  {
+    // Self-diagnosis: per group the shape alignment and the health figures, then the worst
+    // trajectories with their probable causes.
+    Table t{"diagnostics", "Diagnostics: the worst trajectories by their estimate's self-diagnosis", {}, {}, {}};
+    t.columns = {"object", "trajectory", "score", "worst factor", "notes"};
+    std::vector<const EvaluationRow*> ranked;
+    for (const EvaluationRow& r : rows) {
+      if (r.error.empty()) ranked.push_back(&r);
+    }
+    std::stable_sort(ranked.begin(), ranked.end(), [](const EvaluationRow* a, const EvaluationRow* b) { return a->health > b->health; });
+    for (std::size_t k = 0; k < ranked.size() && k < 10; ++k) {
+      const EvaluationRow& r = *ranked[k];
+      std::string notes;
+      for (const std::string& n : r.notes) notes += (notes.empty() ? "" : "; ") + n;
+      for (char& c : notes) c = c == '|' ? '/' : c;
+      t.rows.push_back({r.group, r.name, Fmt(r.health, 3), r.worst_factor, notes});
+    }
+    for (const auto& [g, s] : groups) {
+      const Agg a{&s};
+      std::vector<double> scores;
+      for (const EvaluationRow& r : rows) {
+        if (r.group == g && r.error.empty()) scores.push_back(r.health);
+      }
+      std::sort(scores.begin(), scores.end());
+      const double median = scores.empty() ? 0.0 : scores[scores.size() / 2];
+      std::string line = g + ": median score " + Fmt(median, 3) + " over " + count(g) + " trajectories";
+      const double group_aligned = a.Get("shape/group_aligned/sum"), run_aligned = a.Get("shape/run_aligned/sum");
+      if (group_aligned > 0) line += "; shape aligned for the group (all its recordings together) in " + Fmt(group_aligned, 6);
+      if (run_aligned > 0) line += "; shape aligned by the estimate itself in " + Fmt(run_aligned, 6);
+      t.notes.push_back(line + ".");
+    }
+    t.notes.push_back("Score: the largest chi-square / expected value over the measurement, touching, intersection and "
+                      "quasi-static factors of the trajectory's QS batch estimate (Gaussian noise); about 1 is healthy "
+                      "(docs/estimation.md, Self-diagnosis). Notes: the estimate's warnings.");
     tables.push_back(t);
   }
   return tables;

@@ -91,6 +91,22 @@ Shape FileShape(const Shape& truth, const Misframe& m) {
   return geometry::TransformShape(geometry::TransformShape(truth, m.pose, 1.0), Pose2{}, 1.0 / m.scale);
 }
 
+
+// Calls fn(object, truth, files, misframe, file shape, noise) for every shared object with
+// recordings, every misframe and both noise levels.
+template <class Fn>
+void ForEachCase(Fn fn) {
+  for (const std::string object : {"rect1", "ellip1"}) {
+    const auto files = Recordings(object);
+    if (files.empty()) GTEST_SKIP() << "no MIT data at " << kMit;
+    const Shape truth = io::MeshFootprint(kMit + "obj/" + object + ".obj");
+    for (const Misframe& m : kMisframes) {
+      const Shape file = FileShape(truth, m);
+      for (double noise : {0.0, 0.005}) fn(object, truth, files, m, file, noise);
+    }
+  }
+}
+
 double Median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? 0.0 : v[v.size() / 2];
@@ -109,13 +125,8 @@ bool Undetectable(const std::string& object, const Misframe& m) {
 // comes. One push touches one side over a few centimetres, so a turn or a shift along it is
 // left to the centroid prior; the estimator's graph refines it further (test_alignment).
 TEST(Registration, JudgesTheSharedMeshesOnEveryRealRecording) {
-  for (const std::string object : {"rect1", "ellip1"}) {
-    const auto files = Recordings(object);
-    if (files.empty()) GTEST_SKIP() << "no MIT data at " << kMit;
-    const Shape truth = io::MeshFootprint(kMit + "obj/" + object + ".obj");
-    for (const Misframe& m : kMisframes) {
-      const Shape file = FileShape(truth, m);
-      for (double noise : {0.0, 0.005}) {
+  ForEachCase([](const std::string& object, const Shape& truth, const std::vector<std::string>& files, const Misframe& m,
+                 const Shape& file, double noise) {
         std::vector<double> errors;
         int fitting = 0;
         for (std::size_t k = 0; k < files.size(); ++k) {
@@ -137,9 +148,7 @@ TEST(Registration, JudgesTheSharedMeshesOnEveryRealRecording) {
         } else if (!(object == "rect1" && std::string(m.name) == "quarter turn and 3 cm")) {
           EXPECT_EQ(fitting, 0) << object << " " << m.name << " noise " << noise;
         }
-      }
-    }
-  }
+  });
 }
 
 }  // namespace
@@ -149,13 +158,8 @@ namespace pushgraph::graph {
 namespace {
 
 TEST(Registration, PooledOverAnObjectsRecordings) {
-  for (const std::string object : {"rect1", "ellip1"}) {
-    const auto files = Recordings(object);
-    if (files.empty()) GTEST_SKIP() << "no MIT data at " << kMit;
-    const Shape truth = io::MeshFootprint(kMit + "obj/" + object + ".obj");
-    for (const Misframe& m : kMisframes) {
-      const Shape file = FileShape(truth, m);
-      for (double noise : {0.0, 0.005}) {
+  ForEachCase([](const std::string& object, const Shape& truth, const std::vector<std::string>& files, const Misframe& m,
+                 const Shape& file, double noise) {
         std::vector<limit_surface::Trajectory> trajs;
         for (std::size_t k = 0; k < files.size(); ++k) trajs.push_back(Recording(files[k], file, noise, 7 + k));
         std::vector<const limit_surface::Trajectory*> ptrs;
@@ -167,9 +171,7 @@ TEST(Registration, PooledOverAnObjectsRecordings) {
                     r.sigma.z() * 180 / M_PI, d * 1e3, r.fits_as_given ? " (fits as given)" : "");
         for (const auto& n : r.notes) std::printf("    %s\n", n.c_str());
         EXPECT_LT(d, 2.5e-3) << object << " " << m.name;
-      }
-    }
-  }
+  });
 }
 
 }  // namespace

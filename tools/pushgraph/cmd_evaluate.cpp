@@ -48,6 +48,7 @@ struct EvaluateOptions {
   std::string out;
   std::vector<std::string> merge;
   bool quiet = false;
+  std::string align_shape;  // empty: the estimator configuration's (default auto)
 };
 
 geometry::Shape LoadShape(const std::string& path, const std::string& what) {
@@ -181,6 +182,7 @@ void RunEvaluate(const EvaluateOptions& o) {
   options.mesh_dir = o.mesh_dir;
   if (!o.config.empty()) LoadEvaluationConfig(o.config, &options);
   if (!o.estimator_config.empty()) options.estimator = graph::LoadEstimatorConfig(o.estimator_config);
+  if (!o.align_shape.empty()) options.estimator.align_shape = ParseAlignShape(o.align_shape);
   const bool any_override = !o.object.empty() || !o.finger.empty() || o.mass > 0.0 || o.mu >= 0.0;
   if (any_override) {
     if (o.object.empty() || o.finger.empty() || !(o.mass > 0.0) || !(o.mu >= 0.0))
@@ -211,8 +213,11 @@ void RunEvaluate(const EvaluateOptions& o) {
   if (o.plots > 0) options.plot_dir = (fs::path(o.out) / "plots").string();
 
   const std::vector<std::string> files = o.inputs.empty() ? std::vector<std::string>{} : io::ExpandInputs(o.inputs);
-  const std::vector<io::EvaluationItem> all = io::PlanEvaluation(files, options);
+  std::vector<io::EvaluationItem> all = io::PlanEvaluation(files, options);
   if (all.empty()) throw CliError("nothing to evaluate: give recordings/trajectories or --simulate N");
+  // Each object's shape against all of its recordings together, before sharding (every shard
+  // then uses the same transforms).
+  for (const std::string& line : io::RegisterGroups(all, options)) std::cerr << "evaluate: " << line << "\n";
   int shard = 0, shards = 1;
   if (!o.shard.empty()) std::tie(shard, shards) = io::ParseShard(o.shard);
   const std::vector<io::EvaluationItem> items = io::ShardItems(all, shard, shards);
@@ -287,6 +292,7 @@ void RegisterEvaluate(CLI::App& app) {
   cmd->add_option("--merge", o->merge, "Merge the rows of shard folders/files instead of evaluating")
       ->expected(1, -1);
   cmd->add_flag("-q,--quiet", o->quiet, "No progress display");
+  AddAlignShapeOption(cmd, &o->align_shape);
   cmd->footer("Tables: results.md, TABLE.md and TABLE.csv in --out; see docs/evaluation.md.");
   cmd->callback([o, cmd] {
     if (cmd->got_subcommand("merge")) return;

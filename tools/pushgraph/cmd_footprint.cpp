@@ -1,9 +1,13 @@
-// pushgraph footprint MESH.obj [--up x|y|z] [--object NAME] [--scale S] [-o SHAPE.json]: the exact
-// planar footprint of a mesh as shape JSON.
+// pushgraph footprint MESH.obj|SHAPE.json [--up x|y|z] [--object NAME] [--scale S] [--mirror]
+// [--transform X,Y,THETA] [-o SHAPE.json]: the exact planar footprint of a mesh as shape JSON,
+// optionally moved into another frame (the transform that `pushgraph estimate` reports when it
+// aligns a shape: p' = pose * (scale * mirror(p))); a shape JSON input is only transformed.
 #include "cli_common.h"
 
+#include <pushgraph/geometry/pose.h>
 #include <pushgraph/io/footprint.h>
 
+#include <filesystem>
 #include <iostream>
 
 namespace pushgraph::cli {
@@ -11,15 +15,20 @@ namespace pushgraph::cli {
 void RegisterFootprint(CLI::App& app) {
   auto* cmd = app.add_subcommand("footprint", "Planar footprint of a mesh (exact union of its projected faces) as shape JSON");
   struct Args {
-    std::string mesh, up = "z", object, output;
+    std::string mesh, up = "z", object, output, transform;
     double scale = 1.0;
-    bool quiet = false;
+    bool quiet = false, mirror = false;
   };
   auto args = std::make_shared<Args>();
-  cmd->add_option("MESH", args->mesh, "Mesh file (Wavefront OBJ)")->required();
+  cmd->add_option("MESH", args->mesh, "Mesh file (Wavefront OBJ), or a shape JSON to transform")->required();
   cmd->add_option("--up", args->up, "Axis to project along: x, y or z")->capture_default_str();
   cmd->add_option("--object", args->object, "Only this object/group of the file (default: all together)");
-  cmd->add_option("--scale", args->scale, "Multiply coordinates, e.g. 0.001 for millimetres")->capture_default_str();
+  cmd->add_option("--scale", args->scale, "Multiply coordinates, e.g. 0.001 for millimetres")
+      ->check(FiniteNumber(0.0, false, "> 0"))
+      ->capture_default_str();
+  cmd->add_flag("--mirror", args->mirror, "Mirror y -> -y (a footprint seen from below), after --scale");
+  cmd->add_option("--transform", args->transform,
+                  "Then place the shape at the pose X,Y,THETA (m, m, rad), e.g. the shape_transform of RESULT.json");
   cmd->add_option("-o,--output", args->output, "Write the shape JSON here (default: stdout)");
   cmd->add_flag("-q,--quiet", args->quiet, "Do not print the summary on stderr");
   cmd->callback([args] {
@@ -28,13 +37,23 @@ void RegisterFootprint(CLI::App& app) {
     options.object = args->object;
     options.scale = args->scale;
     io::FootprintReport report;
-    const geometry::Shape shape = io::MeshFootprint(args->mesh, options, &report);
+    const bool json = std::filesystem::path(args->mesh).extension() == ".json";
+    geometry::Shape shape;
+    if (json) {
+      shape = geometry::TransformShape(geometry::LoadShapeJson(args->mesh), geometry::Pose2{}, args->scale);
+    } else {
+      shape = io::MeshFootprint(args->mesh, options, &report);
+    }
+    if (args->mirror || !args->transform.empty()) {
+      const geometry::Pose2 pose = args->transform.empty() ? geometry::Pose2{} : ParsePose(args->transform, "--transform");
+      shape = geometry::TransformShape(shape, pose, 1.0, args->mirror);
+    }
     if (args->output.empty()) {
       std::cout << geometry::ShapeToJson(shape) << "\n";
     } else {
       geometry::SaveShapeJson(shape, args->output);
     }
-    if (!args->quiet) {
+    if (!args->quiet && !json) {
       int holes = 0;
       for (const geometry::Polygon& p : shape.polygons()) holes += static_cast<int>(p.holes.size());
       std::cerr << "footprint: " << shape.polygons().size() << " polygon(s), " << holes << " hole(s), "

@@ -21,6 +21,7 @@
 #include <pushgraph/geometry/shape.h>
 #include <pushgraph/graph/config.h>
 #include <pushgraph/graph/estimator.h>
+#include <pushgraph/graph/registration.h>
 #include <pushgraph/limit_surface/noise.h>
 #include <pushgraph/limit_surface/trajectory.h>
 
@@ -80,9 +81,9 @@ struct ObjectModel {
   double mu_contact = 0.25;
 };
 
-/// Masses from the dataset's own shape table (its README): rect1 0.8374, rect2 1.045, rect3
-/// 1.2508, ellip1 0.8937, ellip2 1.1104, tri1 0.8028, tri2 0.9826, tri3 1.1326 kg. nullopt for
-/// other names.
+/// Masses of the dataset's eleven objects from its own shape table: rect1 0.8374, rect2 1.045,
+/// rect3 1.2508, ellip1 0.8937, ellip2 1.1104, ellip3 1.3338, tri1 0.8028, tri2 0.9826, tri3
+/// 1.1326, hex 0.9827, butter 1.1974 kg. nullopt for other names.
 std::optional<double> MitObjectMass(const std::string& object_name);
 
 /// The MIT object named `object_name` with its footprint from `mesh_dir`/NAME.obj (up z), the
@@ -147,6 +148,9 @@ struct EvaluationItem {
   enum class Source { kFile, kSimulated } source = Source::kSimulated;  ///< kFile: kind by DetectInputKind
   int sim_index = -1;
   bool plot = false;  ///< among the first plots_per_group items of its group (PlanEvaluation)
+  /// The group's shape registration (RegisterGroups): applied to the object's shape before any
+  /// estimate, when the group's recordings together say the shape does not fit as given.
+  std::optional<graph::ShapeTransform> shape_transform;
 };
 
 /// Files from paths, folders (recursively: *.h5, *.hdf5, *.json) and glob patterns, sorted and
@@ -158,6 +162,14 @@ std::vector<std::string> ExpandInputs(const std::vector<std::string>& patterns);
 /// order. The group of a file is the MIT object name in its file name (`shape=NAME`), else its
 /// folder's name.
 std::vector<EvaluationItem> PlanEvaluation(const std::vector<std::string>& files, const EvaluationOptions& options);
+
+/// Shape registration per group (graph::RegisterShape over all of a group's recordings: one
+/// mesh, one tracker, pushes on several sides fix what one push leaves free), before sharding so
+/// that every shard uses the same transforms. Groups whose shape does not fit as given get the
+/// transform in their items (options.estimator.align_shape "off": none do; "on": every group).
+/// Simulated pushes are left alone. Returns one line per group that was checked (what was
+/// found, for the user and the tables).
+std::vector<std::string> RegisterGroups(std::vector<EvaluationItem>& items, const EvaluationOptions& options);
 
 /// "K/N" with 0 <= K < N; throws IoError otherwise.
 std::pair<int, int> ParseShard(const std::string& text);
@@ -172,6 +184,12 @@ struct EvaluationRow {
   std::string error;  ///< non-empty: the trajectory failed (message names the file)
   int steps = 0;
   std::map<std::string, double> stats;
+  /// The self-diagnosis of the trajectory's QS batch estimate with Gaussian noise (the first run
+  /// when that protocol is not run): its score (graph::Diagnostics::score), worst factor, and
+  /// the estimate's warnings (probable causes, shape alignment).
+  double health = 0.0;
+  std::string worst_factor;
+  std::vector<std::string> notes;
 };
 
 /// Evaluates one item for every selected protocol; never throws (errors go into the row).
