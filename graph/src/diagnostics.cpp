@@ -281,7 +281,7 @@ Diagnostics Diagnose(const limit_surface::Trajectory& traj, Model model, const E
   }
   if (d.penetration_share > 0.2) {
     d.causes.push_back(Format("the finger is inside the object in %.0f%% of the steps (by more than %.1f mm): shape frame, "
-                              "units or probe radius?",
+                              "units, probe radius, or a finger touching two walls at once (several contacts)?",
                               d.penetration_share * 100.0, d.penetration_tolerance * 1e3));
   }
   for (const FactorStatistics& f : d.factors) {
@@ -293,7 +293,8 @@ Diagnostics Diagnose(const limit_surface::Trajectory& traj, Model model, const E
     else if (f.type == "quasi_static" || f.type == "limit_surface_load")
       why = "the pushing model does not hold (c, friction, several contacts) or the shape's centre of pressure is off";
     else if (f.type == "touching" || f.type == "intersection")
-      why = "the finger cannot touch the object where the data put it: shape frame, units or probe radius";
+      why = "the finger cannot touch the object where the data put it: shape frame, units, probe radius, or several "
+            "contacts at once";
     else continue;
     d.causes.push_back(Format("%s residuals are %.1f times their expected size (chi-square %.0f for %.0f expected): %s",
                               f.type.c_str(), f.Ratio(), f.chi2, f.expected, why.c_str()));

@@ -918,14 +918,12 @@ EstimationResult Estimate(const limit_surface::Trajectory& trajectory, Model mod
   RegistrationOptions options = RegistrationOptionsFor(config);
   options.estimate_scale = config.align_scale;
   std::optional<RegistrationResult> registration;
-  bool gaps_fit = true;
   internal::ValidateTrajectory(trajectory);
   try {
     alignment.check = CheckShapeFit(trajectory, options);
     alignment.checked = true;
     // Always: the check's gaps miss a turn that the noise hides, the likelihood ratio does not.
     registration = RegisterShape(trajectory, options);
-    gaps_fit = alignment.check.fits;
     alignment.check.fits = registration->fits_as_given;
   } catch (const std::exception& e) {
     // Too few contacts with object poses near them to say anything about the shape.
@@ -945,8 +943,7 @@ EstimationResult Estimate(const limit_surface::Trajectory& trajectory, Model mod
   bool size_wins = false, identity_wins = false;
   const bool will_align = registration && (config.align_shape == Align::kOn || (config.align_shape == Align::kAuto && misfit));
   if (registration && (misfit || config.align_shape == Align::kOn) &&
-      (size_candidate || !registration->alternatives.empty() || (will_align && mode == Mode::kIncremental) ||
-       (gaps_fit && misfit))) {
+      (size_candidate || !registration->alternatives.empty() || will_align)) {
     EstimatorConfig quick = config;
     quick.covariance = false;
     quick.diagnostics = false;
@@ -968,8 +965,9 @@ EstimationResult Estimate(const limit_surface::Trajectory& trajectory, Model mod
     };
     ShapeTransform best, refined;
     double best_cost = framed_cost(registration->transform, &best);
-    // When only the likelihood ratio (not the gaps) says misfit, the shape as given competes too.
-    if (gaps_fit && misfit) {
+    // The shape as given competes too: the contacts alone can misjudge a push the model does
+    // not describe (a finger wedged between two walls under bimodal noise misfired so).
+    {
       ShapeTransform as_given;
       const double cost = framed_cost(as_given, &refined);
       char text[200];
@@ -1065,14 +1063,7 @@ EstimationResult Estimate(const limit_surface::Trajectory& trajectory, Model mod
     result = inc.Finish();
   }
   if (alignment.checked && !alignment.check.fits) {
-    std::string what = "the object's shape does not fit this recording as given (" + alignment.check.Describe();
-    if (gaps_fit && registration) {
-      char lr[160];
-      std::snprintf(lr, sizeof lr, "; a placement that moves it by %.1f mm fits the contacts better by %.1f in log-likelihood",
-                    registration->displacement * 1e3, registration->identity_cost - registration->aligned_cost);
-      what += lr;
-    }
-    what += ")";
+    const std::string what = "the object's shape does not fit this recording as given (" + alignment.check.Describe() + ")";
     if (size_wins) {
       char size[160];
       std::snprintf(size, sizeof size, "the finger %.1f mm %s than given (radius %.1f mm instead of %.1f mm)",
@@ -1093,6 +1084,16 @@ EstimationResult Estimate(const limit_surface::Trajectory& trajectory, Model mod
     }
   }
 
+  if (registration && registration->fits_as_given && registration->better_elsewhere && !alignment.aligned) {
+    // The gaps are within tolerance, but a different placement explains the contacts clearly
+    // better: say so; aligning on this alone misfired on pushes that break the model.
+    char text[400];
+    std::snprintf(text, sizeof text,
+                  "the object's shape fits this recording within the tolerance, but the contacts fit it better %s "
+                  "(log-likelihood +%.1f): if the shape file's frame is uncertain, --align-shape on aligns it",
+                  registration->Describe().c_str(), registration->identity_cost - registration->aligned_cost);
+    warnings.push_back(text);
+  }
   if (alignment.checked || !alignment.notes.empty()) result.shape_alignment = alignment;
   if (config.diagnostics) {
     result.diagnostics = internal::Diagnose(*working, model, config, result, frame_state ? &*frame_state : nullptr);

@@ -795,6 +795,7 @@ EvaluationRow EvaluateItem(const EvaluationItem& item, const EvaluationOptions& 
         row.notes = r.warnings;
         if (r.shape_alignment && r.shape_alignment->aligned) row.stats["shape/run_aligned/sum"] = 1.0;
       }
+      if (r.shape_alignment && r.shape_alignment->aligned) row.stats[run.Prefix() + "/aligned/sum"] = 1.0;
       AccumulateRun(t, r, run.Prefix(), run.noise == "occluded" ? window : Window{}, sink);
       if (row.steps == 0) row.steps = static_cast<int>(r.states.size());
       if (plot && run.mode == graph::Mode::kBatch) kept.emplace(run.Prefix(), std::move(r));

@@ -87,9 +87,9 @@ struct RegistrationOptions {
   /// sectors of the full turn (fewer for a symmetric outline).
   double alternative_margin = 10.0;
   int sectors = 8;
-  /// The shape as given does not fit either when the best placement's log-likelihood is higher
-  /// by this much and moves the outline by more than fit_tolerance.
-  double misfit_evidence = 5.0;
+  /// RegistrationResult::better_elsewhere: the best placement's log-likelihood is higher by this
+  /// much and it moves the outline by more than fit_tolerance.
+  double misfit_evidence = 6.0;
   /// A best fit that moves no outline point further than this (m) is the shape as given.
   double min_displacement = 1e-3;
   /// Contact gating as the estimator's (EstimatorConfig: contact_max_gap, contact_force_threshold).
@@ -140,7 +140,11 @@ struct RegistrationResult {
   /// The outline is unchanged by turns of 360 / symmetry_order degrees about its centroid;
   /// 0: by any turn (a disk), 1: no symmetry.
   int symmetry_order = 1;
-  bool fits_as_given = true;   ///< the identity explains the data as well (see options)
+  bool fits_as_given = true;   ///< the gaps of the shape as given are within tolerance (see options)
+  /// The gaps fit, but a placement moving the outline by more than fit_tolerance fits the
+  /// contacts better by misfit_evidence or more (a suspicion: estimators warn, "auto" does not
+  /// align on it).
+  bool better_elsewhere = false;
   /// Unit directions (object frame) of translations the contacts do not fix (the prior does).
   std::vector<geometry::Vec2> weak_directions;
   bool ambiguous = false;      ///< another, non-equivalent placement fits about as well
