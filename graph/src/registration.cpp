@@ -841,8 +841,12 @@ RegistrationResult RegisterShape(const std::vector<const limit_surface::Trajecto
     // of log(independent samples) for them.
     double independent = 0.0;
     for (double w : refine.weight) independent += w;
+    // A wrong radius or size offsets every recording alike: recordings whose own gaps differ by
+    // more than the fit tolerance (one side of a turned rectangle pushed in each) are a frame error.
+    const double spread = identity.gap.size() > 0 ? (identity.gap.array() - result.size_offset).abs().maxCoeff() : 0.0;
     result.size_explains = sized_cost <= placed_cost + std::log(std::max(2.0, independent)) &&
-                           std::abs(result.size_offset) <= plausible;
+                           std::abs(result.size_offset) <= plausible && spread <= o.fit_tolerance &&
+                           std::abs(result.size_offset) >= 0.5 * o.gap_sigma;
     if (result.size_explains) {
       result.notes.push_back(Format("the shape as given fits as well with the finger %.1f mm %s (cost %.1f against %.1f for the "
                                     "best placement): a wrong probe radius or object size rather than a wrong frame",
