@@ -1,14 +1,17 @@
-// Exact signed distance + closest point on non-convex polygons (64, 1000, 10000 vertices):
-// pushgraph's QueryPoint against the naive CGAL Epick edge loop and Boost.Geometry, plus
-// pushgraph's brute-force reference and DistanceField lookups, all in the same run on the same
-// query points. Before timing, every exact method's answers are compared with QueryPoint on all
-// query points; the program aborts on a mismatch above 1e-9 (m).
+// Exact signed distance + closest point on detailed non-convex polygons (64 to 100000 vertices),
+// on query sets that cannot hide a worst case: uniform in the bounding box, deep inside, far
+// outside (a random star polygon), inside, near the centre and on the medial axis (spokes) of a
+// regular polygon, and its exact centre. pushgraph's QueryPoint against the naive CGAL Epick
+// edge loop and Boost.Geometry on the same points in the same run; DistanceField lookups and
+// 256 x 256 field construction. Before a case is timed, every method's answers on its points are
+// compared with QueryPoint (the program aborts on a mismatch above 1e-9 m); cases are built
+// lazily, so `--benchmark_list_tests` builds nothing and timing starts after the first case's
+// set-up (printed).
 //
-//   build-gt/bench/geometry/bench_geometry --benchmark_min_time=0.3 --benchmark_repetitions=5 \
-//       --benchmark_enable_random_interleaving=true
+//   build-gt/bench/geometry/bench_geometry --benchmark_min_time=0.2 --benchmark_repetitions=3
 //
-// After the Google Benchmark output, a markdown table of ns/query and speed-ups is printed
-// (the table in docs/benchmarks.md).
+// After the Google Benchmark output, markdown tables of ns/query, speed-ups and each set's ratio to
+// the uniform set are printed (the tables in docs/benchmarks.md).
 #include <pushgraph/geometry/distance_field.h>
 #include <pushgraph/geometry/point_query.h>
 
@@ -23,6 +26,8 @@
 #include <boost/geometry/geometries/polygon.hpp>
 
 #include <algorithm>
+#include <chrono>
+#include <functional>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -44,25 +49,12 @@ using BLinestring = bg::model::linestring<BPoint>;
 namespace {
 
 constexpr int kNumQueries = 4096;  // power of two: index = i & (kNumQueries - 1)
+constexpr int kSizes[] = {64, 1000, 10000, 100000};
 constexpr double kSize = 0.05;     // object radius in metres (a 10 cm object)
 
 struct Answer {
   double sd;
   pg::Vec2 closest;
-};
-
-/// One polygon size: the shape and every competitor's data structure, and the query points.
-struct Case {
-  int n = 0;
-  pg::Shape shape;
-  std::vector<K::Point_2> cgal_ring;
-  BPolygon boost_polygon;
-  BLinestring boost_boundary;
-  std::unique_ptr<pg::DistanceField> field;
-  std::vector<pg::Vec2> queries;
-  std::vector<K::Point_2> cgal_queries;
-  std::vector<BPoint> boost_queries;
-  double field_max_error_seen = 0.0;
 };
 
 // --- The naive CGAL Epick loop: min squared_distance over edges, bounded_side for the sign. ---
@@ -132,208 +124,286 @@ pg::Polygon MakePolygon(int n, uint64_t seed) {
   std::abort();
 }
 
-Case& GetCase(int n) {
-  static std::map<int, std::unique_ptr<Case>> cases;
-  auto it = cases.find(n);
-  if (it != cases.end()) return *it->second;
-  auto c = std::make_unique<Case>();
-  c->n = n;
-  const pg::Polygon poly = MakePolygon(n, 1000 + static_cast<uint64_t>(n));
-  c->shape = pg::Shape::FromPolygons({poly});
-  const pg::Ring& ring = c->shape.polygons()[0].outer;  // normalized (CCW)
+
+// --- Cases: one shape per (kind, size) with every competitor's structures; query sets. ---------
+
+enum class Kind { kStar, kRound };
+
+struct Shape {
+  Kind kind;
+  int n = 0;
+  pg::Shape shape;
+  std::vector<K::Point_2> cgal_ring;
+  BPolygon boost_polygon;
+  BLinestring boost_boundary;
+};
+
+struct QuerySet {
+  std::string name;
+  const Shape* shape = nullptr;
+  std::vector<pg::Vec2> points;
+  std::vector<K::Point_2> cgal_points;
+  std::vector<BPoint> boost_points;
+};
+
+double Seconds(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+const Shape& GetShape(Kind kind, int n) {
+  static std::map<std::pair<int, int>, std::unique_ptr<Shape>> shapes;
+  auto& slot = shapes[{static_cast<int>(kind), n}];
+  if (slot) return *slot;
+  const auto t0 = std::chrono::steady_clock::now();
+  slot = std::make_unique<Shape>();
+  Shape& c = *slot;
+  c.kind = kind;
+  c.n = n;
+  c.shape = kind == Kind::kStar ? pg::Shape::FromPolygons({MakePolygon(n, 1000 + static_cast<uint64_t>(n))})
+                                : pg::Shape::RegularPolygon(n, kSize);
+  const pg::Ring& ring = c.shape.polygons()[0].outer;  // normalized (CCW)
   for (const pg::Vec2& v : ring) {
-    c->cgal_ring.emplace_back(v.x(), v.y());
-    bg::append(c->boost_polygon.outer(), BPoint(v.x(), v.y()));
-    c->boost_boundary.emplace_back(v.x(), v.y());
+    c.cgal_ring.emplace_back(v.x(), v.y());
+    bg::append(c.boost_polygon.outer(), BPoint(v.x(), v.y()));
+    c.boost_boundary.emplace_back(v.x(), v.y());
   }
-  bg::append(c->boost_polygon.outer(), BPoint(ring[0].x(), ring[0].y()));
-  c->boost_boundary.emplace_back(ring[0].x(), ring[0].y());
-  // A 256 x 256 field over the shape (the resolution of the figure in geometry-speed.md); the
-  // margin covers every query point, so all lookups interpolate.
-  const pg::Box2 b = c->shape.bounds();
-  const double side = std::max(b.max.x() - b.min.x(), b.max.y() - b.min.y());
-  pg::DistanceField::Options fo;
-  fo.margin = 0.1 * side + 1e-9;
-  fo.resolution = (side + 2 * fo.margin) / 255.0;
-  fo.error_samples_per_cell = 2;
-  c->field = std::make_unique<pg::DistanceField>(c->shape, fo);
-  // Query points: uniform in the bounding box grown by 10 % (about half inside).
+  bg::append(c.boost_polygon.outer(), BPoint(ring[0].x(), ring[0].y()));
+  c.boost_boundary.emplace_back(ring[0].x(), ring[0].y());
+  std::printf("set-up: %s polygon, %d vertices: shape and index built in %.3f s\n",
+              kind == Kind::kStar ? "star" : "regular", n, Seconds(t0));
+  return c;
+}
+
+const char* const kSets[] = {"uniform", "deep", "far", "round", "centre", "medial", "exact-centre"};
+
+// Points of one set (seeded; the same in every run).
+const QuerySet& GetSet(const std::string& name, int n) {
+  static std::map<std::pair<std::string, int>, std::unique_ptr<QuerySet>> sets;
+  auto& slot = sets[{name, n}];
+  if (slot) return *slot;
+  const bool star = name == "uniform" || name == "deep" || name == "far";
+  const Shape& shape = GetShape(star ? Kind::kStar : Kind::kRound, n);
+  const auto t0 = std::chrono::steady_clock::now();
+  slot = std::make_unique<QuerySet>();
+  QuerySet& q = *slot;
+  q.name = name;
+  q.shape = &shape;
   std::mt19937_64 rng(42);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const double apothem = kSize * std::cos(M_PI / n);
+  const auto in_disk = [&](double radius) {  // uniform in a disk about the origin
+    const double r = radius * std::sqrt(unit(rng)), a = 2.0 * M_PI * unit(rng);
+    return pg::Vec2(r * std::cos(a), r * std::sin(a));
+  };
+  const pg::Ring& ring = shape.shape.polygons()[0].outer;
   for (int i = 0; i < kNumQueries; ++i) {
-    const pg::Vec2 p = pg::testing::RandomPointNear(rng, b, 0.1);
-    c->queries.push_back(p);
-    c->cgal_queries.emplace_back(p.x(), p.y());
-    c->boost_queries.emplace_back(p.x(), p.y());
+    pg::Vec2 p;
+    if (name == "uniform") {
+      p = pg::testing::RandomPointNear(rng, shape.shape.bounds(), 0.1);  // about half inside
+    } else if (name == "deep") {  // at least a third of the size inside
+      p = in_disk(0.9 * pg::testing::InscribedRadius(n, 0.5 * kSize));
+    } else if (name == "far") {  // 10 to 1000 sizes away
+      const double r = kSize * std::pow(10.0, 1.0 + 2.0 * unit(rng)), a = 2.0 * M_PI * unit(rng);
+      p = pg::Vec2(r * std::cos(a), r * std::sin(a));
+    } else if (name == "round") {  // anywhere inside a near-circular shape
+      p = in_disk(0.99 * apothem);
+    } else if (name == "centre") {  // within 1 % of the size of its centre
+      p = in_disk(0.01 * kSize);
+    } else if (name == "medial") {  // on a spoke: equidistant from two edges (up to rounding)
+      const pg::Vec2& v = ring[std::uniform_int_distribution<std::size_t>(0, ring.size() - 1)(rng)];
+      p = (0.01 + 0.98 * unit(rng)) * v;
+    } else {  // every edge at the same distance, up to the rounding of the vertices
+      p = pg::Vec2(0.0, 0.0);
+    }
+    q.points.push_back(p);
+    q.cgal_points.emplace_back(p.x(), p.y());
+    q.boost_points.emplace_back(p.x(), p.y());
   }
-  // Same answers, or no timings.
-  for (int i = 0; i < kNumQueries; ++i) {
-    const pg::Vec2& p = c->queries[static_cast<size_t>(i)];
-    const pg::PointQuery q = pg::QueryPoint(c->shape, p);
-    const pg::PointQuery r = pg::QueryPointBruteForce(c->shape, p);
-    if (q.signed_distance != r.signed_distance) Mismatch("QueryPointBruteForce", n, p, q.signed_distance, r.signed_distance);
-    const Answer a = CgalNaive(c->cgal_ring, c->cgal_queries[static_cast<size_t>(i)]);
-    if (std::abs(a.sd - q.signed_distance) > 1e-9) Mismatch("CGAL Epick loop sd", n, p, a.sd, q.signed_distance);
-    if ((a.closest - q.closest_point).norm() > 1e-9 &&
-        std::abs((a.closest - p).norm() - (q.closest_point - p).norm()) > 1e-9)  // a tie may pick either
-      Mismatch("CGAL Epick loop closest point", n, p, (a.closest - q.closest_point).norm(), 0.0);
-    const double bsd = BoostSignedDistance(c->boost_polygon, c->boost_boundary, c->boost_queries[static_cast<size_t>(i)]);
-    if (std::abs(bsd - q.signed_distance) > 1e-9) Mismatch("Boost.Geometry sd", n, p, bsd, q.signed_distance);
-    c->field_max_error_seen =
-        std::max(c->field_max_error_seen, std::abs(c->field->Evaluate(p) - q.signed_distance));
+  // Same answers, or no timings (a subset at 100000 vertices: the naive loops take 0.5 ms each).
+  const int step = n >= 100000 ? 16 : 1;
+  for (int i = 0; i < kNumQueries; i += step) {
+    const pg::Vec2& p = q.points[static_cast<size_t>(i)];
+    const pg::PointQuery a = pg::QueryPoint(shape.shape, p);
+    if (i % 64 == 0) {
+      const pg::PointQuery r = pg::QueryPointBruteForce(shape.shape, p);
+      if (a.signed_distance != r.signed_distance || a.feature.edge.index != r.feature.edge.index)
+        Mismatch("QueryPointBruteForce", n, p, a.signed_distance, r.signed_distance);
+    }
+    const Answer c = CgalNaive(shape.cgal_ring, q.cgal_points[static_cast<size_t>(i)]);
+    if (std::abs(c.sd - a.signed_distance) > 1e-9) Mismatch("CGAL Epick loop sd", n, p, c.sd, a.signed_distance);
+    if ((c.closest - a.closest_point).norm() > 1e-9 &&
+        std::abs((c.closest - p).norm() - (a.closest_point - p).norm()) > 1e-9)  // a tie may pick either
+      Mismatch("CGAL Epick loop closest point", n, p, (c.closest - a.closest_point).norm(), 0.0);
+    const double b = BoostSignedDistance(shape.boost_polygon, shape.boost_boundary, q.boost_points[static_cast<size_t>(i)]);
+    if (std::abs(b - a.signed_distance) > 1e-9) Mismatch("Boost.Geometry sd", n, p, b, a.signed_distance);
   }
-  return *cases.emplace(n, std::move(c)).first->second;
+  std::printf("set-up: %s set, %d vertices: %d points made and checked in %.3f s\n", name.c_str(), n, kNumQueries,
+              Seconds(t0));
+  return q;
 }
 
-// --- Benchmarks: one query per iteration, cycling through the same 4096 points. -------------
+// --- Benchmarks: one query per iteration, cycling through the set's 4096 points. -------------
 
-void BM_PushgraphQueryPoint(benchmark::State& state) {
-  const Case& c = GetCase(static_cast<int>(state.range(0)));
+void BM_Pushgraph(benchmark::State& state, std::string set, int n) {
+  const QuerySet& q = GetSet(set, n);
   size_t i = 0;
   for (auto _ : state) {
-    const pg::PointQuery q = pg::QueryPoint(c.shape, c.queries[i++ & (kNumQueries - 1)]);
-    benchmark::DoNotOptimize(q.signed_distance);
-    benchmark::DoNotOptimize(q.closest_point);
+    const pg::PointQuery r = pg::QueryPoint(q.shape->shape, q.points[i++ & (kNumQueries - 1)]);
+    benchmark::DoNotOptimize(r.signed_distance);
+    benchmark::DoNotOptimize(r.closest_point);
   }
   state.SetItemsProcessed(state.iterations());
 }
 
-void BM_PushgraphBruteForce(benchmark::State& state) {
-  const Case& c = GetCase(static_cast<int>(state.range(0)));
+void BM_CgalNaive(benchmark::State& state, std::string set, int n) {
+  const QuerySet& q = GetSet(set, n);
   size_t i = 0;
   for (auto _ : state) {
-    const pg::PointQuery q = pg::QueryPointBruteForce(c.shape, c.queries[i++ & (kNumQueries - 1)]);
-    benchmark::DoNotOptimize(q.signed_distance);
-    benchmark::DoNotOptimize(q.closest_point);
-  }
-  state.SetItemsProcessed(state.iterations());
-}
-
-void BM_CgalEpickNaiveLoop(benchmark::State& state) {
-  const Case& c = GetCase(static_cast<int>(state.range(0)));
-  size_t i = 0;
-  for (auto _ : state) {
-    const Answer a = CgalNaive(c.cgal_ring, c.cgal_queries[i++ & (kNumQueries - 1)]);
+    const Answer a = CgalNaive(q.shape->cgal_ring, q.cgal_points[i++ & (kNumQueries - 1)]);
     benchmark::DoNotOptimize(a.sd);
     benchmark::DoNotOptimize(a.closest);
   }
   state.SetItemsProcessed(state.iterations());
 }
 
-void BM_CgalEpickEdgeLoopOnly(benchmark::State& state) {
-  const Case& c = GetCase(static_cast<int>(state.range(0)));
-  size_t i = 0;
-  for (auto _ : state) benchmark::DoNotOptimize(CgalEdgeLoopOnly(c.cgal_ring, c.cgal_queries[i++ & (kNumQueries - 1)]));
-  state.SetItemsProcessed(state.iterations());
-}
-
-void BM_CgalEpickBoundedSideOnly(benchmark::State& state) {
-  const Case& c = GetCase(static_cast<int>(state.range(0)));
-  size_t i = 0;
-  for (auto _ : state)
-    benchmark::DoNotOptimize(
-        CGAL::bounded_side_2(c.cgal_ring.begin(), c.cgal_ring.end(), c.cgal_queries[i++ & (kNumQueries - 1)], K()));
-  state.SetItemsProcessed(state.iterations());
-}
-
-void BM_PlainDoubleLoop(benchmark::State& state) {
-  const Case& c = GetCase(static_cast<int>(state.range(0)));
-  const pg::Ring& ring = c.shape.polygons()[0].outer;
-  size_t i = 0;
-  for (auto _ : state) benchmark::DoNotOptimize(PlainDoubleSignedDistance(ring, c.queries[i++ & (kNumQueries - 1)]));
-  state.SetItemsProcessed(state.iterations());
-}
-
-void BM_BoostGeometry(benchmark::State& state) {
-  const Case& c = GetCase(static_cast<int>(state.range(0)));
+void BM_Boost(benchmark::State& state, std::string set, int n) {
+  const QuerySet& q = GetSet(set, n);
   size_t i = 0;
   for (auto _ : state) {
-    const double d = BoostSignedDistance(c.boost_polygon, c.boost_boundary, c.boost_queries[i++ & (kNumQueries - 1)]);
-    benchmark::DoNotOptimize(d);
+    const size_t k = i++ & (kNumQueries - 1);
+    benchmark::DoNotOptimize(BoostSignedDistance(q.shape->boost_polygon, q.shape->boost_boundary, q.boost_points[k]));
   }
   state.SetItemsProcessed(state.iterations());
 }
 
-void BM_DistanceField(benchmark::State& state) {
-  const Case& c = GetCase(static_cast<int>(state.range(0)));
+// Components of the naive loop and a plain double loop (not exact), on the uniform set.
+void BM_CgalEdgeLoopOnly(benchmark::State& state, int n) {
+  const QuerySet& q = GetSet("uniform", n);
+  size_t i = 0;
+  for (auto _ : state) benchmark::DoNotOptimize(CgalEdgeLoopOnly(q.shape->cgal_ring, q.cgal_points[i++ & (kNumQueries - 1)]));
+  state.SetItemsProcessed(state.iterations());
+}
+
+void BM_PlainDoubleLoop(benchmark::State& state, int n) {
+  const QuerySet& q = GetSet("uniform", n);
+  const pg::Ring& ring = q.shape->shape.polygons()[0].outer;
+  size_t i = 0;
+  for (auto _ : state) benchmark::DoNotOptimize(PlainDoubleSignedDistance(ring, q.points[i++ & (kNumQueries - 1)]));
+  state.SetItemsProcessed(state.iterations());
+}
+
+// A 256 x 256 distance field over the star polygon (65536 exact queries plus the error estimate
+// at 2 samples per cell): its cost per node against a query's.
+pg::DistanceField::Options FieldOptions(const pg::Shape& shape) {
+  const pg::Box2 b = shape.bounds();
+  const double side = std::max(b.max.x() - b.min.x(), b.max.y() - b.min.y());
+  pg::DistanceField::Options fo;
+  fo.margin = 0.1 * side + 1e-9;
+  fo.resolution = (side + 2 * fo.margin) / 255.0;
+  fo.error_samples_per_cell = 2;
+  return fo;
+}
+
+void BM_DistanceFieldBuild(benchmark::State& state, int n) {
+  const Shape& s = GetShape(Kind::kStar, n);
+  int nodes = 0;
+  for (auto _ : state) {
+    pg::DistanceField field(s.shape, FieldOptions(s.shape));
+    nodes = field.rows() * field.cols();
+    benchmark::DoNotOptimize(field.max_error());
+  }
+  state.counters["nodes"] = nodes;
+}
+
+void BM_DistanceFieldLookup(benchmark::State& state, int n) {
+  const QuerySet& q = GetSet("uniform", n);
+  static std::map<int, std::unique_ptr<pg::DistanceField>> fields;
+  auto& field = fields[n];
+  if (!field) field = std::make_unique<pg::DistanceField>(q.shape->shape, FieldOptions(q.shape->shape));
   size_t i = 0;
   pg::Vec2 g;
   for (auto _ : state) {
-    const double v = c.field->Evaluate(c.queries[i++ & (kNumQueries - 1)], &g);
-    benchmark::DoNotOptimize(v);
+    benchmark::DoNotOptimize(field->Evaluate(q.points[i++ & (kNumQueries - 1)], &g));
     benchmark::DoNotOptimize(g);
   }
   state.SetItemsProcessed(state.iterations());
-  state.counters["max_err_seen_m"] = c.field_max_error_seen;
-  state.counters["max_err_reported_m"] = c.field->max_error();
 }
 
-BENCHMARK(BM_PushgraphQueryPoint)->Arg(64)->Arg(1000)->Arg(10000);
-BENCHMARK(BM_PushgraphBruteForce)->Arg(64)->Arg(1000)->Arg(10000);
-BENCHMARK(BM_CgalEpickNaiveLoop)->Arg(64)->Arg(1000)->Arg(10000);
-BENCHMARK(BM_CgalEpickEdgeLoopOnly)->Arg(64)->Arg(1000)->Arg(10000);
-BENCHMARK(BM_CgalEpickBoundedSideOnly)->Arg(64)->Arg(1000)->Arg(10000);
-BENCHMARK(BM_PlainDoubleLoop)->Arg(64)->Arg(1000)->Arg(10000);
-BENCHMARK(BM_BoostGeometry)->Arg(64)->Arg(1000)->Arg(10000);
-BENCHMARK(BM_DistanceField)->Arg(64)->Arg(1000)->Arg(10000);
+void RegisterAll() {
+  for (const int n : kSizes) {
+    for (const char* set : kSets) {
+      const std::string tail = std::string("/") + set + "/" + std::to_string(n);
+      benchmark::RegisterBenchmark(("pushgraph" + tail).c_str(), BM_Pushgraph, std::string(set), n);
+      benchmark::RegisterBenchmark(("cgal_loop" + tail).c_str(), BM_CgalNaive, std::string(set), n);
+      benchmark::RegisterBenchmark(("boost" + tail).c_str(), BM_Boost, std::string(set), n);
+    }
+    const std::string tail = "/uniform/" + std::to_string(n);
+    benchmark::RegisterBenchmark(("cgal_edge_loop_only" + tail).c_str(), BM_CgalEdgeLoopOnly, n);
+    benchmark::RegisterBenchmark(("plain_double_loop" + tail).c_str(), BM_PlainDoubleLoop, n);
+    benchmark::RegisterBenchmark(("field_lookup" + tail).c_str(), BM_DistanceFieldLookup, n);
+    benchmark::RegisterBenchmark(("field_build_256" + tail).c_str(), BM_DistanceFieldBuild, n)
+        ->Unit(benchmark::kMillisecond)
+        ->Iterations(1);
+  }
+}
 
-/// Console output plus a markdown table of ns/query and ratios at the end.
+/// Console output plus markdown tables at the end (median CPU time over the repetitions).
 class TableReporter : public benchmark::ConsoleReporter {
  public:
   void ReportRuns(const std::vector<Run>& runs) override {
     ConsoleReporter::ReportRuns(runs);
     for (const Run& r : runs) {
       if (r.error_occurred || r.run_type != Run::RT_Iteration) continue;
-      const std::string name = r.benchmark_name();
-      const auto slash = name.find('/');
-      // CPU time (the machine is shared: wall time includes being descheduled); the table
-      // takes the median over --benchmark_repetitions.
-      samples_[std::stoi(name.substr(slash + 1))][name.substr(0, slash)].push_back(
-          r.GetAdjustedCPUTime() * (r.time_unit == benchmark::kMicrosecond ? 1e3 : r.time_unit == benchmark::kMillisecond ? 1e6 : 1.0));
+      const double unit = r.time_unit == benchmark::kMicrosecond ? 1e3
+                          : r.time_unit == benchmark::kMillisecond ? 1e6
+                          : r.time_unit == benchmark::kSecond     ? 1e9
+                                                                  : 1.0;
+      // CPU time (the machine is shared: wall time includes being descheduled).
+      std::string name = r.benchmark_name();
+      const auto tag = name.find("/iterations:");
+      if (tag != std::string::npos) name.erase(tag);
+      samples_[name].push_back(r.GetAdjustedCPUTime() * unit);
     }
   }
-  void PrintTable() {
-    for (auto& [n, m] : samples_)
-      for (auto& [k, v] : m) {
-        std::sort(v.begin(), v.end());
-        ns_[n][k] = v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+  double Ns(const std::string& method, const std::string& set, int n) const {
+    auto it = samples_.find(method + "/" + set + "/" + std::to_string(n));
+    if (it == samples_.end() || it->second.empty()) return std::nan("");
+    std::vector<double> v = it->second;
+    std::sort(v.begin(), v.end());
+    return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+  }
+  void PrintTables() const {
+    std::printf("\nMedian CPU time per query (ns) over the repetitions; x CGAL = the naive CGAL loop's time over "
+                "pushgraph's; / uniform = pushgraph's time over its uniform set's.\n");
+    std::printf("\n| vertices | set | pushgraph | CGAL Epick loop | Boost.Geometry | x CGAL | x Boost | / uniform |\n");
+    std::printf("|---:|---|---:|---:|---:|---:|---:|---:|\n");
+    for (const int n : kSizes) {
+      const double uniform = Ns("pushgraph", "uniform", n);
+      double worst = 0.0;
+      std::string worst_set;
+      for (const char* set : kSets) {
+        const double p = Ns("pushgraph", set, n), c = Ns("cgal_loop", set, n), b = Ns("boost", set, n);
+        if (std::isnan(p)) continue;
+        std::printf("| %d | %s | %.0f | %.0f | %.0f | %.0fx | %.0fx | %.2f |\n", n, set, p, c, b, c / p, b / p, p / uniform);
+        if (std::string(set) != "exact-centre" && p > worst) worst = p, worst_set = set;
       }
-    std::printf("\nMedian CPU time per query over %zu repetition(s).\n",
-                samples_.empty() ? size_t{0} : samples_.begin()->second.begin()->second.size());
-    std::printf("\n| vertices | pushgraph QueryPoint | brute force (ref.) | CGAL Epick naive loop | Boost.Geometry "
-                "distance + within | DistanceField 256^2 | speed-up vs CGAL loop | vs Boost.Geometry |\n");
-    std::printf("|---:|---:|---:|---:|---:|---:|---:|---:|\n");
-    for (const auto& [n, m] : ns_) {
-      auto get = [&](const char* k) {
-        auto it = m.find(k);
-        return it == m.end() ? std::nan("") : it->second;
-      };
-      const double q = get("BM_PushgraphQueryPoint");
-      std::printf("| %d | %.0f ns | %.0f ns | %.0f ns | %.0f ns | %.1f ns | %.1fx | %.1fx |\n", n, q,
-                  get("BM_PushgraphBruteForce"), get("BM_CgalEpickNaiveLoop"), get("BM_BoostGeometry"),
-                  get("BM_DistanceField"), get("BM_CgalEpickNaiveLoop") / q, get("BM_BoostGeometry") / q);
+      if (!worst_set.empty())
+        std::printf("| %d | **worst set (%s)** | %.0f | | | | | **%.2f** |\n", n, worst_set.c_str(), worst, worst / uniform);
     }
-    std::printf("\n| vertices | CGAL edge loop only | CGAL bounded_side_2 only | plain double loop (not exact) |\n");
-    std::printf("|---:|---:|---:|---:|\n");
-    for (const auto& [n, m] : ns_) {
-      auto get = [&](const char* k) {
-        auto it = m.find(k);
-        return it == m.end() ? std::nan("") : it->second;
-      };
-      std::printf("| %d | %.0f ns | %.0f ns | %.0f ns |\n", n, get("BM_CgalEpickEdgeLoopOnly"),
-                  get("BM_CgalEpickBoundedSideOnly"), get("BM_PlainDoubleLoop"));
-    }
-    std::printf("\n");
-    for (const int n : {64, 1000, 10000}) {
-      const Case& c = GetCase(n);
-      std::printf("DistanceField %d vertices: %d x %d grid, max |error| on the 4096 query points %.3g m, reported "
-                  "max_error() %.3g m\n",
-                  n, c.field->rows(), c.field->cols(), c.field_max_error_seen, c.field->max_error());
+    std::printf("\n| vertices | CGAL edge loop only | plain double loop (not exact) | field lookup | 256^2 field build | "
+                "build per node | / uniform query |\n");
+    std::printf("|---:|---:|---:|---:|---:|---:|---:|\n");
+    for (const int n : kSizes) {
+      const double build = Ns("field_build_256", "uniform", n);
+      std::printf("| %d | %.0f ns | %.0f ns | %.1f ns | %.1f ms | %.0f ns | %.2f |\n", n,
+                  Ns("cgal_edge_loop_only", "uniform", n), Ns("plain_double_loop", "uniform", n),
+                  Ns("field_lookup", "uniform", n), build * 1e-6, build / 65536.0,
+                  build / 65536.0 / Ns("pushgraph", "uniform", n));
     }
   }
 
  private:
-  std::map<int, std::map<std::string, double>> ns_;
-  std::map<int, std::map<std::string, std::vector<double>>> samples_;
+  std::map<std::string, std::vector<double>> samples_;
 };
 
 }  // namespace
@@ -341,12 +411,10 @@ class TableReporter : public benchmark::ConsoleReporter {
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  // Build every case (and check every answer) before any timing.
-  for (const int n : {64, 1000, 10000}) GetCase(n);
-  std::printf("answers agree on %d query points per polygon (|diff| <= 1e-9 m)\n", kNumQueries);
+  RegisterAll();
   TableReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
-  reporter.PrintTable();
+  reporter.PrintTables();
   benchmark::Shutdown();
   return 0;
 }

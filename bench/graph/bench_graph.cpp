@@ -48,6 +48,35 @@ void Batch(benchmark::State& state, graph::Model model, bool covariance,
   state.counters["lm_iterations"] = iterations;
 }
 
+// The same square with every side cut into equal collinear edges: the same geometry, so the same
+// estimate, with n vertices. Its time against the 4-vertex square's is what a detailed mesh costs
+// the estimator (the registration, every factor's shape query and the diagnostics included).
+geometry::Shape SubdividedSquare(double side, int vertices) {
+  const int per_side = std::max(1, vertices / 4);
+  geometry::Polygon p;
+  const geometry::Vec2 corners[4] = {{-side / 2, -side / 2}, {side / 2, -side / 2}, {side / 2, side / 2}, {-side / 2, side / 2}};
+  for (int c = 0; c < 4; ++c)
+    for (int k = 0; k < per_side; ++k)
+      p.outer.push_back(corners[c] + (corners[(c + 1) % 4] - corners[c]) * (static_cast<double>(k) / per_side));
+  return geometry::Shape::FromPolygons({p});
+}
+
+void BM_BatchQsDetailedObject(benchmark::State& state) {
+  limit_surface::Trajectory traj = Push(1000);
+  traj.object.shape = SubdividedSquare(0.09, static_cast<int>(state.range(0)));
+  graph::EstimatorConfig cfg;
+  cfg.covariance = false;
+  double rms = 0.0;
+  for (auto _ : state) {
+    const graph::EstimationResult r = graph::Estimate(traj, graph::Model::kQs, graph::Mode::kBatch, cfg);
+    rms = r.metrics.count("object_position_rms") ? r.metrics.at("object_position_rms") : -1.0;
+    benchmark::DoNotOptimize(r.states.data());
+  }
+  state.counters["vertices"] = static_cast<double>(traj.object.shape.num_vertices());
+  state.counters["object_rms_m"] = rms;
+}
+BENCHMARK(BM_BatchQsDetailedObject)->Arg(4)->Arg(1000)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond)->Iterations(1);
+
 void BM_BatchQs(benchmark::State& s) { Batch(s, graph::Model::kQs, false); }
 void BM_BatchQsWithCovariance(benchmark::State& s) { Batch(s, graph::Model::kQs, true); }
 // The peer: the same solve with ceres::Covariance (SPARSE_QR) for the marginals.

@@ -7,6 +7,7 @@
 
 #include <ceres/cubic_interpolation.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -66,12 +67,24 @@ DistanceField::DistanceField(const Shape& shape, const Options& options) : impl_
   m.interpolator = std::make_unique<ceres::BiCubicInterpolator<ceres::Grid2D<double, 1>>>(*m.grid);
 
   const int samples = options.error_samples_per_cell;
+  const auto is_kink = [&](std::size_t k) {
+    return feature[k] != feature[k + 1] || feature[k] != feature[k + m.cols] || feature[k] != feature[k + m.cols + 1];
+  };
+  // Kink cells get 8 s + 1 samples per axis, but all of them together at most twice the plain
+  // check's samples: a detailed outline (edges shorter than a cell) makes most cells near it kink
+  // cells, and the check's cost must stay proportional to the grid.
+  std::size_t kinks = 0;
+  for (int i = 0; samples > 0 && i + 1 < m.rows; ++i)
+    for (int j = 0; j + 1 < m.cols; ++j) kinks += is_kink(static_cast<std::size_t>(i) * m.cols + j) ? 1 : 0;
+  const double cells = static_cast<double>(m.rows - 1) * (m.cols - 1);
+  const int kink_samples =
+      kinks == 0 ? samples
+                 : std::clamp(static_cast<int>(std::sqrt(2.0 * cells * samples * samples / static_cast<double>(kinks))),
+                              samples, 8 * samples + 1);
   for (int i = 0; samples > 0 && i + 1 < m.rows; ++i) {
     for (int j = 0; j + 1 < m.cols; ++j) {
       const std::size_t k = static_cast<std::size_t>(i) * m.cols + j;
-      const bool kink = feature[k] != feature[k + 1] || feature[k] != feature[k + m.cols] ||
-                        feature[k] != feature[k + m.cols + 1];
-      const int s = kink ? 8 * samples + 1 : samples;
+      const int s = is_kink(k) ? kink_samples : samples;
       for (int a = 0; a < s; ++a) {
         for (int c = 0; c < s; ++c) {
           const Vec2 p = m.bounds.min + m.h * Vec2(j + (c + 0.5) / s, i + (a + 0.5) / s);

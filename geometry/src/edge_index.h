@@ -1,11 +1,15 @@
 #pragma once
 // Spatial index over a shape's edges, so that a point query does not visit every edge.
 //
-// Two levels: a uniform grid over the shape's neighbourhood whose cells each store a
-// conservative candidate list (every edge that can be closest to some point of the cell:
-// those whose distance to the cell is at most the cell's upper bound on the nearest-edge
-// distance), and a Boost.Geometry R-tree for points outside the grid. Candidate lists are
-// filters only; the final choice among candidates is made with exact predicates.
+// Two levels: a uniform grid over the shape's neighbourhood (about 16 cells per edge, at most
+// 512 x 512) whose cells store a conservative candidate list (every edge that can be closest to
+// some point of the cell: those whose distance to the cell is at most the cell's upper bound on
+// the nearest-edge distance), and a strip tree (chains of edges in chord-aligned rectangles and,
+// where they bend like arcs, annular sectors) searched by branch and bound for points outside the
+// grid and in cells whose lists would be long. A query reads O(log n) nodes plus the features tied
+// with the nearest to within rounding. A Boost.Geometry R-tree answers box queries (validation).
+// Candidate lists are filters only; the final choice among candidates is made with exact
+// predicates.
 #include <pushgraph/geometry/types.h>
 
 #include <memory>

@@ -19,6 +19,12 @@ inline void TwoDiff(double a, double b, double* s, double* e) {
   const double av = *s + bv;
   *e = (a - av) + (bv - b);
 }
+inline void TwoSum(double a, double b, double* s, double* e) {
+  *s = a + b;
+  const double bv = *s - a;
+  const double av = *s - bv;
+  *e = (a - av) + (b - bv);
+}
 inline void TwoProduct(double a, double b, double* p, double* e) {
   *p = a * b;
 #if defined(__FMA__) || defined(__aarch64__)
@@ -68,23 +74,48 @@ int DotSignExact(const Vec2& p, const Vec2& a, const Vec2& b) {
   }
 }
 
-double AccurateCross(const Vec2& a, const Vec2& b, const Vec2& p) {
+namespace {
+
+// cross(b - a, p - a) (or, with `dot`, dot(p - a, b - a)) as the double-double s + tail, the
+// differences taken error-free (TwoDiff) and the products by TwoProduct; `scale` = |first
+// product| + |second product|. The tail's own rounding is below ~4 eps^2 scale.
+struct Expansion {
+  double s, tail, scale;
+};
+Expansion CrossOrDot(const Vec2& a, const Vec2& b, const Vec2& p, bool dot) {
   double ex, exl, ey, eyl, px, pxl, py, pyl;
   TwoDiff(b.x(), a.x(), &ex, &exl);
   TwoDiff(b.y(), a.y(), &ey, &eyl);
   TwoDiff(p.x(), a.x(), &px, &pxl);
   TwoDiff(p.y(), a.y(), &py, &pyl);
+  // cross = ex py - ey px; dot = ex px + ey py: the same expansion with (px, py) -> (py, -px).
+  if (dot) {
+    const double qx = py, qxl = pyl;
+    py = px, pyl = pxl;
+    px = -qx, pxl = -qxl;
+  }
   double p1, e1, p2, e2, s, es;
   TwoProduct(ex, py, &p1, &e1);
   TwoProduct(ey, px, &p2, &e2);
   TwoDiff(p1, p2, &s, &es);
   const double tail = es + e1 - e2 + (ex * pyl + exl * py + exl * pyl) - (ey * pxl + eyl * px + eyl * pxl);
-  const double value = s + tail;
-  // The tail's own rounding is below ~4 eps^2 (|ex py| + |ey px|): below half an ulp of the
-  // value whenever |value| > 8 eps scale. Closer to the edge's line, compute it exactly.
-  const double scale = std::abs(p1) + std::abs(p2);
-  if (std::abs(value) > 8.0 * kEps * scale) return value;
+  return {s, tail, std::abs(p1) + std::abs(p2)};
+}
+
+}  // namespace
+
+double AccurateCross(const Vec2& a, const Vec2& b, const Vec2& p) {
+  const Expansion c = CrossOrDot(a, b, p, false);
+  const double value = c.s + c.tail;
+  // Below half an ulp of the value whenever |value| > 8 eps scale. Closer to the edge's line,
+  // compute it exactly.
+  if (std::abs(value) > 8.0 * kEps * c.scale) return value;
   return CGAL::to_double(ExactCross(a, b, p));
+}
+
+double AccurateDot(const Vec2& a, const Vec2& b, const Vec2& p) {
+  const Expansion d = CrossOrDot(a, b, p, true);
+  return d.s + d.tail;
 }
 
 double AccurateSquaredLength(const Vec2& a, const Vec2& b) {
@@ -92,6 +123,67 @@ double AccurateSquaredLength(const Vec2& a, const Vec2& b) {
   TwoDiff(b.x(), a.x(), &ex, &exl);
   TwoDiff(b.y(), a.y(), &ey, &eyl);
   return ex * ex + ey * ey + 2.0 * (ex * exl + ey * eyl);
+}
+
+namespace {
+
+// x^2 + y^2 for x = xh + xl, y = yh + yl (exact differences) as a double-double with its error.
+SquaredDistanceDD SumOfSquares(double xh, double xl, double yh, double yl) {
+  double sx, ex, sy, ey, s, es;
+  TwoProduct(xh, xh, &sx, &ex);
+  TwoProduct(yh, yh, &sy, &ey);
+  TwoSum(sx, sy, &s, &es);
+  SquaredDistanceDD r;
+  r.hi = s;
+  r.lo = es + ex + ey + 2.0 * (xh * xl + yh * yl) + (xl * xl + yl * yl);
+  // Every term of lo is below 3 eps s; their rounding is below a few eps^2 s.
+  r.err = 32.0 * kEps * kEps * s;
+  return r;
+}
+
+}  // namespace
+
+SquaredDistanceDD AccurateSquaredDistance(const Vec2& p, const FeatureDistance& f) {
+  if (!f.is_edge) {
+    double xh, xl, yh, yl;
+    TwoDiff(p.x(), f.a.x(), &xh, &xl);
+    TwoDiff(p.y(), f.a.y(), &yh, &yl);
+    return SumOfSquares(xh, xl, yh, yl);
+  }
+  // cross(b - a, p - a)^2 / |b - a|^2, the cross product as a double-double C = ch + cl with
+  // |C - exact| <= errc.
+  const Vec2 &a = f.a, &b = f.b;
+  const Expansion cross = CrossOrDot(a, b, p, false);
+  double ch, cl;
+  TwoSum(cross.s, cross.tail, &ch, &cl);
+  const double errc = 8.0 * kEps * kEps * cross.scale;
+  double ex, exl, ey, eyl;
+  TwoDiff(b.x(), a.x(), &ex, &exl);
+  TwoDiff(b.y(), a.y(), &ey, &eyl);
+  const SquaredDistanceDD len2 = SumOfSquares(ex, exl, ey, eyl);
+  // C^2 as q + qe, then the quotient by the length: hi = q / L, lo = remainder / L.
+  double q, qe;
+  TwoProduct(ch, ch, &q, &qe);
+  qe += 2.0 * ch * cl + cl * cl;
+  const double L = len2.hi;
+  SquaredDistanceDD r;
+  r.hi = q / L;
+  double m, me;
+  TwoProduct(r.hi, L, &m, &me);  // r.hi L exactly; q - m is exact (Sterbenz)
+  r.lo = ((q - m) - me + qe - r.hi * len2.lo) / L;
+  const double c = std::abs(ch) + std::abs(cl);
+  r.err = (2.0 * c * errc + errc * errc) / L + r.hi * (len2.err + 4.0 * kEps * kEps * L) / L + 32.0 * kEps * kEps * r.hi;
+  return r;
+}
+
+int CompareSquaredDistance(const Vec2& p, const FeatureDistance& f, const FeatureDistance& g) {
+  const SquaredDistanceDD x = AccurateSquaredDistance(p, f), y = AccurateSquaredDistance(p, g);
+  const double diff = (x.hi - y.hi) + (x.lo - y.lo);
+  const double bound = (x.err + y.err) * (1.0 + 1e-6) + 4.0 * kEps * (std::abs(x.lo) + std::abs(y.lo) + std::abs(diff)) +
+                       4.0 * kEps * kEps * (x.hi + y.hi);
+  if (diff > bound) return 1;
+  if (-diff > bound) return -1;
+  return CompareSquaredDistanceExact(p, f, g);
 }
 
 int CompareSquaredDistanceExact(const Vec2& p, const FeatureDistance& f, const FeatureDistance& g) {

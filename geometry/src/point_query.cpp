@@ -2,8 +2,9 @@
 //
 // The closest feature (a vertex, or the interior of an edge) is found among the edge index's
 // candidates. Which part of an edge is closest is decided by exact dot-product signs; features
-// whose approximate squared distances tie to within rounding are compared in exact rational
-// arithmetic, and exact ties go to the lowest vertex number, so the answer never depends on the
+// whose approximate squared distances tie to within rounding are compared in double-double
+// arithmetic with an error bound, and in exact rationals where even that cannot decide; exact
+// ties go to the lowest vertex number, so the answer never depends on the
 // candidates' order. The side (inside/outside) follows from the closest feature with exact
 // orientation tests: interior is on the left of every ring (outer CCW, holes CW).
 #include <pushgraph/geometry/point_query.h>
@@ -49,37 +50,17 @@ FeatureDistance ToExact(const Shape::Impl& m, const Feature& f) {
   return fd;
 }
 
-// First pass, plain double arithmetic: bounds on the squared distance from p to an edge (the
-// clamped projection). Near the switch between the edge's interior and an end the two formulas
-// agree to far below the bound, so the bounds hold even where the double classification could
-// be wrong.
+// First pass, plain double arithmetic: bounds on the squared distance from p to an edge
+// (exact::SegmentDistanceBounds).
 struct Bounded {  // plain data: a buffer of these is not initialized per query
   int start;
   double lo, hi;
 };
 
 inline Bounded BoundEdge(const Shape::Impl& m, int start, const Vec2& p) {
-  const Vec2& a = m.vertices[start];
-  const Vec2& b = m.vertices[m.next[start]];
-  const double ex = b.x() - a.x(), ey = b.y() - a.y(), wx = p.x() - a.x(), wy = p.y() - a.y();
-  const double t = ex * wx + ey * wy;
-  const double len2 = ex * ex + ey * ey;
-  double d2;
-  if (t <= 0.0) {
-    d2 = wx * wx + wy * wy;
-  } else if (t >= len2) {
-    const double vx = p.x() - b.x(), vy = p.y() - b.y();
-    d2 = vx * vx + vy * vy;
-  } else {
-    const double c = ex * wy - ey * wx;
-    d2 = c * c / len2;
-  }
-  // |error of the distance| <= 8 eps (|w| + |e|) covers every branch (cross-product rounding
-  // included); a cheap upper bound of |w| + |e| is the sum of the absolute components.
-  const double err = 8.0 * exact::kEps * (std::abs(wx) + std::abs(wy) + std::abs(ex) + std::abs(ey));
-  const double d = std::sqrt(d2);
-  const double lo = std::max(0.0, d - err);
-  return {start, lo * lo, (d + err) * (d + err)};
+  double lo, hi;
+  exact::SegmentDistanceBounds(p, m.vertices[start], m.vertices[m.next[start]], &lo, &hi);
+  return {start, lo * lo, hi * hi};
 }
 
 // Second pass, for the edges that can still win: which part of the edge is closest (exact
@@ -112,7 +93,7 @@ bool Closer(const Shape::Impl& m, const Vec2& p, const Feature& candidate, const
   const double window = 32.0 * exact::kEps * std::max(candidate.d2, best.d2);
   if (candidate.d2 < best.d2 - window) return true;
   if (candidate.d2 > best.d2 + window) return false;
-  const int c = exact::CompareSquaredDistanceExact(p, ToExact(m, candidate), ToExact(m, best));
+  const int c = exact::CompareSquaredDistance(p, ToExact(m, candidate), ToExact(m, best));
   return c < 0 || (c == 0 && candidate.key() < best.key());
 }
 
@@ -187,7 +168,7 @@ CoreResult QueryCore(const Shape::Impl& m, const Vec2& p, EdgeIndex::Span span) 
     // A segment core has no inside: its normal points to the side the point is on.
     out.normal = m.degenerate_core && best.cross > 0.0 ? left_unit : Vec2(-left_unit);
     out.side = best.cross == 0.0 ? 0 : (m.degenerate_core ? 1 : (best.cross > 0 ? -1 : 1));
-    out.feature.t = std::clamp((p - a).dot(b - a) / best.len2, 0.0, 1.0);
+    out.feature.t = std::clamp(exact::AccurateDot(a, b, p) / best.len2, 0.0, 1.0);
     return out;
   }
   out.closest = a;
@@ -247,7 +228,7 @@ PointQuery Finish(const Shape::Impl& m, const Vec2& p, const CoreResult& core) {
 PointQuery QueryPoint(const Shape& shape, const Vec2& point) {
   CheckPoint(point);
   const Shape::Impl& m = shape.impl();
-  return Finish(m, point, QueryCore(m, point, m.index.Candidates(point)));
+  return Finish(m, point, QueryCore(m, point, m.index->Candidates(point)));
 }
 
 PointQuery QueryPointBruteForce(const Shape& shape, const Vec2& point) {

@@ -129,7 +129,7 @@ void CheckEdgeIntersections(const Shape::Impl& impl) {
     const Vec2& a = impl.vertices[i];
     const Vec2& b = impl.vertices[impl.next[i]];
     Box2 box{a.cwiseMin(b), a.cwiseMax(b)};
-    impl.index.EdgesInBox(box, &nearby);
+    impl.index->EdgesInBox(box, &nearby);
     const K::Segment_2 s(K::Point_2(a.x(), a.y()), K::Point_2(b.x(), b.y()));
     for (int l : nearby) {
       if (l <= k) continue;
@@ -263,7 +263,9 @@ std::shared_ptr<Shape::Impl> BuildShapeImpl(std::vector<Polygon> polygons, doubl
   for (std::size_t k = 1; k < order.size(); ++k)
     if (v[order[k]] == v[order[k - 1]]) impl->shared_vertex[order[k]] = impl->shared_vertex[order[k - 1]] = 1;
   impl->polygons = std::move(polygons);
-  impl->index.Build(impl->vertices, impl->edges, impl->next, impl->core_bounds);
+  auto index = std::make_shared<EdgeIndex>();
+  index->Build(impl->vertices, impl->edges, impl->next, impl->core_bounds);
+  impl->index = std::move(index);
   return impl;
 }
 
@@ -367,8 +369,10 @@ const Ring& Shape::ring(int polygon, int ring) const {
 Shape Shape::WithRadius(double radius) const {
   if (!std::isfinite(radius) || radius < 0.0) throw GeometryError("rounding radius must be finite and >= 0");
   if (impl().degenerate_core && radius <= 0.0) throw GeometryError("a point or segment core needs a rounding radius > 0");
-  // The polygons were validated when this shape was made; only the index is rebuilt.
-  return Shape(BuildShapeImpl(impl().polygons, radius));
+  // The same core (validated when this shape was made) and its index; only the radius differs.
+  auto copy = std::make_shared<Impl>(impl());
+  copy->radius = radius;
+  return Shape(std::move(copy));
 }
 
 }  // namespace pushgraph::geometry

@@ -4,6 +4,7 @@
 
 #include "edge_index.h"
 
+#include <memory>
 #include <vector>
 
 namespace pushgraph::geometry {
@@ -32,7 +33,8 @@ struct Shape::Impl {
   std::vector<int> edges;  // global start-vertex index of every edge
   Box2 core_bounds;
   double core_area = 0.0;
-  EdgeIndex index;
+  // Depends on the core only: shapes that differ in the rounding radius share it.
+  std::shared_ptr<const EdgeIndex> index;
 
   EdgeId edge_id(int global_vertex) const {
     const RingInfo& r = rings[vertex_ring[global_vertex]];

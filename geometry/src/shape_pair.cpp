@@ -325,7 +325,7 @@ ShapePairResult ShapePairQuerier::Impl::QuerySampled(const Pose2& object_pose, c
     std::vector<int> nearby;
     for (int e : fi.edges) {
       const Vec2 a = Act(rel, fi.vertices[e]), b = Act(rel, fi.vertices[fi.next[e]]);
-      oi.index.EdgesInBox({a.cwiseMin(b), a.cwiseMax(b)}, &nearby);
+      oi.index->EdgesInBox({a.cwiseMin(b), a.cwiseMax(b)}, &nearby);
       for (int k : nearby) {
         const Vec2& u = oi.vertices[oi.edges[k]];
         const Vec2& v = oi.vertices[oi.next[oi.edges[k]]];

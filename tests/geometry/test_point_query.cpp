@@ -571,6 +571,36 @@ TEST(PointQueryAccelerated, BitIdenticalToBruteForce10000) {
   CompareWithBruteForce(s, Scaled(1000, 100), 315);
 }
 
+// The index on regular polygons (near-circular: the strip tree's sectors) at the points where
+// bounding-box indexes read every edge: the exact centre, near it, the spokes (medial axis),
+// deep inside and far outside; bit for bit against the brute force.
+TEST(PointQueryAccelerated, BitIdenticalToBruteForceOnRegularPolygons) {
+  std::mt19937_64 rng(316);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (const int n : {100, 5000, Scaled(50000, 5000)}) {
+    for (const Vec2& centre : {Vec2(0.0, 0.0), Vec2(0.3, -0.7)}) {
+      const Shape s = TransformShape(Shape::RegularPolygon(n, 0.05), Pose2{centre.x(), centre.y(), 0.3});
+      std::vector<Vec2> pts{centre};
+      for (int i = 0; i < Scaled(200, 40); ++i) {
+        const double a = 2.0 * testing::kPi * unit(rng);
+        const Vec2 dir(std::cos(a), std::sin(a));
+        pts.push_back(centre + 0.05 * std::pow(10.0, -14.0 + 12.0 * unit(rng)) * dir);
+        pts.push_back(centre + 0.05 * unit(rng) * dir);
+        pts.push_back(centre + 0.05 * std::pow(10.0, 1.0 + 3.0 * unit(rng)) * dir);
+        const Ring& ring = s.polygons()[0].outer;
+        const Vec2& v = ring[std::uniform_int_distribution<std::size_t>(0, ring.size() - 1)(rng)];
+        pts.push_back(centre + unit(rng) * (v - centre));
+      }
+      int failures = 0;
+      for (const Vec2& p : pts) {
+        const auto res = BitIdentical(QueryPoint(s, p), QueryPointBruteForce(s, p));
+        if (!res && ++failures <= 5) ADD_FAILURE() << n << " vertices, at " << Str(p) << "\n" << res.message();
+      }
+      EXPECT_EQ(failures, 0) << n << " vertices, of " << pts.size() << " points";
+    }
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Errors.
 

@@ -21,7 +21,9 @@ class DistanceField {
     double margin = 1e-2;      ///< how far beyond the shape's bounds the grid extends (>= 0)
     /// Error check: points per cell per axis at which the interpolant is compared with the
     /// exact query (0 disables the check). Cells crossed by the medial axis (where the closest
-    /// feature changes between corners and the error peaks) get 8 times as many plus one.
+    /// feature changes between corners and the error peaks) get 8 times as many plus one, but
+    /// together at most twice the plain check's count (a detailed outline makes most cells near
+    /// it such cells): the build costs at most (1 + 3 s^2) exact queries per grid cell.
     int error_samples_per_cell = 2;
   };
 
