@@ -2,6 +2,7 @@
 // path and the polygon/vertex.
 //   {"polygons": [{"outer": [[x, y], ...], "holes": [[[x, y], ...], ...]}, ...], "radius": 0.0}
 #include <pushgraph/geometry/shape.h>
+#include <pushgraph/geometry/file_output.h>
 
 #include <nlohmann/json.hpp>
 
@@ -112,10 +113,8 @@ std::string ShapeToJson(const Shape& shape, int indent) {
 }
 
 void SaveShapeJson(const Shape& shape, const std::string& path) {
-  std::ofstream out(path);
-  if (!out) throw GeometryError(path + ": cannot open file for writing");
-  out << ShapeToJson(shape) << "\n";
-  if (!out) throw GeometryError(path + ": write failed");
+  if (const std::string error = WriteFileAtomically(path, ShapeToJson(shape) + "\n"); !error.empty())
+    throw GeometryError(error);
 }
 
 }  // namespace pushgraph::geometry

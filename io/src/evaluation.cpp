@@ -1,5 +1,6 @@
 // The evaluation workflow (evaluation.h): inputs, noise, per-trajectory statistics, tables,
 // shards.
+#include <pushgraph/geometry/file_output.h>
 #include <pushgraph/io/evaluation.h>
 #include <pushgraph/io/plot_svg.h>
 
@@ -843,8 +844,7 @@ std::vector<EvaluationRow> RunEvaluation(const std::vector<EvaluationItem>& item
 // Rows files.
 
 void WriteRows(const std::string& path, const RowsHeader& header, const std::vector<EvaluationRow>& rows) {
-  std::ofstream out(path);
-  if (!out) throw IoError(path + ": cannot write");
+  std::ostringstream out;
   nlohmann::json h = {{"pushgraph_evaluation_rows", 1},
                       {"shard", header.shard},
                       {"shards", header.shards},
@@ -860,7 +860,7 @@ void WriteRows(const std::string& path, const RowsHeader& header, const std::vec
     if (!r.notes.empty()) j["notes"] = r.notes;
     out << j.dump() << "\n";
   }
-  if (!out) throw IoError(path + ": write failed");
+  if (const std::string error = geometry::WriteFileAtomically(path, out.str()); !error.empty()) throw IoError(error);
 }
 
 std::vector<EvaluationRow> ReadRows(const std::string& path, RowsHeader* header) {
@@ -1252,9 +1252,7 @@ std::string WriteTables(const std::string& dir, const std::vector<Table>& tables
   if (ec) throw IoError(dir + ": cannot create folder (" + ec.message() + ")");
   auto write = [&](const std::string& name, const std::string& text) {
     const std::string path = (fs::path(dir) / name).string();
-    std::ofstream out(path);
-    out << text;
-    if (!out) throw IoError(path + ": cannot write");
+    if (const std::string error = geometry::WriteFileAtomically(path, text); !error.empty()) throw IoError(error);
   };
   std::ostringstream all;
   for (const Table& t : tables) {

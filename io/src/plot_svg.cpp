@@ -1,5 +1,6 @@
 // SVG plots of pushes and estimates (plot_svg.h). Plain string building: no drawing library, the
 // output is small hand-readable SVG 1.1 that browsers and rsvg-convert render alike.
+#include <pushgraph/geometry/file_output.h>
 #include <pushgraph/io/plot_svg.h>
 #include <pushgraph/io/trajectory_json.h>
 
@@ -703,11 +704,7 @@ std::string TrajectorySvg(const limit_surface::Trajectory& trajectory, const gra
 }
 
 void WriteSvgFile(const std::string& path, const std::string& svg) {
-  std::ofstream out(path);
-  if (!out) throw IoError(path + ": cannot open file for writing");
-  out << svg;
-  out.close();
-  if (!out) throw IoError(path + ": write failed");
+  if (const std::string error = geometry::WriteFileAtomically(path, svg); !error.empty()) throw IoError(error);
 }
 
 void WriteTrajectorySvg(const std::string& path, const limit_surface::Trajectory& trajectory,

@@ -1,3 +1,4 @@
+#include <pushgraph/geometry/file_output.h>
 #include <pushgraph/io/result_json.h>
 #include <pushgraph/io/trajectory_json.h>
 
@@ -132,11 +133,8 @@ std::string ResultToJson(const graph::EstimationResult& r, int indent) {
 }
 
 void SaveResultJson(const graph::EstimationResult& result, const std::string& path) {
-  const std::string text = ResultToJson(result);
-  std::ofstream out(path);
-  if (!out) throw IoError(path + ": cannot open file for writing");
-  out << text << "\n";
-  if (!out) throw IoError(path + ": write failed");
+  if (const std::string error = geometry::WriteFileAtomically(path, ResultToJson(result) + "\n"); !error.empty())
+    throw IoError(error);
 }
 
 }  // namespace pushgraph::io

@@ -1,5 +1,6 @@
 // Reading and writing "pushgraph-trajectory-1" JSON files. Every problem is reported with the
 // file name and the JSON path of the offending value.
+#include <pushgraph/geometry/file_output.h>
 #include <pushgraph/io/trajectory_json.h>
 
 #include <nlohmann/json.hpp>
@@ -257,10 +258,8 @@ std::string TrajectoryToJson(const Trajectory& t, int indent) {
 }
 
 void SaveTrajectoryJson(const Trajectory& t, const std::string& path) {
-  std::ofstream out(path);
-  if (!out) throw IoError(path + ": cannot open file for writing");
-  out << TrajectoryToJson(t) << "\n";
-  if (!out) throw IoError(path + ": write failed");
+  if (const std::string error = geometry::WriteFileAtomically(path, TrajectoryToJson(t) + "\n"); !error.empty())
+    throw IoError(error);
 }
 
 }  // namespace pushgraph::io

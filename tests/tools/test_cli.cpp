@@ -158,4 +158,55 @@ TEST_F(CliTest, DemoRunsOnShippedShapesAndWritesSvg) {
   EXPECT_GT(fs::file_size(svg), 500u);
 }
 
+// An output that is an input (the same path, another spelling, a link) or another output is
+// refused before any work, and the input is left as it was; written files replace the old ones
+// whole, with no temporary file left beside them.
+TEST_F(CliTest, OutputsThatAreInputsAreRefusedAndInputsKept) {
+  const std::string shape = Write("s.json", kSquareWithHole);
+  const std::string dir = fs::path(shape).parent_path().string();
+  fs::create_symlink(shape, dir_ / "link.json");
+  const std::string traj = (dir_ / "t.json").string();
+  ASSERT_EQ(Exec("simulate -o " + traj + " --duration 0.2").status, 0);
+  const std::string traj_text = [&] {
+    std::ifstream in(traj);
+    std::stringstream t;
+    t << in.rdbuf();
+    return t.str();
+  }();
+  struct Case {
+    std::string args, output_flag, input;
+  };
+  const std::vector<Case> cases = {
+      {"footprint " + shape + " -o " + shape, "-o", shape},
+      {"footprint " + shape + " -o " + dir + "/./s.json", "-o", shape},
+      {"footprint " + shape + " -o " + (dir_ / "link.json").string(), "-o", shape},
+      {"simulate --object " + shape + " -o " + shape, "-o", shape},
+      {"estimate " + traj + " -o " + traj, "-o", traj},
+      {"estimate " + traj + " -o " + (dir_ / "r.json").string() + " --svg " + traj, "--svg", traj},
+      {"estimate " + traj + " -o " + (dir_ / "r.json").string() + " --svg " + (dir_ / "r.json").string(), "--svg", "-o"},
+      {"mit-import " + traj + " --object " + shape + " --finger " + shape + " --mass 1 --mu-surface 0.3 -o " + shape, "-o", shape},
+  };
+  for (const Case& c : cases) {
+    const ToolRun r = Exec(c.args);
+    EXPECT_EQ(r.status, 1) << c.args;
+    EXPECT_NE(r.err.find(c.output_flag), std::string::npos) << c.args << ": " << r.err;
+    EXPECT_NE(r.err.find(c.input), std::string::npos) << c.args << ": " << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "r.json")) << c.args;
+  }
+  std::ifstream in(shape);
+  std::stringstream kept;
+  kept << in.rdbuf();
+  EXPECT_EQ(kept.str(), kSquareWithHole);
+  std::ifstream tin(traj);
+  std::stringstream tkept;
+  tkept << tin.rdbuf();
+  EXPECT_EQ(tkept.str(), traj_text);
+  // A real write replaces the file whole and leaves nothing else in the folder.
+  const std::string out = (dir_ / "out.json").string();
+  ASSERT_EQ(Exec("footprint " + shape + " -o " + out + " -q").status, 0);
+  ASSERT_EQ(Exec("footprint " + shape + " --scale 2 -o " + out + " -q").status, 0);
+  for (const auto& entry : fs::directory_iterator(dir_))
+    EXPECT_EQ(entry.path().filename().string().find(".tmp-"), std::string::npos) << entry.path();
+}
+
 }  // namespace

@@ -90,6 +90,40 @@ std::string FormatDouble(double value) {
   return std::string(buffer, result.ptr);
 }
 
+namespace {
+
+// Two names of one file: equivalent() when both exist, else the same normalized absolute path.
+bool SameFile(const std::string& a, const std::string& b) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::exists(a, ec) && fs::exists(b, ec)) {
+    const bool same = fs::equivalent(a, b, ec);
+    if (!ec) return same;
+  }
+  const fs::path ca = fs::weakly_canonical(fs::absolute(a, ec), ec);
+  const fs::path cb = fs::weakly_canonical(fs::absolute(b, ec), ec);
+  return ca.lexically_normal() == cb.lexically_normal();
+}
+
+}  // namespace
+
+void CheckOutputsAreNew(const std::vector<NamedPath>& inputs, const std::vector<NamedPath>& outputs) {
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    const NamedPath& out = outputs[i];
+    if (out.path.empty()) continue;
+    for (const NamedPath& in : inputs) {
+      if (!in.path.empty() && SameFile(out.path, in.path))
+        throw CliError(out.what + " " + out.path + " is the input " + in.what + " " + in.path +
+                       ": writing it would destroy the input; choose another output file");
+    }
+    for (std::size_t j = 0; j < i; ++j) {
+      if (!outputs[j].path.empty() && SameFile(out.path, outputs[j].path))
+        throw CliError(out.what + " " + out.path + " is also the output " + outputs[j].what +
+                       ": one would overwrite the other; choose two files");
+    }
+  }
+}
+
 std::string DumpJson(const nlohmann::json& value, int indent) {
   // nlohmann prints the shortest round-trip representation, which is exact.
   return value.dump(indent);

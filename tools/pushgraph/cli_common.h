@@ -47,6 +47,15 @@ void AddAlignShapeOption(CLI::App* sub, std::string* value);
 graph::EstimatorConfig::AlignShape ParseAlignShape(const std::string& value);
 /// Formats a double with 17 significant digits (round-trips exactly).
 std::string FormatDouble(double value);
+
+/// A file a subcommand reads or writes, with the flag or argument that names it.
+struct NamedPath {
+  std::string what;  ///< e.g. "-o", "--svg", "TRAJECTORY"
+  std::string path;  ///< empty: not given (skipped)
+};
+/// Refuses, before any work, an output that is one of the inputs or another output: the same
+/// path, or the same file under another name (a link, "./a" and "a"). Names both.
+void CheckOutputsAreNew(const std::vector<NamedPath>& inputs, const std::vector<NamedPath>& outputs);
 /// Writes JSON with doubles printed to 17 significant digits.
 std::string DumpJson(const nlohmann::json& value, int indent = 2);
 

@@ -12,6 +12,7 @@
 #include "cli_common.h"
 
 #include <pushgraph/geometry/distance_field.h>
+#include <pushgraph/geometry/file_output.h>
 #include <pushgraph/geometry/point_query.h>
 #include <pushgraph/geometry/shape_pair.h>
 #ifdef PUSHGRAPH_WITH_GRAPH
@@ -29,6 +30,7 @@
 #include <iostream>
 #include <memory>
 #include <random>
+#include <sstream>
 
 namespace pushgraph::cli {
 namespace {
@@ -127,13 +129,13 @@ void RunGeometryDemo(const std::string& data_dir, const std::string& svg_path) {
   std::printf("distance field %dx%d at 1 mm: max interpolation error %.3g m (measured against the exact query)\n",
               field.rows(), field.cols(), field.max_error());
 
-  std::ofstream svg(svg_path);
-  if (!svg) throw CliError(svg_path + ": cannot open for writing");
+  std::ostringstream svg;
   svg << "<svg xmlns='http://www.w3.org/2000/svg' width='" << 0.14 * scale << "' height='" << 0.15 * scale
       << "' style='background:white'>\n<path d='" << SvgPath(object, scale, origin)
       << "' fill='lightsteelblue' stroke='navy' fill-rule='evenodd'/>\n"
       << markers << "<text x='10' y='20' font-family='sans-serif' font-size='13'>disk finger sweep: red overlapping,"
       << " black: witness pairs</text>\n</svg>\n";
+  if (const std::string error = geometry::WriteFileAtomically(svg_path, svg.str()); !error.empty()) throw CliError(error);
   std::printf("picture: %s\n", svg_path.c_str());
   if (mismatches != 0) throw CliError("accelerated queries disagree with the brute-force reference");
 }

@@ -79,6 +79,8 @@ limit_surface::Trajectory LoadInput(const EstimateOptions& o, std::string* sourc
 }
 
 void RunEstimate(const EstimateOptions& o) {
+  CheckOutputsAreNew({{"INPUT", o.input}, {"--config", o.config}, {"--object", o.object}, {"--finger", o.finger}},
+                     {{"-o", o.output}, {"--svg", o.svg}});
   const graph::Model model = graph::ParseModel(o.model);
   const graph::Mode mode = graph::ParseMode(o.mode);
   // A bad configuration file is reported before any input is read.

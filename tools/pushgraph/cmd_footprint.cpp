@@ -32,6 +32,7 @@ void RegisterFootprint(CLI::App& app) {
   cmd->add_option("-o,--output", args->output, "Write the shape JSON here (default: stdout)");
   cmd->add_flag("-q,--quiet", args->quiet, "Do not print the summary on stderr");
   cmd->callback([args] {
+    CheckOutputsAreNew({{"MESH", args->mesh}}, {{"-o", args->output}});
     io::FootprintOptions options;
     options.up = io::ParseUpAxis(args->up);
     options.object = args->object;

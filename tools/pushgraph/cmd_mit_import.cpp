@@ -28,6 +28,7 @@ void RegisterMitImport(CLI::App& app) {
   cmd->add_flag("--trim", a->trim, "Keep only the contact phase");
   cmd->add_option("-o,--output", a->output, "Trajectory JSON to write")->required();
   cmd->callback([a] {
+    CheckOutputsAreNew({{"RECORDING", a->recording}, {"--object", a->object}, {"--finger", a->finger}}, {{"-o", a->output}});
     if (!(a->mass > 0.0)) throw CliError("--mass must be > 0");
     if (!(a->mu_surface >= 0.0) || !(a->mu_contact >= 0.0)) throw CliError("friction coefficients must be >= 0");
     io::MitReadOptions options;

@@ -80,6 +80,7 @@ std::pair<double, double> ParseWindow(const std::string& text, const std::string
 }
 
 void Run(const SimulateOptions& o) {
+  CheckOutputsAreNew({{"--object", o.object_path}, {"--finger", o.finger_path}}, {{"-o", o.output}});
   ls::PushPlan plan;
   Positive(o.mass, "--mass");
   Positive(o.mu_surface, "--mu-surface");

@@ -1,0 +1,72 @@
+// Atomic file replacement: temporary file in the same folder, fsync, rename (POSIX).
+#include <pushgraph/geometry/file_output.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <string>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+namespace pushgraph::geometry {
+
+std::string WriteFileAtomically(const std::string& path, const std::string& content) {
+  namespace fs = std::filesystem;
+  const auto failure = [&](const std::string& what, int error) {
+    return path + ": cannot write (" + what + (error != 0 ? std::string(": ") + std::strerror(error) : "") + ")";
+  };
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) return path + ": is a directory, not a file to write";
+  // The temporary file sits beside the target (same file system, so the rename is atomic).
+  const fs::path target(path);
+  const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  std::string pattern = (folder / ("." + target.filename().string() + ".tmp-XXXXXX")).string();
+  const int fd = ::mkstemp(pattern.data());
+  if (fd < 0) return failure("cannot create a temporary file in " + folder.string(), errno);
+  const std::string temporary = pattern;
+  const auto abandon = [&](const std::string& what, int error) {
+    ::close(fd);
+    ::unlink(temporary.c_str());
+    return failure(what, error);
+  };
+  for (std::size_t written = 0; written < content.size();) {
+    const ssize_t n = ::write(fd, content.data() + written, content.size() - written);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return abandon("write failed", errno);
+    }
+    written += static_cast<std::size_t>(n);
+  }
+  if (::fsync(fd) != 0) return abandon("flush to disk failed", errno);
+  // mkstemp makes the file 0600: keep the target's permissions, or give a new file what open(2)
+  // would (0666 & ~umask; the umask read from /proc, as setting it to read it is not
+  // thread-safe).
+  const fs::file_status old_status = fs::status(target, ec);
+  mode_t mode = 0644;
+  if (!ec && fs::exists(old_status)) {
+    mode = static_cast<mode_t>(old_status.permissions() & fs::perms::mask);
+  } else if (std::FILE* status = std::fopen("/proc/self/status", "r")) {
+    char line[256];
+    unsigned mask = 022;
+    while (std::fgets(line, sizeof line, status))
+      if (std::sscanf(line, "Umask: %o", &mask) == 1) break;
+    std::fclose(status);
+    mode = static_cast<mode_t>(0666 & ~mask);
+  }
+  ::fchmod(fd, mode);
+  if (::close(fd) != 0) {
+    ::unlink(temporary.c_str());
+    return failure("close failed", errno);
+  }
+  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
+    const int error = errno;
+    ::unlink(temporary.c_str());
+    return failure("rename into place failed", error);
+  }
+  return "";
+}
+
+}  // namespace pushgraph::geometry
