@@ -18,6 +18,7 @@
 #include <cstdlib>
 #include <functional>
 #include <iostream>
+#include <sstream>
 #include <tuple>
 
 namespace pushgraph::graph {
@@ -118,6 +119,43 @@ void CheckSorted(const std::vector<Sample>& s, const std::string& stream) {
   }
 }
 
+// A clock jump: a gap in a stream, or between streams, longer than max(kClockJumpSeconds,
+// kClockJumpPeriods median periods). The estimator's states follow the clock, so such a gap
+// (a corrupted time stamp 1e9 s ahead) would cost memory and time in proportion to the gap, not
+// to the samples; it is refused with the stream and the sample.
+constexpr double kClockJumpSeconds = 10.0;
+constexpr double kClockJumpPeriods = 1000.0;
+
+template <class Sample>
+double MedianPeriod(const std::vector<Sample>& s) {
+  std::vector<double> d;
+  for (std::size_t i = 1; i < s.size(); ++i) d.push_back(s[i].t - s[i - 1].t);
+  if (d.empty()) return 0.0;
+  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+  return d[d.size() / 2];
+}
+
+std::string Seconds(double t) {
+  std::ostringstream s;
+  s.precision(6);
+  s << t << " s";
+  return s.str();
+}
+
+template <class Sample>
+void CheckNoClockJump(const std::vector<Sample>& s, const std::string& stream, double finest_period) {
+  const double period = MedianPeriod(s);
+  const double bound = std::max(kClockJumpSeconds, kClockJumpPeriods * std::max(period, finest_period));
+  for (std::size_t i = 1; i < s.size(); ++i) {
+    if (s[i].t - s[i - 1].t > bound) {
+      throw GraphError("trajectory: streams." + stream + "[" + std::to_string(i) + "] jumps " + Seconds(s[i].t - s[i - 1].t) +
+                       " ahead of the previous sample (t = " + Seconds(s[i - 1].t) + " -> " + Seconds(s[i].t) +
+                       "; the stream's median period is " + Seconds(period) + "): a clock jump longer than " +
+                       Seconds(bound) + " is refused; fix the time stamps or split the recording");
+    }
+  }
+}
+
 void ValidateTrajectory(const limit_surface::Trajectory& traj) {
   if (traj.object.shape.empty()) throw GraphError("trajectory: object.shape is missing or empty");
   if (traj.finger.shape.empty()) throw GraphError("trajectory: finger.shape is missing or empty");
@@ -138,6 +176,37 @@ void ValidateTrajectory(const limit_surface::Trajectory& traj) {
   CheckSorted(m.finger_pose, "finger_pose");
   CheckSorted(m.contact_point, "contact_point");
   CheckSorted(m.force, "force");
+  {
+    double finest = INFINITY;
+    for (double p : {MedianPeriod(m.object_pose), MedianPeriod(m.finger_pose), MedianPeriod(m.contact_point), MedianPeriod(m.force)})
+      if (p > 0.0) finest = std::min(finest, p);
+    if (!std::isfinite(finest)) finest = 0.0;
+    CheckNoClockJump(m.object_pose, "object_pose", 0.0);
+    CheckNoClockJump(m.finger_pose, "finger_pose", 0.0);
+    CheckNoClockJump(m.contact_point, "contact_point", 0.0);
+    CheckNoClockJump(m.force, "force", 0.0);
+    // Between streams: the streams' spans must overlap or follow within the same bound.
+    std::vector<std::pair<double, std::pair<double, std::string>>> spans;
+    auto add = [&](const auto& s, const std::string& name) {
+      if (!s.empty()) spans.push_back({s.front().t, {s.back().t, name}});
+    };
+    add(m.object_pose, "object_pose");
+    add(m.finger_pose, "finger_pose");
+    add(m.contact_point, "contact_point");
+    add(m.force, "force");
+    std::sort(spans.begin(), spans.end());
+    const double bound = std::max(kClockJumpSeconds, kClockJumpPeriods * finest);
+    double reach = spans.empty() ? 0.0 : spans.front().second.first;
+    std::string reached_by = spans.empty() ? "" : spans.front().second.second;
+    for (std::size_t i = 1; i < spans.size(); ++i) {
+      if (spans[i].first - reach > bound) {
+        throw GraphError("trajectory: streams." + spans[i].second.second + " starts " + Seconds(spans[i].first - reach) +
+                         " after streams." + reached_by + " ends (t = " + Seconds(reach) + " -> " + Seconds(spans[i].first) +
+                         "): a clock jump longer than " + Seconds(bound) + " between streams is refused; are the streams on one clock?");
+      }
+      if (spans[i].second.first > reach) reach = spans[i].second.first, reached_by = spans[i].second.second;
+    }
+  }
   if (m.object_pose.empty()) {
     throw GraphError("trajectory: no object pose measurements (streams.object_pose is empty): nothing anchors the object");
   }

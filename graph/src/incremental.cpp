@@ -402,6 +402,14 @@ struct OnlineEstimator::Impl {
       throw GraphError(where() + " is not after the previous sample (t = " + Precise(last_seen[stream]) +
                        "): each stream must arrive in time order");
     }
+    // A clock jump (the batch estimator's bound: 10 s or 1000 object periods): the smoother's
+    // states follow the clock, so its cost would follow the jump, not the samples.
+    const double jump_bound = std::max(10.0, std::isfinite(object_period) ? 1000.0 * object_period : 0.0);
+    if (std::isfinite(newest_t) && t - newest_t > jump_bound) {
+      throw GraphError(where() + " is " + Precise(t - newest_t) + " s after the newest sample of any stream (t = " +
+                       Precise(newest_t) + "): a clock jump longer than " + Precise(jump_bound) +
+                       " s is refused; fix the time stamps or start a new estimator");
+    }
     last_seen[stream] = t;
     ++seen[stream];
     newest_t = std::max(newest_t, t);

@@ -214,6 +214,23 @@ TEST(Estimator, BadTrajectoriesGetClearErrors) {
   auto no_shape = t;
   no_shape.finger.shape = geometry::Shape();
   EXPECT_NE(message(no_shape).find("finger.shape"), std::string::npos);
+  // Clock jumps (a corrupted time stamp 1e9 s ahead) are refused at once in batch and
+  // incremental alike, naming the stream and sample, instead of costing memory and time in
+  // proportion to the jump.
+  auto jump_one = t;
+  jump_one.measured.finger_pose.back().t += 1e9;
+  const std::string one = message(jump_one);
+  EXPECT_NE(one.find("streams.finger_pose[" + std::to_string(t.measured.finger_pose.size() - 1) + "] jumps"),
+            std::string::npos) << one;
+  auto jump_half = t;
+  for (std::size_t i = jump_half.measured.object_pose.size() / 2; i < jump_half.measured.object_pose.size(); ++i)
+    jump_half.measured.object_pose[i].t += 1e9;
+  EXPECT_NE(message(jump_half).find("streams.object_pose["), std::string::npos) << message(jump_half);
+  EXPECT_THROW(Estimate(jump_one, Model::kQs, Mode::kIncremental), GraphError);
+  auto other_clock = t;
+  for (auto& f : other_clock.measured.force) f.t += 1e6;
+  EXPECT_NE(message(other_clock).find("streams.force starts"), std::string::npos) << message(other_clock);
+  EXPECT_EQ(message(t), "no error");
 }
 
 TEST(Estimator, StepsFollowTheInputClocks) {

@@ -212,6 +212,13 @@ TEST(Online, RefusesBadAndLateSamples) {
   EXPECT_THROW(online.Update(), GraphError);  // no object pose yet: nothing anchors the object
   online.AddObjectPose(0.0, pose);
   online.AddObjectPose(0.04, pose);
+  try {  // a clock jump is refused with the stream and the gap
+    online.AddFingerPose(1e9, finger);
+    ADD_FAILURE() << "a finger sample 1e9 s ahead was accepted";
+  } catch (const GraphError& e) {
+    EXPECT_NE(std::string(e.what()).find("finger_pose"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("clock jump"), std::string::npos) << e.what();
+  }
   try {
     online.AddObjectPose(0.02, pose);
     ADD_FAILURE() << "out-of-order sample accepted";

@@ -281,6 +281,16 @@ TEST_F(Evaluation, CommandReportsBadOptionsInOneLine) {
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("x.json"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("every trajectory failed"), std::string::npos) << r.err;
+  // Some failed: the tables are written without them, status 1 unless --allow-failures.
+  const std::string good = (dir_ / "good.json").string();
+  ASSERT_EQ(Exec("simulate -o " + good + " --duration 1").status, 0);
+  const std::string partial = "evaluate " + good + " " + (dir_ / "x.json").string() + " --protocol table1 -q --out " + out;
+  r = Exec(partial);
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("1 of 2 trajectories failed; the tables leave them out"), std::string::npos) << r.err;
+  EXPECT_TRUE(std::filesystem::exists(std::filesystem::path(out) / "results.md"));
+  r = Exec(partial + " --allow-failures");
+  EXPECT_EQ(r.status, 0) << r.err;
 }
 
 }  // namespace

@@ -209,4 +209,23 @@ TEST_F(CliTest, OutputsThatAreInputsAreRefusedAndInputsKept) {
     EXPECT_EQ(entry.path().filename().string().find(".tmp-"), std::string::npos) << entry.path();
 }
 
+TEST_F(CliTest, UnknownSubcommandsSeedsAndIgnoredSigmasAreNamed) {
+  ToolRun r = Exec("frobnicate x");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("unknown subcommand 'frobnicate'"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("estimate"), std::string::npos) << r.err;  // the list of subcommands
+  const std::string out = (dir_ / "t.json").string();
+  for (const std::string seed : {"-1", "18446744073709551616", "1.5", "x"}) {
+    r = Exec("simulate -o " + out + " --duration 0.1 --seed " + seed);
+    EXPECT_EQ(r.status, 2) << seed;
+    EXPECT_NE(r.err.find("--seed: '" + seed + "'"), std::string::npos) << r.err;
+  }
+  EXPECT_FALSE(fs::exists(out));
+  r = Exec("simulate -o " + out + " --duration 0.1 --seed 18446744073709551615");
+  EXPECT_EQ(r.status, 0) << r.err;
+  r = Exec("simulate -o " + out + " --duration 0.1 --noise none --sigma-force 5");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("--sigma-force 5 is given with --noise none"), std::string::npos) << r.err;
+}
+
 }  // namespace

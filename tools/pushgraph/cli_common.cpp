@@ -151,6 +151,23 @@ std::vector<std::string> JoinNegativeValues(const std::vector<std::string>& args
   return out;
 }
 
+CLI::Option* AddSeedOption(CLI::App* app, std::uint64_t* seed, const std::string& help) {
+  return app
+      ->add_option_function<std::string>(
+          "--seed",
+          [seed](const std::string& text) {
+            std::uint64_t value = 0;
+            const char* end = text.data() + text.size();
+            const auto [ptr, ec] = std::from_chars(text.data(), end, value);
+            if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos || ec != std::errc() || ptr != end)
+              throw CLI::ValidationError("--seed", "'" + text + "' is not an integer from 0 to 18446744073709551615");
+            *seed = value;
+          },
+          help)
+      ->type_name("UINT")
+      ->default_str(std::to_string(*seed));
+}
+
 void AddAlignShapeOption(CLI::App* sub, std::string* value) {
   sub->add_option("--align-shape", *value,
                   "Shape registration: auto (check the shape against the data, align it when it does not fit), "

@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -47,6 +48,9 @@ void AddAlignShapeOption(CLI::App* sub, std::string* value);
 graph::EstimatorConfig::AlignShape ParseAlignShape(const std::string& value);
 /// Formats a double with 17 significant digits (round-trips exactly).
 std::string FormatDouble(double value);
+
+/// `--seed N`: a non-negative integer below 2^64 ("-1" is refused, not wrapped around).
+CLI::Option* AddSeedOption(CLI::App* app, std::uint64_t* seed, const std::string& help);
 
 /// A file a subcommand reads or writes, with the flag or argument that names it.
 struct NamedPath {

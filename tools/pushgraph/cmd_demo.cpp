@@ -272,7 +272,7 @@ void RegisterDemo(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "demo", "Run the built-in demo: estimate a simulated push with occlusion (raw vs CP vs SDF vs QS)");
   auto o = std::make_shared<DemoOptions>();
-  cmd->add_option("--seed", o->seed, "Noise seed of the simulated push")->capture_default_str();
+  AddSeedOption(cmd, &o->seed, "Noise seed of the simulated push");
   cmd->add_flag("--geometry", o->geometry, "Run the geometry demo instead (exact separations and depths)");
 #else
   auto* cmd = app.add_subcommand("demo", "Run the built-in geometry demo (the estimation demo needs pushgraph::graph)");

@@ -176,7 +176,7 @@ void RegisterEstimate(CLI::App& app) {
   sub->add_option("--add-noise", opts->add_noise,
                   "Add the paper's noise (5 mm, 0.05 rad, 0.5 N per axis) to the clean streams, which stay as ground truth")
       ->check(CLI::IsMember({"gaussian", "bimodal"}));
-  sub->add_option("--seed", opts->seed, "Seed of --add-noise")->capture_default_str();
+  AddSeedOption(sub, &opts->seed, "Seed of --add-noise");
   sub->add_option("--svg", opts->svg, "Also write a picture of the estimate (SVG)");
   AddAlignShapeOption(sub, &opts->align_shape);
   sub->callback([opts]() { RunEstimate(*opts); });

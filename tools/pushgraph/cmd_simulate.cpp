@@ -117,6 +117,13 @@ void Run(const SimulateOptions& o) {
                              : o.noise == "bimodal" ? ls::NoiseKind::kBimodal
                                                     : ls::NoiseKind::kGaussian;
   plan.noise = ls::DefaultNoise(kind);
+  if (kind == ls::NoiseKind::kNone) {
+    for (const auto& [flag, value] : {std::pair{"--sigma-object", &o.sigma_object}, {"--sigma-finger", &o.sigma_finger},
+                                      {"--sigma-contact", &o.sigma_contact}, {"--sigma-force", &o.sigma_force}})
+      if (!value->empty())
+        throw CliError(std::string(flag) + " " + *value + " is given with --noise none, which adds no noise: drop it or "
+                       "choose --noise gaussian or bimodal");
+  }
   auto set_sigma = [&](const std::string& text, ls::StreamNoise& stream, bool with_angle, const std::string& what) {
     if (text.empty()) return;
     const std::vector<double> v = ParseNumbers(text, with_angle ? 2 : 1, what);
@@ -218,7 +225,7 @@ void RegisterSimulate(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--rate-force", o->rate_force, "Force stream rate (Hz; 0 disables)")->capture_default_str();
   cmd->add_option("--internal-step", o->internal_step, "Largest integration step (s)")->capture_default_str();
-  cmd->add_option("--seed", o->seed, "Noise seed (same seed, same file)")->capture_default_str();
+  AddSeedOption(cmd, &o->seed, "Noise seed (same seed, same file)");
   cmd->add_option("--noise", o->noise,
                   "Measurement noise: gaussian, bimodal (mixture of two triangular densities, same sigma) or none")
       ->check(CLI::IsMember({"gaussian", "bimodal", "none"}))

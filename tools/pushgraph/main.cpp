@@ -23,6 +23,20 @@ int main(int argc, char** argv) {
   RegisterMitImport(app);
 
   std::vector<std::string> args(argv + 1, argv + argc);
+  // A first word that is no subcommand is named (CLI11 would only say that one is required).
+  if (!args.empty() && !args[0].empty() && args[0][0] != '-') {
+    std::string names;
+    bool known = false;
+    for (const CLI::App* sub : app.get_subcommands({})) {
+      known = known || sub->check_name(args[0]);
+      names += (names.empty() ? "" : ", ") + sub->get_name();
+    }
+    if (!known) {
+      std::cerr << "pushgraph: unknown subcommand '" << args[0] << "'; the subcommands are " << names
+                << " (see pushgraph --help)\n";
+      return 2;
+    }
+  }
   // Every option that takes a value may be given a negative number after a space.
   std::vector<std::string> value_options;
   for (const CLI::App* sub : app.get_subcommands({})) {
