@@ -32,20 +32,35 @@ const limit_surface::Trajectory& Push(int steps) {
   return it->second;
 }
 
+// range(1): 0 the chain solver, 1 Ceres (the default, the peer). Registration and the
+// self-diagnosis are left out (they do not depend on the solver); every solver stage is in.
 void Batch(benchmark::State& state, graph::Model model, bool covariance,
            graph::EstimatorConfig::CovarianceMethod method = graph::EstimatorConfig::CovarianceMethod::kSelectedInversion) {
   const auto& traj = Push(static_cast<int>(state.range(0)));
   graph::EstimatorConfig cfg;
   cfg.covariance = covariance;
   cfg.covariance_method = method;
-  int iterations = 0;
+  cfg.diagnostics = false;
+  cfg.align_shape = graph::EstimatorConfig::AlignShape::kOff;
+  cfg.solver = state.range(1) == 1 ? graph::EstimatorConfig::Solver::kCeres : graph::EstimatorConfig::Solver::kChain;
+  graph::SolverStats stats;
   for (auto _ : state) {
     const graph::EstimationResult r = graph::Estimate(traj, model, graph::Mode::kBatch, cfg);
-    iterations = r.solver.iterations;
+    stats = r.solver;
     benchmark::DoNotOptimize(r.states.data());
   }
+  state.SetLabel(stats.name);
   state.counters["steps"] = static_cast<double>(state.range(0));
-  state.counters["lm_iterations"] = iterations;
+  state.counters["iterations"] = stats.iterations;
+  state.counters["solver_ms"] = 1e3 * stats.time_s;
+  if (stats.factor_flops > 0.0) {
+    // The final stage's profile: where an iteration's time goes, and the factorization's rate
+    // against its flop count (the physical limit: about 1-4 GFlop/s for this sparse, scalar
+    // code on one core of this machine).
+    state.counters["final_stage_eval_ms"] = 1e3 * stats.evaluation_time_s;
+    state.counters["final_stage_linear_ms"] = 1e3 * stats.linear_solve_time_s;
+    state.counters["factor_mflop"] = 1e-6 * stats.factor_flops;
+  }
 }
 
 // The same square with every side cut into equal collinear edges: the same geometry, so the same
@@ -79,22 +94,28 @@ BENCHMARK(BM_BatchQsDetailedObject)->Arg(4)->Arg(1000)->Arg(10000)->Arg(100000)-
 
 void BM_BatchQs(benchmark::State& s) { Batch(s, graph::Model::kQs, false); }
 void BM_BatchQsWithCovariance(benchmark::State& s) { Batch(s, graph::Model::kQs, true); }
-// The peer: the same solve with ceres::Covariance (SPARSE_QR) for the marginals.
+// The peer of the covariances: ceres::Covariance (SPARSE_QR) for the marginals.
 void BM_BatchQsWithCeresCovariance(benchmark::State& s) {
   Batch(s, graph::Model::kQs, true, graph::EstimatorConfig::CovarianceMethod::kCeres);
 }
 void BM_BatchCp(benchmark::State& s) { Batch(s, graph::Model::kCp, false); }
-BENCHMARK(BM_BatchQs)->Arg(100)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond)->Iterations(1);
-BENCHMARK(BM_BatchCp)->Arg(100)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond)->Iterations(1);
-BENCHMARK(BM_BatchQsWithCovariance)->Arg(100)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond)->Iterations(1);
-BENCHMARK(BM_BatchQsWithCeresCovariance)->Arg(100)->Arg(1000)->Unit(benchmark::kMillisecond)->Iterations(1);
+// Args: steps, solver (0 chain, 1 Ceres).
+BENCHMARK(BM_BatchQs)->ArgsProduct({{100, 1000, 10000}, {0, 1}})->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_BatchCp)->ArgsProduct({{100, 1000, 10000}, {0, 1}})->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_BatchQsWithCovariance)->ArgsProduct({{100, 1000, 10000}, {0, 1}})->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_BatchQsWithCeresCovariance)->Args({100, 1})->Args({1000, 1})->Unit(benchmark::kMillisecond)->Iterations(1);
 
 // Runs the whole incremental estimation; reports the mean and max update time and the mean of
 // the last quarter of the updates (flat against length means bounded cost).
+// range(1): incremental_update_every_steps (0: every 5 object samples, the default); range(2):
+// 0 chain, 1 Ceres.
 void Incremental(benchmark::State& state, bool covariance) {
   const auto& traj = Push(static_cast<int>(state.range(0)));
   graph::EstimatorConfig cfg;
   cfg.covariance = covariance;
+  cfg.diagnostics = false;
+  cfg.incremental_update_every_steps = static_cast<int>(state.range(1));
+  cfg.solver = state.range(2) == 1 ? graph::EstimatorConfig::Solver::kCeres : graph::EstimatorConfig::Solver::kChain;
   double mean = 0, worst = 0, last_quarter = 0;
   for (auto _ : state) {
     graph::IncrementalEstimator inc(traj, graph::Model::kQs, cfg);
@@ -117,8 +138,13 @@ void Incremental(benchmark::State& state, bool covariance) {
 }
 void BM_IncrementalQs(benchmark::State& s) { Incremental(s, false); }
 void BM_IncrementalQsWithCovariance(benchmark::State& s) { Incremental(s, true); }
-BENCHMARK(BM_IncrementalQs)->Arg(500)->Arg(2000)->Arg(8000)->Unit(benchmark::kMillisecond)->Iterations(1);
-BENCHMARK(BM_IncrementalQsWithCovariance)->Arg(500)->Arg(2000)->Unit(benchmark::kMillisecond)->Iterations(1);
+// Args: steps, update every k steps (0: every 5 object samples), solver (0 chain, 1 Ceres).
+BENCHMARK(BM_IncrementalQs)
+    ->ArgsProduct({{500, 2000, 8000}, {0}, {0, 1}})
+    ->ArgsProduct({{500, 2000}, {1}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
+BENCHMARK(BM_IncrementalQsWithCovariance)->ArgsProduct({{500, 2000}, {0}, {0, 1}})->Unit(benchmark::kMillisecond)->Iterations(1);
 
 // The same push through graph::OnlineEstimator, one sample at a time (grouped by time stamp,
 // UpdateDue polled after each stamp): the update times, and the bookkeeping per sample outside

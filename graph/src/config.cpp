@@ -149,6 +149,13 @@ EstimatorConfig ParseEstimatorConfig(const std::string& json_text, const std::st
           *it, source, key, {{"auto", EstimatorConfig::LimitSurfaceLoad::kAuto},
                              {"on", EstimatorConfig::LimitSurfaceLoad::kOn},
                              {"off", EstimatorConfig::LimitSurfaceLoad::kOff}});
+    } else if (key == "solver") {
+      cfg.solver = ParseChoice<EstimatorConfig::Solver>(
+          *it, source, key, {{"chain", EstimatorConfig::Solver::kChain}, {"ceres", EstimatorConfig::Solver::kCeres}});
+    } else if (key == "incremental_update_every_steps") {
+      if (!it->is_number_integer()) Fail(source, key, "expected an integer");
+      cfg.incremental_update_every_steps = it->get<int>();
+      if (cfg.incremental_update_every_steps < 1) Fail(source, key, "must be >= 1");
     } else if (key == "covariance_method") {
       cfg.covariance_method = ParseChoice<EstimatorConfig::CovarianceMethod>(
           *it, source, key, {{"selected_inversion", EstimatorConfig::CovarianceMethod::kSelectedInversion},
@@ -225,6 +232,9 @@ void ValidateConfig(const EstimatorConfig& cfg) {
   for (const auto& [key, member] : LossFields()) CheckPositive((cfg.*member).scale, "losses." + key + ".scale");
   for (const auto& [key, member] : IntFields()) {
     if (cfg.*member < 1) throw GraphError("config key '" + key + "' must be >= 1");
+  }
+  if (cfg.incremental_update_every_steps < 0) {
+    throw GraphError("config key 'incremental_update_every_steps' must be >= 1 (0: unset)");
   }
   if (cfg.incremental_window < cfg.incremental_update_every) {
     throw GraphError("config: incremental_window must be >= incremental_update_every");

@@ -19,26 +19,6 @@ namespace {
 
 using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
-const char* TypeName(FactorType t) {
-  switch (t) {
-    case FactorType::kObjectPose: return "object_pose";
-    case FactorType::kFingerPose: return "finger_pose";
-    case FactorType::kContactPoint: return "contact_point";
-    case FactorType::kForce: return "force";
-    case FactorType::kContactOnObject: return "contact_on_object";
-    case FactorType::kContactOnFinger: return "contact_on_finger";
-    case FactorType::kTouching: return "touching";
-    case FactorType::kIntersection: return "intersection";
-    case FactorType::kConstantVelocity: return "constant_velocity";
-    case FactorType::kZeroVelocity: return "zero_velocity";
-    case FactorType::kForceContinuity: return "force_continuity";
-    case FactorType::kForcePrior: return "force_prior";
-    case FactorType::kQuasiStatic: return "quasi_static";
-    case FactorType::kLimitSurfaceLoad: return "limit_surface_load";
-    case FactorType::kPrior: return "priors";
-  }
-  return "?";
-}
 
 
 
@@ -127,7 +107,7 @@ Diagnostics Diagnose(const limit_surface::Trajectory& traj, Model model, const E
     double c = 0.0;
     if (!problem.EvaluateResidualBlock(tag.id, false, &c, r.data(), d.expected_from_covariance ? jac.data() : nullptr)) continue;
     FactorStatistics& f = stats[tag.type];
-    f.type = TypeName(tag.type);
+    f.type = FactorTypeName(tag.type);
     ++f.count;
     f.dof += m;
     residual_dims += m;
@@ -247,11 +227,11 @@ Diagnostics Diagnose(const limit_surface::Trajectory& traj, Model model, const E
     // them, or one beyond 10 sigma.
     if (spikes > 0 && spikes <= std::max(1, count / 50) && (spikes >= 2 || worst > 10.0)) {
       double at = 0.0;
-      for (const FactorStatistics& f : d.factors) if (f.type == TypeName(t)) at = f.worst_t;
-      d.faults.push_back({TypeName(t), "spikes",
+      for (const FactorStatistics& f : d.factors) if (f.type == FactorTypeName(t)) at = f.worst_t;
+      d.faults.push_back({FactorTypeName(t), "spikes",
                           Format("the %s stream has %d of %d samples more than 6 sigma from the estimate (worst %.1f "
                                  "sigma at t = %.3f s): spikes",
-                                 TypeName(t), spikes, count, worst, at)});
+                                 FactorTypeName(t), spikes, count, worst, at)});
     }
   }
 

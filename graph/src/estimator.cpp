@@ -316,6 +316,87 @@ void AddSharedParameterPrior(GraphBuilder& builder, ceres::Problem& problem, dou
 }
 }  // namespace
 
+const char* FactorTypeName(FactorType t) {
+  switch (t) {
+    case FactorType::kObjectPose: return "object_pose";
+    case FactorType::kFingerPose: return "finger_pose";
+    case FactorType::kContactPoint: return "contact_point";
+    case FactorType::kForce: return "force";
+    case FactorType::kContactOnObject: return "contact_on_object";
+    case FactorType::kContactOnFinger: return "contact_on_finger";
+    case FactorType::kTouching: return "touching";
+    case FactorType::kIntersection: return "intersection";
+    case FactorType::kConstantVelocity: return "constant_velocity";
+    case FactorType::kZeroVelocity: return "zero_velocity";
+    case FactorType::kForceContinuity: return "force_continuity";
+    case FactorType::kForcePrior: return "force_prior";
+    case FactorType::kQuasiStatic: return "quasi_static";
+    case FactorType::kLimitSurfaceLoad: return "limit_surface_load";
+    case FactorType::kPrior: return "priors";
+  }
+  return "?";
+}
+
+std::string GraphBuilder::Describe(ceres::ResidualBlockId id) const {
+  const auto it = origin_.find(id);
+  if (it == origin_.end()) return "a marginal prior or unnamed factor";
+  const auto [type, step] = it->second;
+  std::string s = std::string(FactorTypeName(type)) + " factor";
+  if (step >= 0 && step < static_cast<int>(steps_.size())) {
+    char t[48];
+    std::snprintf(t, sizeof t, "%.9g", steps_[step].t);
+    s += " at step " + std::to_string(step) + " (t = " + t + " s)";
+  } else {
+    s += " (shared by the trajectory)";
+  }
+  return s;
+}
+
+SolveOutcome GraphBuilder::Solve(ceres::Problem& problem, int max_iterations, double function_tolerance,
+                                 const char* what) const {
+  SolveOutcome out;
+  if (cfg_.solver == EstimatorConfig::Solver::kCeres) {
+    ceres::Solver::Summary summary;
+    ceres::Solve(SolverOptions(max_iterations, function_tolerance), &problem, &summary);
+    LogSummary(what, summary);
+    if (summary.termination_type == ceres::FAILURE) throw GraphError(std::string(what) + " failed: " + summary.message);
+    out.iterations = summary.num_successful_steps + summary.num_unsuccessful_steps;
+    out.final_cost = summary.final_cost;
+    out.converged = summary.termination_type == ceres::CONVERGENCE;
+    out.termination = summary.message;
+    return out;
+  }
+  ChainSolverOptions options;
+  options.max_iterations = max_iterations;
+  options.function_tolerance = function_tolerance;
+  options.describe = [this](ceres::ResidualBlockId id) { return Describe(id); };
+  options.log_iterations = SolverLogLevel() >= 2;
+  out.chain = std::make_unique<ChainSolver>(problem);
+  ChainSolverSummary summary;
+  try {
+    summary = out.chain->Solve(options);
+  } catch (const GraphError& e) {
+    throw GraphError(std::string(what) + ": " + e.what());
+  }
+  if (SolverLogLevel() >= 1) {
+    std::fprintf(stderr,
+                 "pushgraph %s (chain solver): %d unknowns, %d iterations (%d successful), cost %.6e -> %.6e, %s; "
+                 "%.3f ms (evaluation %.3f, linear %.3f), J^T J nonzeros %ld, factor nonzeros %ld, %.3g flops per "
+                 "factorization\n",
+                 what, summary.unknowns, summary.iterations, summary.successful_steps, summary.initial_cost,
+                 summary.final_cost, summary.termination.c_str(), 1e3 * summary.total_s, 1e3 * summary.evaluate_s,
+                 1e3 * summary.linear_solve_s, summary.hessian_nonzeros, summary.factor_nonzeros, summary.factor_flops);
+  }
+  out.iterations = summary.iterations;
+  out.final_cost = summary.final_cost;
+  out.converged = summary.converged;
+  out.termination = summary.termination;
+  out.evaluation_s = summary.evaluate_s;
+  out.linear_solve_s = summary.linear_solve_s;
+  out.factor_flops = summary.factor_flops;
+  return out;
+}
+
 void GraphBuilder::EnableShapeFrame(const Vec2& centroid, double sigma_centroid, double sigma_theta, bool rotation) {
   shape_frame_ = true;
   frame_centroid_ = centroid;
@@ -341,6 +422,7 @@ ceres::ResidualBlockId GraphBuilder::Add(ceres::Problem& problem, FactorType typ
   }
   const ceres::ResidualBlockId id = problem.AddResidualBlock(cost, loss, blocks);
   if (tags_ != nullptr) tags_->push_back({type, id});
+  origin_[id] = {type, type == FactorType::kPrior ? -1 : adding_step_};
   return id;
 }
 
@@ -427,9 +509,7 @@ int GraphBuilder::SmoothInitialMotion(int max_iterations, double function_tolera
       problem.SetParameterBlockConstant(vars_[i].e);
     }
   }
-  ceres::Solver::Summary summary;
-  ceres::Solve(SolverOptions(max_iterations, function_tolerance), &problem, &summary);
-  LogSummary("motion-only initialization", summary);
+  const SolveOutcome outcome = Solve(problem, max_iterations, function_tolerance, "motion-only initialization");
   if (!streams_.contact_point) {
     for (int i = first; i < n; ++i) {
       if (!steps_[i].in_contact) continue;
@@ -439,7 +519,7 @@ int GraphBuilder::SmoothInitialMotion(int max_iterations, double function_tolera
       v.p[1] = q.closest_point.y();
     }
   }
-  return summary.num_successful_steps + summary.num_unsuccessful_steps;
+  return outcome.iterations;
 }
 
 ceres::LossFunction* GraphBuilder::MakeLoss(const LossConfig& loss) const {
@@ -467,6 +547,7 @@ void GraphBuilder::AddFactors(ceres::Problem& problem, int i, int parts) {
 }
 
 void GraphBuilder::AddKinematicFactors(ceres::Problem& problem, int i) {
+  adding_step_ = i;
   const auto& m = traj_.measured;
   const Step& s = steps_[i];
   StepVars& v = vars_[i];
@@ -511,6 +592,7 @@ void GraphBuilder::AddKinematicFactors(ceres::Problem& problem, int i) {
 }
 
 void GraphBuilder::AddPoseMeasurementFactors(ceres::Problem& problem, int i) {
+  adding_step_ = i;
   const auto& m = traj_.measured;
   const Step& s = steps_[i];
   StepVars& v = vars_[i];
@@ -527,6 +609,7 @@ void GraphBuilder::AddPoseMeasurementFactors(ceres::Problem& problem, int i) {
 }
 
 void GraphBuilder::AddConstantVelocityFactors(ceres::Problem& problem, int i) {
+  adding_step_ = i;
   if (i < 2) return;
   const double dt1 = steps_[i - 1].t - steps_[i - 2].t, dt2 = steps_[i].t - steps_[i - 1].t;
   const double st = ConstantVelocitySigma(cfg_.accel_trans, dt1, dt2);
@@ -538,6 +621,7 @@ void GraphBuilder::AddConstantVelocityFactors(ceres::Problem& problem, int i) {
 }
 
 void GraphBuilder::AddDynamicFactors(ceres::Problem& problem, int i) {
+  adding_step_ = i;
   const auto& m = traj_.measured;
   const Step& s = steps_[i];
   StepVars& v = vars_[i];
@@ -649,7 +733,7 @@ StateEstimate GraphBuilder::State(int i) const {
 
 std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder, const std::vector<int>& steps,
                                std::vector<StateEstimate>& states, EstimatorConfig::CovarianceMethod method,
-                               EstimationResult* parameters, Eigen::Matrix3d* frame_cov) {
+                               EstimationResult* parameters, Eigen::Matrix3d* frame_cov, ChainSolver* chain) {
   // The shared parameters (c, mu) whose sigmas are wanted.
   std::vector<std::pair<double*, std::optional<double>*>> shared;
   if (parameters != nullptr) {
@@ -663,7 +747,7 @@ std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder, c
   std::string marginals_error;
   if (method == EstimatorConfig::CovarianceMethod::kSelectedInversion) {
     const auto start = std::chrono::steady_clock::now();
-    if (marginals.Compute(problem)) {
+    if (chain != nullptr ? marginals.Compute(*chain) : marginals.Compute(problem)) {
       if (SolverLogLevel() >= 1) {
         const SparseMarginals::Timings& t = marginals.timings();
         std::cerr << "pushgraph marginals: " << marginals.num_unknowns() << " unknowns, "
@@ -803,10 +887,7 @@ EstimationResult EstimateBatch(const limit_surface::Trajectory& traj, Model mode
     for (int i = 0; i < n; ++i) kinematic.Initialize(i, INFINITY);
     stage_iterations += kinematic.SmoothInitialMotion(10, 1e-3);
     for (int i = 0; i < n; ++i) kinematic.AddFactors(pre, i);
-    ceres::Solver::Summary pre_summary;
-    ceres::Solve(internal::SolverOptions(cfg.max_iterations, cfg.function_tolerance), &pre, &pre_summary);
-    internal::LogSummary("batch warm start (sdf)", pre_summary);
-    stage_iterations += pre_summary.num_successful_steps + pre_summary.num_unsuccessful_steps;
+    stage_iterations += kinematic.Solve(pre, cfg.max_iterations, cfg.function_tolerance, "batch warm start (sdf)").iterations;
     for (int i = 0; i < n; ++i) {
       auto& dst = builder.vars()[i];
       const auto& src = kinematic.vars()[i];
@@ -817,12 +898,7 @@ EstimationResult EstimateBatch(const limit_surface::Trajectory& traj, Model mode
   }
   if (!ModelHasForce(model)) stage_iterations += builder.SmoothInitialMotion(10, 1e-3);
   for (int i = 0; i < n; ++i) builder.AddFactors(problem, i);
-  ceres::Solver::Summary summary;
-  ceres::Solve(internal::SolverOptions(cfg.max_iterations, cfg.function_tolerance), &problem, &summary);
-  internal::LogSummary("batch", summary);
-  if (summary.termination_type == ceres::FAILURE) {
-    throw GraphError("batch solve failed: " + summary.message);
-  }
+  const internal::SolveOutcome summary = builder.Solve(problem, cfg.max_iterations, cfg.function_tolerance, "batch solve");
   EstimationResult r;
   r.model = model;
   r.mode = Mode::kBatch;
@@ -834,7 +910,8 @@ EstimationResult EstimateBatch(const limit_surface::Trajectory& traj, Model mode
   if (cfg.covariance) {
     Eigen::Matrix3d frame_cov = Eigen::Matrix3d::Zero();
     r.solver.covariance_status =
-        internal::ComputeCovariances(problem, builder, idx, r.states, cfg.covariance_method, &r, frame ? &frame_cov : nullptr);
+        internal::ComputeCovariances(problem, builder, idx, r.states, cfg.covariance_method, &r, frame ? &frame_cov : nullptr,
+                                     summary.chain.get());
     if (frame && r.solver.covariance_status == "ok") frame->covariance = frame_cov;
   }
   if (frame) frame->frame = builder.frame();
@@ -847,8 +924,16 @@ EstimationResult EstimateBatch(const limit_surface::Trajectory& traj, Model mode
   if (r.c_at_bound) r.c_sigma.reset();
   if (r.mu_at_bound) r.mu_sigma.reset();
   r.solver.time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  r.solver.iterations = stage_iterations + summary.num_successful_steps + summary.num_unsuccessful_steps;
+  r.solver.iterations = stage_iterations + summary.iterations;
   r.solver.final_cost = summary.final_cost;
+  r.solver.name = cfg.solver == EstimatorConfig::Solver::kCeres ? "ceres" : "chain";
+  r.solver.evaluation_time_s = summary.evaluation_s;
+  r.solver.linear_solve_time_s = summary.linear_solve_s;
+  r.solver.factor_flops = summary.factor_flops;
+  if (!summary.converged) {
+    r.warnings.push_back("the batch solve stopped at its iteration limit (" + std::to_string(cfg.max_iterations) +
+                         ") before converging: " + summary.termination);
+  }
   r.solver.updates = 1;
   r.solver.max_update_time_s = r.solver.mean_update_time_s = r.solver.time_s;
   builder.DropUnobservableForces(r);

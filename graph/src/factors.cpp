@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <exception>
+#include <cstring>
 #include <iostream>
 #include <utility>
 
@@ -97,17 +98,46 @@ bool BoundaryPointFactor::Evaluate(double const* const* parameters, double* resi
 
 // Object pose in parameters[0], finger pose in parameters[1]. A geometry error (non-finite
 // poses during a bad step) makes Ceres reject the step rather than abort the solve.
-static bool QueryPair(const geometry::ShapePairQuerier& querier, double const* const* parameters,
-               geometry::ShapePairResult* r, geometry::ShapePairJacobians* J) {
+// The touching, witness and intersection factors of a step ask the same querier about the same
+// two poses one after another (both solvers evaluate residual blocks in order): the last answer
+// is kept per thread and reused when the querier (the same object, not just the same address:
+// weak_ptr ownership) and the six pose values are bit-identical. The query is deterministic,
+// so the reuse changes nothing but the time (one shape-pair query per step instead of three).
+static bool QueryPair(const std::shared_ptr<const geometry::ShapePairQuerier>& querier,
+                      double const* const* parameters, geometry::ShapePairResult* r, geometry::ShapePairJacobians* J) {
+  struct LastQuery {
+    std::weak_ptr<const geometry::ShapePairQuerier> querier;
+    double poses[6] = {};
+    bool has_jacobians = false;
+    geometry::ShapePairResult result;
+    geometry::ShapePairJacobians jacobians;
+  };
+  thread_local LastQuery last;
+  double poses[6];
+  std::copy(parameters[0], parameters[0] + 3, poses);
+  std::copy(parameters[1], parameters[1] + 3, poses + 3);
+  const bool same_querier = !last.querier.expired() && !last.querier.owner_before(querier) &&
+                            !querier.owner_before(last.querier);
+  if (same_querier && (J == nullptr || last.has_jacobians) && std::memcmp(poses, last.poses, sizeof poses) == 0) {
+    *r = last.result;
+    if (J != nullptr) *J = last.jacobians;
+    return true;
+  }
   try {
-    *r = querier.Query(PoseFrom(parameters[0]), PoseFrom(parameters[1]), J);
+    *r = querier->Query(PoseFrom(parameters[0]), PoseFrom(parameters[1]), J);
   } catch (const std::exception& e) {
     // Ceres treats a failed evaluation as an infeasible step; say why when asked to.
     if (internal::SolverLogLevel() >= 1) {
       std::cerr << "pushgraph: shape-pair query failed: " << e.what() << "\n";
     }
+    last.querier.reset();
     return false;
   }
+  last.querier = querier;
+  std::copy(poses, poses + 6, last.poses);
+  last.has_jacobians = J != nullptr;
+  last.result = *r;
+  if (J != nullptr) last.jacobians = *J;
   return true;
 }
 
@@ -121,7 +151,7 @@ bool TouchingFactor::Evaluate(double const* const* parameters, double* residuals
                               double** jacobians) const {
   geometry::ShapePairJacobians J;
   geometry::ShapePairResult r;
-  if (!QueryPair(*querier_, parameters, &r, &J)) return false;
+  if (!QueryPair(querier_, parameters, &r, &J)) return false;
   residuals[0] = w_ * r.signed_distance;
   if (jacobians != nullptr) {
     if (jacobians[0] != nullptr) Eigen::Map<Eigen::RowVector3d>{jacobians[0]} = w_ * J.J_sd_object_pose;
@@ -141,7 +171,7 @@ bool ContactWitnessFactor::Evaluate(double const* const* parameters, double* res
                                     double** jacobians) const {
   geometry::ShapePairJacobians J;
   geometry::ShapePairResult r;
-  if (!QueryPair(*querier_, parameters, &r, &J)) return false;
+  if (!QueryPair(querier_, parameters, &r, &J)) return false;
   const Vec2 mid = 0.5 * (r.object_point + r.finger_point);
   Eigen::Map<Eigen::Vector2d>{residuals} = w_ * (Vec2(parameters[2][0], parameters[2][1]) - mid);
   if (jacobians != nullptr) {
@@ -168,7 +198,7 @@ bool IntersectionFactor::Evaluate(double const* const* parameters, double* resid
                                   double** jacobians) const {
   geometry::ShapePairJacobians J;
   geometry::ShapePairResult r;
-  if (!QueryPair(*querier_, parameters, &r, &J)) return false;
+  if (!QueryPair(querier_, parameters, &r, &J)) return false;
   Eigen::Map<Eigen::Vector2d> res(residuals);
   if (!r.intersecting) {
     res.setZero();

@@ -1,5 +1,6 @@
 #pragma once
 // Internal: steps, variables and factor assembly shared by the batch and incremental solvers.
+#include <pushgraph/graph/chain_solver.h>
 #include <pushgraph/graph/estimator.h>
 #include <pushgraph/graph/incremental.h>
 
@@ -9,6 +10,8 @@
 #include <algorithm>
 #include <memory>
 #include <optional>
+#include <string>
+#include <unordered_map>
 #include <vector>
 
 namespace pushgraph::graph::internal {
@@ -71,8 +74,27 @@ struct TaggedBlock {
   ceres::ResidualBlockId id;
 };
 
+/// "quasi_static", "constant_velocity", ... (RESULT.json's diagnostics names).
+const char* FactorTypeName(FactorType type);
+
+/// What a solve did (either solver).
+struct SolveOutcome {
+  int iterations = 0;
+  double final_cost = 0.0;
+  bool converged = false;
+  std::string termination;
+  double evaluation_s = 0.0, linear_solve_s = 0.0, factor_flops = 0.0;  ///< chain solver only
+  /// The chain solver that ran (its factor serves the covariances); null for Ceres.
+  std::unique_ptr<ChainSolver> chain;
+};
+
 class GraphBuilder {
  public:
+  /// Solves `problem` (built by this builder) with config.solver; `what` names the stage in
+  /// logs. Throws GraphError when the solve fails (naming the factor and step when known).
+  SolveOutcome Solve(ceres::Problem& problem, int max_iterations, double function_tolerance, const char* what) const;
+  /// Names a residual block this builder added: "quasi_static factor at step 17 (t = 0.068 s)".
+  std::string Describe(ceres::ResidualBlockId id) const;
   /// Adds a residual block, records its type when RecordFactorTypes is on, and, for a factor
   /// that places the object's shape (`object_pose_blocks` non-empty) while the shape frame is a
   /// variable, wraps it in ShapeFrameFactor with those blocks composed with F.
@@ -192,6 +214,8 @@ class GraphBuilder {
   double frame_[3] = {0.0, 0.0, 0.0};
   Vec2 frame_centroid_ = Vec2::Zero();
   std::vector<TaggedBlock>* tags_ = nullptr;
+  int adding_step_ = -1;  ///< the step whose factors are being added (-1: shared)
+  std::unordered_map<ceres::ResidualBlockId, std::pair<FactorType, int>> origin_;  ///< for Describe
   double frame_sigma_centroid_ = 0.01, frame_sigma_theta_ = 0.2;
 };
 
@@ -202,7 +226,8 @@ class GraphBuilder {
 std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder,
                                const std::vector<int>& steps, std::vector<StateEstimate>& states,
                                EstimatorConfig::CovarianceMethod method,
-                               EstimationResult* parameters = nullptr, Eigen::Matrix3d* frame_cov = nullptr);
+                               EstimationResult* parameters = nullptr, Eigen::Matrix3d* frame_cov = nullptr,
+                               ChainSolver* chain = nullptr);
 
 /// The shape frame of an estimate, for Diagnose.
 struct FrameState {

@@ -8,6 +8,8 @@
 // graph), so only that pattern is ever computed.
 #include <pushgraph/graph/marginals.h>
 
+#include "chain_solver_impl.h"
+
 #include <ceres/crs_matrix.h>
 
 #include <Eigen/OrderingMethods>
@@ -138,11 +140,22 @@ bool SparseMarginals::Compute(ceres::Problem& problem) {
     return false;
   }
   impl->perm = llt.permutationP().indices();
-  const Eigen::SparseMatrix<double>& L = llt.matrixL().nestedExpression();
-  // A pivot that keeps almost none of its variable's information (L_jj^2 against H_jj: 1 - R^2
-  // of that unknown on the earlier ones) is a numerically dependent direction.
   Eigen::VectorXd h_diag(n);
   for (int a = 0; a < n; ++a) h_diag[impl->perm[a]] = H.coeff(a, a);
+  const bool ok = SelectedInverse(llt.matrixL().nestedExpression(), h_diag, variable, *impl, phase);
+  if (ok) impl_ = std::move(impl);
+  return ok;
+}
+
+bool SparseMarginals::SelectedInverse(const Eigen::SparseMatrix<double>& L, const Eigen::VectorXd& h_diag,
+                                      const std::vector<double*>& variable, Impl& impl_ref,
+                                      std::chrono::steady_clock::time_point phase) {
+  using Clock = std::chrono::steady_clock;
+  auto seconds_since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
+  Impl* impl = &impl_ref;
+  const int n = static_cast<int>(h_diag.size());
+  // A pivot that keeps almost none of its variable's information (L_jj^2 against H_jj: 1 - R^2
+  // of that unknown on the earlier ones) is a numerically dependent direction.
   impl->col_start.assign(n + 1, 0);
   std::vector<std::pair<int, double>> column;
   std::vector<double> values;
@@ -221,8 +234,35 @@ bool SparseMarginals::Compute(ceres::Problem& problem) {
     impl->z[begin] = (1.0 / ljj - l_r.dot(z_rj)) / ljj;
   }
   timings_.inversion = seconds_since(phase);
-  impl_ = std::move(impl);
   return true;
+}
+
+bool SparseMarginals::Compute(ChainSolver& solver) {
+  impl_.reset();
+  error_.clear();
+  failed_block_ = nullptr;
+  timings_ = Timings{};
+  min_pivot_ratio_ = 0.0;
+  ChainSolver::Impl& s = solver.impl();
+  if (s.n == 0) {
+    error_ = "no variable parameter blocks";
+    return false;
+  }
+  const auto phase = std::chrono::steady_clock::now();
+  if (!s.FactorizeAtCurrentValues(&error_)) return false;
+  auto impl = std::make_unique<Impl>();
+  std::vector<double*> variable;
+  for (const ChainSolver::Impl::Block& b : s.blocks) {
+    impl->blocks[b.ptr] = {b.offset, b.size};
+    variable.push_back(b.ptr);
+  }
+  for (const auto& [ptr, size] : s.fixed) impl->fixed[ptr] = size;
+  impl->perm = s.llt.permutationP().indices();
+  Eigen::VectorXd h_diag(s.n);
+  for (int a = 0; a < s.n; ++a) h_diag[impl->perm[a]] = s.values[s.diagonal[a]];
+  const bool ok = SelectedInverse(s.llt.matrixL().nestedExpression(), h_diag, variable, *impl, phase);
+  if (ok) impl_ = std::move(impl);
+  return ok;
 }
 
 Eigen::MatrixXd SparseMarginals::CrossCovariance(const double* a, const double* b) const {

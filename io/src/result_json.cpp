@@ -52,7 +52,9 @@ std::string ResultToJson(const graph::EstimationResult& r, int indent) {
                  {"updates", r.solver.updates},
                  {"max_update_time_s", r.solver.max_update_time_s},
                  {"mean_update_time_s", r.solver.mean_update_time_s},
+                 {"name", r.solver.name},
                  {"covariance", r.solver.covariance_status}};
+  if (r.mode == graph::Mode::kIncremental) j["solver"]["update_times_s"] = r.solver.update_times_s;
   // The model's shared parameters: c (QS, baseline) and the load factor's mu, estimated or not.
   nlohmann::json parameters = nlohmann::json::object();
   if (r.c) {

@@ -23,6 +23,7 @@ struct EstimateOptions {
   std::string input;
   std::string model = "qs";
   std::string mode = "batch";
+  std::string solver;
   std::string output;
   std::string config;
   std::string object, finger;
@@ -104,6 +105,9 @@ void RunEstimate(const EstimateOptions& o) {
   if (traj.measurement_sigmas) config = graph::ApplyMeasurementSigmas(config, *traj.measurement_sigmas);
   if (!o.config.empty()) config = graph::LoadEstimatorConfig(o.config, config);
   if (!o.align_shape.empty()) config.align_shape = ParseAlignShape(o.align_shape);
+  if (!o.solver.empty()) {
+    config.solver = o.solver == "ceres" ? graph::EstimatorConfig::Solver::kCeres : graph::EstimatorConfig::Solver::kChain;
+  }
   if (mode == graph::Mode::kIncremental && (config.estimate_c || config.estimate_mu)) {
     throw CliError(o.config + ": estimate_c and estimate_mu are batch only (the incremental mode keeps c and mu "
                    "fixed): use --mode batch or drop them");
@@ -163,6 +167,9 @@ void RegisterEstimate(CLI::App& app) {
   sub->add_option("--model", opts->model, "Graph: cp, sdf, qs or yu (Yu-Rodriguez baseline)")->capture_default_str();
   sub->add_option("--mode", opts->mode, "batch or incremental (fixed-lag smoothing)")->capture_default_str();
   sub->add_option("-o,--output", opts->output, "Output RESULT.json")->required();
+  sub->add_option("--solver", opts->solver,
+                  "ceres (the default, the reference) or chain (banded Levenberg-Marquardt, chain_solver.h); overrides the config's")
+      ->check(CLI::IsMember({"chain", "ceres"}));
   sub->add_option("--config", opts->config, "Estimator configuration JSON (sigmas, losses, window; docs/estimation.md)");
   sub->add_option("--object", opts->object, "Object shape JSON (required for MIT recordings; overrides a trajectory's)");
   sub->add_option("--finger", opts->finger, "Finger (probe) shape JSON (required for MIT recordings)");

@@ -17,8 +17,8 @@
 // cross-multiplied quasi-static factor + zero-velocity (random-walk) priors, no S.
 // Steps: the sorted union of all measurement time stamps; a step has a factor for each
 // measurement it has, contact variables only while in contact (EstimatorConfig's gating).
-// Modes: kBatch solves everything at once (Ceres LM, SPARSE_NORMAL_CHOLESKY; covariances by
-// SparseMarginals, marginals.h);
+// Modes: kBatch solves everything at once (config.solver: Ceres' LM with SPARSE_NORMAL_CHOLESKY
+// by default, or ChainSolver, chain_solver.h; covariances by SparseMarginals, marginals.h);
 // kIncremental is a fixed-lag smoother (incremental.h).
 #include <pushgraph/graph/config.h>
 #include <pushgraph/graph/diagnostics.h>
@@ -64,6 +64,12 @@ struct SolverStats {
   double max_update_time_s = 0.0;
   double mean_update_time_s = 0.0;
   std::string covariance_status = "not computed";
+  std::string name = "ceres";           ///< which solver ran: "ceres" or "chain" (ChainSolver)
+  std::vector<double> update_times_s;   ///< incremental: each update's wall time, in order
+  /// The chain solver's profile of the batch's final stage: wall time (s) in residual and
+  /// Jacobian evaluation with the J^T J accumulation and in factorizations and solves, and the
+  /// floating-point operations of one factorization and solve (0 with Ceres).
+  double evaluation_time_s = 0.0, linear_solve_time_s = 0.0, factor_flops = 0.0;
 };
 
 /// What the estimator did about the object's shape frame (EstimatorConfig::align_shape).

@@ -21,12 +21,17 @@
 #include <ceres/problem.h>
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include <chrono>
 
 #include <memory>
 #include <string>
 #include <vector>
 
 namespace pushgraph::graph {
+
+class ChainSolver;
 
 class SparseMarginals {
  public:
@@ -44,6 +49,10 @@ class SparseMarginals {
   /// Parameter bounds are ignored (as ceres::Covariance does): a variable on its bound gets the
   /// unconstrained Gaussian covariance.
   bool Compute(ceres::Problem& problem);
+  /// The same from a ChainSolver (after its Solve): its J^T J at the solution (no second
+  /// evaluation when the values have not moved) and its symbolic factorization; the unknowns in
+  /// the solver's time order, so the factor is banded and the selected inverse costs O(n w^2).
+  bool Compute(ChainSolver& solver);
 
   /// The marginal covariance of one parameter block (size x size); zero for a block held fixed
   /// (constant, or used by no residual), as ceres::Covariance does. Throws std::logic_error
@@ -72,6 +81,10 @@ class SparseMarginals {
 
  private:
   struct Impl;
+  // Checks the pivots of L (factor order; h_diag the diagonal of H in that order) and computes
+  // the selected inverse into impl.
+  bool SelectedInverse(const Eigen::SparseMatrix<double>& L, const Eigen::VectorXd& h_diag,
+                       const std::vector<double*>& variable, Impl& impl, std::chrono::steady_clock::time_point phase);
   std::unique_ptr<Impl> impl_;
   std::string error_;
   const double* failed_block_ = nullptr;

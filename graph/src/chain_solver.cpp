@@ -1,0 +1,471 @@
+// Levenberg-Marquardt on a fixed sparse pattern (Nielsen's damping update, as Ceres'
+// LEVENBERG_MARQUARDT strategy: lambda *= max(1/3, 1 - (2 rho - 1)^3) after a successful step,
+// lambda *= nu, nu *= 2 after a rejected one; K. Madsen, H. B. Nielsen, O. Tingleff, "Methods
+// for non-linear least squares problems", 2004, Sec. 3.2). The normal equations are scattered
+// straight into the stored lower triangle of J^T J through offsets computed once.
+#include "chain_solver_impl.h"
+
+#include <pushgraph/graph/factors.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <limits>
+#include <numeric>
+#include <unordered_map>
+
+namespace pushgraph::graph {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double SecondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// A block used by more residual blocks than this is shared by the trajectory (c, mu, the shape
+// frame): ordered last, it borders the band instead of filling it.
+constexpr int kSharedBlockDegree = 32;
+// Ceres' defaults: the smallest relative decrease of an accepted step, and the clamp of
+// diag(J^T J) in the damping.
+constexpr double kMinRelativeDecrease = 1e-3;
+constexpr double kMinDiagonal = 1e-6, kMaxDiagonal = 1e32;
+
+std::string DefaultDescription(int index, const ChainSolver::Impl::Residual& r) {
+  return "residual block " + std::to_string(index) + " (" + std::to_string(r.cost->num_residuals()) + " residuals, " +
+         std::to_string(r.params.size()) + " parameter blocks)";
+}
+
+}  // namespace
+
+ChainSolver::Impl::Impl(ceres::Problem& p) : problem(&p) {
+  std::vector<double*> all;
+  problem->GetParameterBlocks(&all);
+  std::vector<ceres::ResidualBlockId> ids;
+  problem->GetResidualBlocks(&ids);
+  std::unordered_map<const double*, int> degree;
+  std::vector<std::vector<double*>> params(ids.size());
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    problem->GetParameterBlocksForResidualBlock(ids[k], &params[k]);
+    for (double* b : params[k]) ++degree[b];
+  }
+  // Time order (insertion order), shared blocks last.
+  std::vector<double*> chain, shared;
+  for (double* b : all) {
+    const int size = problem->ParameterBlockSize(b);
+    if (problem->IsParameterBlockConstant(b) || !degree.count(b) || size == 0) {
+      fixed[b] = size;
+      continue;
+    }
+    if (problem->GetManifold(b) != nullptr) throw GraphError("ChainSolver: a parameter block has a manifold (not supported)");
+    (degree[b] > kSharedBlockDegree ? shared : chain).push_back(b);
+  }
+  chain.insert(chain.end(), shared.begin(), shared.end());
+  int offset = 0;
+  for (double* b : chain) {
+    Block block;
+    block.ptr = b;
+    block.offset = offset;
+    block.size = problem->ParameterBlockSize(b);
+    for (int i = 0; i < block.size; ++i) {
+      block.lower.push_back(problem->GetParameterLowerBound(b, i));
+      block.upper.push_back(problem->GetParameterUpperBound(b, i));
+      block.bounded |= block.lower.back() > -std::numeric_limits<double>::max() ||
+                       block.upper.back() < std::numeric_limits<double>::max();
+    }
+    index[b] = static_cast<int>(blocks.size());
+    blocks.push_back(std::move(block));
+    offset += blocks.back().size;
+  }
+  n = offset;
+  // Residual blocks, their Jacobian storage and the block pairs of J^T J they touch.
+  std::vector<std::pair<int, int>> block_pairs;  // (row block, column block), row >= column
+  int jacobian_size = 0, residual_size = 0;
+  residuals.reserve(ids.size());
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    Residual r;
+    r.id = ids[k];
+    r.cost = problem->GetCostFunctionForResidualBlock(ids[k]);
+    r.loss = problem->GetLossFunctionForResidualBlock(ids[k]);
+    r.params = params[k];
+    r.residual_offset = residual_size;
+    residual_size += r.cost->num_residuals();
+    for (double* b : r.params) {
+      const auto it = index.find(b);
+      r.block.push_back(it == index.end() ? -1 : it->second);
+      r.jacobian_offset.push_back(jacobian_size);
+      if (it != index.end()) jacobian_size += r.cost->num_residuals() * blocks[it->second].size;
+    }
+    for (std::size_t a = 0; a < r.block.size(); ++a) {
+      for (std::size_t b = 0; b < r.block.size(); ++b) {
+        if (r.block[a] < 0 || r.block[b] < 0 || r.block[a] < r.block[b]) continue;
+        block_pairs.emplace_back(r.block[a], r.block[b]);
+      }
+    }
+    // A residual block on constant blocks only adds a constant to the cost (Ceres' fixed cost):
+    // it is evaluated once per Solve, not in every iteration.
+    r.constant = std::all_of(r.block.begin(), r.block.end(), [](int b) { return b < 0; });
+    residuals.push_back(std::move(r));
+  }
+  jacobian_values.assign(jacobian_size, 0.0);
+  residual_values.assign(residual_size, 0.0);
+  std::sort(block_pairs.begin(), block_pairs.end());
+  block_pairs.erase(std::unique(block_pairs.begin(), block_pairs.end()), block_pairs.end());
+  // The pattern: the lower triangle of every touched block pair.
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (const auto& [a, b] : block_pairs) {
+    const Block& ra = blocks[a];
+    const Block& cb = blocks[b];
+    for (int k = 0; k < cb.size; ++k) {
+      for (int u = (a == b ? k : 0); u < ra.size; ++u) triplets.emplace_back(ra.offset + u, cb.offset + k, 0.0);
+    }
+  }
+  H.resize(n, n);
+  H.setFromTriplets(triplets.begin(), triplets.end());
+  H.makeCompressed();
+  auto position = [&](int row, int col) {
+    const int* first = H.innerIndexPtr() + H.outerIndexPtr()[col];
+    const int* last = H.innerIndexPtr() + H.outerIndexPtr()[col + 1];
+    return static_cast<int>(std::lower_bound(first, last, row) - H.innerIndexPtr());
+  };
+  diagonal.resize(n);
+  for (int j = 0; j < n; ++j) diagonal[j] = position(j, j);
+  for (Residual& r : residuals) {
+    r.pair_begin = static_cast<int>(pairs.size());
+    for (std::size_t a = 0; a < r.block.size(); ++a) {
+      for (std::size_t b = 0; b < r.block.size(); ++b) {
+        if (r.block[a] < 0 || r.block[b] < 0 || r.block[a] < r.block[b]) continue;
+        Pair pair;
+        pair.row_param = static_cast<int>(a);
+        pair.col_param = static_cast<int>(b);
+        pair.offsets_begin = static_cast<int>(column_offsets.size());
+        const Block& ra = blocks[r.block[a]];
+        const Block& cb = blocks[r.block[b]];
+        for (int k = 0; k < cb.size; ++k) column_offsets.push_back(position(ra.offset + (a == b ? k : 0), cb.offset + k));
+        pairs.push_back(pair);
+      }
+    }
+    r.pair_end = static_cast<int>(pairs.size());
+  }
+  values.assign(H.nonZeros(), 0.0);
+  trial_values.assign(H.nonZeros(), 0.0);
+  gradient = Eigen::VectorXd::Zero(n);
+  trial_gradient = Eigen::VectorXd::Zero(n);
+}
+
+void ChainSolver::Impl::Gather(Eigen::VectorXd& x) const {
+  x.resize(n);
+  for (const Block& b : blocks) std::copy(b.ptr, b.ptr + b.size, x.data() + b.offset);
+}
+
+void ChainSolver::Impl::Scatter(const Eigen::VectorXd& x) {
+  for (const Block& b : blocks) std::copy(x.data() + b.offset, x.data() + b.offset + b.size, b.ptr);
+}
+
+void ChainSolver::Impl::Project(Eigen::VectorXd& x) const {
+  for (const Block& b : blocks) {
+    if (!b.bounded) continue;
+    for (int i = 0; i < b.size; ++i) x[b.offset + i] = std::clamp(x[b.offset + i], b.lower[i], b.upper[i]);
+  }
+}
+
+bool ChainSolver::Impl::Evaluate(std::vector<double>& h, Eigen::VectorXd& g, double* cost, int* failed) {
+  std::fill(h.begin(), h.end(), 0.0);
+  g.setZero();
+  double total = 0.0;
+  std::vector<double*> jacobians;
+  for (std::size_t k = 0; k < residuals.size(); ++k) {
+    const Residual& r = residuals[k];
+    if (r.constant) continue;
+    const int m = r.cost->num_residuals();
+    jacobians.assign(r.params.size(), nullptr);
+    for (std::size_t q = 0; q < r.params.size(); ++q) {
+      if (r.block[q] >= 0) jacobians[q] = jacobian_values.data() + r.jacobian_offset[q];
+    }
+    double* res = residual_values.data() + r.residual_offset;
+    bool ok = r.cost->Evaluate(r.params.data(), res, jacobians.data());
+    double sq = 0.0;
+    for (int i = 0; ok && i < m; ++i) {
+      ok = std::isfinite(res[i]);
+      sq += res[i] * res[i];
+    }
+    for (std::size_t q = 0; ok && q < r.params.size(); ++q) {
+      if (r.block[q] < 0) continue;
+      const double* J = jacobians[q];
+      for (int i = 0, size = m * blocks[r.block[q]].size; ok && i < size; ++i) ok = std::isfinite(J[i]);
+    }
+    if (!ok) {
+      *failed = static_cast<int>(k);
+      return false;
+    }
+    double weight = 1.0;
+    if (r.loss != nullptr) {
+      double rho[3];
+      r.loss->Evaluate(sq, rho);
+      total += 0.5 * rho[0];
+      weight = std::max(rho[1], 0.0);
+    } else {
+      total += 0.5 * sq;
+    }
+    // The residual block's Jacobian over its variable blocks as one m x k matrix, then its
+    // k x k normal matrix in one product, scattered into the stored lower triangle.
+    using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+    int k_total = 0;
+    for (std::size_t q = 0; q < r.params.size(); ++q) {
+      if (r.block[q] >= 0) k_total += blocks[r.block[q]].size;
+    }
+    local_jacobian.resize(m, k_total);
+    local_offset.resize(r.params.size());
+    for (std::size_t q = 0, col = 0; q < r.params.size(); ++q) {
+      if (r.block[q] < 0) continue;
+      const int size = blocks[r.block[q]].size;
+      local_offset[q] = static_cast<int>(col);
+      local_jacobian.middleCols(col, size) = Eigen::Map<const RowMajor>(jacobians[q], m, size);
+      col += size;
+    }
+    const Eigen::Map<const Eigen::VectorXd> rv(res, m);
+    local_hessian.resize(k_total, k_total);
+    // Coefficient-wise products: the blocks are tiny (k <= 11 but for marginal priors), where
+    // Eigen's blocked GEMM path costs more than the arithmetic.
+    local_hessian.noalias() = local_jacobian.transpose().lazyProduct(local_jacobian);
+    local_gradient.noalias() = local_jacobian.transpose().lazyProduct(rv);
+    if (weight != 1.0) {
+      local_hessian *= weight;
+      local_gradient *= weight;
+    }
+    for (std::size_t q = 0; q < r.params.size(); ++q) {
+      if (r.block[q] < 0) continue;
+      const Block& b = blocks[r.block[q]];
+      g.segment(b.offset, b.size) += local_gradient.segment(local_offset[q], b.size);
+    }
+    for (int pi = r.pair_begin; pi < r.pair_end; ++pi) {
+      const Pair& pair = pairs[pi];
+      const int rows = blocks[r.block[pair.row_param]].size, cols = blocks[r.block[pair.col_param]].size;
+      const int row0 = local_offset[pair.row_param], col0 = local_offset[pair.col_param];
+      const bool diagonal_block = pair.row_param == pair.col_param;
+      for (int c = 0; c < cols; ++c) {
+        double* column = h.data() + column_offsets[pair.offsets_begin + c];
+        const double* source = local_hessian.data() + (col0 + c) * k_total + row0;  // column-major
+        for (int u = diagonal_block ? c : 0, o = 0; u < rows; ++u, ++o) column[o] += source[u];
+      }
+    }
+  }
+  *cost = total;
+  return std::isfinite(total);
+}
+
+bool ChainSolver::Impl::FixedCost(double* cost, int* failed) {
+  double total = 0.0;
+  for (std::size_t k = 0; k < residuals.size(); ++k) {
+    const Residual& r = residuals[k];
+    if (!r.constant) continue;
+    double* res = residual_values.data() + r.residual_offset;
+    if (!r.cost->Evaluate(r.params.data(), res, nullptr)) {
+      *failed = static_cast<int>(k);
+      return false;
+    }
+    double sq = 0.0;
+    for (int i = 0; i < r.cost->num_residuals(); ++i) sq += res[i] * res[i];
+    if (r.loss != nullptr) {
+      double rho[3];
+      r.loss->Evaluate(sq, rho);
+      sq = rho[0];
+    }
+    if (!std::isfinite(sq)) {
+      *failed = static_cast<int>(k);
+      return false;
+    }
+    total += 0.5 * sq;
+  }
+  *cost = total;
+  return true;
+}
+
+std::string ChainSolver::Impl::Describe(const ChainSolverOptions& options, int k) const {
+  return options.describe ? options.describe(residuals[k].id) : DefaultDescription(k, residuals[k]);
+}
+
+std::string ChainSolver::Impl::DescribeUnknown(int unknown) const {
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    if (unknown >= blocks[b].offset && unknown < blocks[b].offset + blocks[b].size) {
+      return "parameter block " + std::to_string(b) + " (component " + std::to_string(unknown - blocks[b].offset) + ")";
+    }
+  }
+  return "unknown " + std::to_string(unknown);
+}
+
+bool ChainSolver::Impl::Factorize(const std::vector<double>& h, double lambda) {
+  std::copy(h.begin(), h.end(), H.valuePtr());
+  if (lambda > 0.0) {
+    for (int j = 0; j < n; ++j) {
+      double& d = H.valuePtr()[diagonal[j]];
+      d += lambda * std::clamp(d, kMinDiagonal, kMaxDiagonal);
+    }
+  }
+  if (!analyzed) {
+    llt.analyzePattern(H);
+    analyzed = true;
+  }
+  llt.factorize(H);
+  return llt.info() == Eigen::Success;
+}
+
+ChainSolver::ChainSolver(ceres::Problem& problem) : impl_(std::make_unique<Impl>(problem)) {}
+ChainSolver::~ChainSolver() = default;
+ChainSolver::ChainSolver(ChainSolver&&) noexcept = default;
+ChainSolver& ChainSolver::operator=(ChainSolver&&) noexcept = default;
+
+ChainSolverSummary ChainSolver::Solve(const ChainSolverOptions& options) {
+  Impl& s = *impl_;
+  const auto start = Clock::now();
+  ChainSolverSummary summary;
+  summary.unknowns = s.n;
+  summary.hessian_nonzeros = static_cast<long>(s.values.size());
+  s.evaluated_at_current = false;
+  if (s.n == 0) {
+    summary.converged = true;
+    summary.termination = "no variable parameter blocks";
+    return summary;
+  }
+  Eigen::VectorXd x, x_trial, step;
+  s.Gather(x);
+  double cost = 0.0;
+  int failed = -1;
+  auto timed_evaluate = [&](std::vector<double>& h, Eigen::VectorXd& g, double* c) {
+    const auto t = Clock::now();
+    const bool ok = s.Evaluate(h, g, c, &failed);
+    summary.evaluate_s += SecondsSince(t);
+    return ok;
+  };
+  double fixed_cost = 0.0;
+  if (!s.FixedCost(&fixed_cost, &failed)) {
+    throw GraphError("solver: " + s.Describe(options, failed) + " (on constant blocks) fails to evaluate or is not finite");
+  }
+  if (!timed_evaluate(s.values, s.gradient, &cost)) {
+    throw GraphError("solver: " + s.Describe(options, failed) +
+                     " fails to evaluate or is not finite at the starting point");
+  }
+  s.x_evaluated = x;
+  s.evaluated_at_current = true;
+  summary.initial_cost = summary.final_cost = cost + fixed_cost;
+  double lambda = options.initial_damping, nu = 2.0;
+  auto gradient_converged = [&](const Eigen::VectorXd& at, const Eigen::VectorXd& g) {
+    Eigen::VectorXd projected = at - g;
+    s.Project(projected);
+    return (at - projected).lpNorm<Eigen::Infinity>() <= options.gradient_tolerance;
+  };
+  if (gradient_converged(x, s.gradient)) {
+    summary.converged = true;
+    summary.termination = "gradient tolerance";
+  }
+  int failed_factorizations = 0;
+  while (!summary.converged && summary.iterations < options.max_iterations) {
+    ++summary.iterations;
+    const auto t_linear = Clock::now();
+    const bool factorized = s.Factorize(s.values, lambda);
+    if (factorized) step = -s.llt.solve(s.gradient);
+    summary.linear_solve_s += SecondsSince(t_linear);
+    if (summary.factor_flops == 0.0 && factorized) {
+      const auto& L = s.llt.matrixL().nestedExpression();
+      double flops = 0.0;
+      for (int j = 0; j < s.n; ++j) {
+        const double c = L.outerIndexPtr()[j + 1] - L.outerIndexPtr()[j] - 1;
+        flops += c * c + 3.0 * c;
+      }
+      summary.factor_nonzeros = L.nonZeros();
+      summary.factor_flops = flops + 4.0 * static_cast<double>(L.nonZeros());
+    }
+    if (!factorized || !step.allFinite()) {
+      // Not positive definite under this damping: more damping (a gradient-descent-like step).
+      ++summary.unsuccessful_steps;
+      lambda *= nu;
+      nu *= 2.0;
+      if (++failed_factorizations > 30) {
+        int worst = 0;
+        for (int j = 0; j < s.n; ++j) {
+          if (!(s.values[s.diagonal[j]] > s.values[s.diagonal[worst]])) worst = j;
+        }
+        throw GraphError("solver: J^T J is singular or not finite under any damping; smallest diagonal at " +
+                         s.DescribeUnknown(worst));
+      }
+      continue;
+    }
+    failed_factorizations = 0;
+    x_trial = x + step;
+    s.Project(x_trial);
+    step = x_trial - x;
+    if (step.norm() <= options.parameter_tolerance * (x.norm() + options.parameter_tolerance)) {
+      summary.converged = true;
+      summary.termination = "parameter tolerance";
+      --summary.iterations;
+      break;
+    }
+    const Eigen::VectorXd h_step = s.H_undamped_times(step);
+    const double model_decrease = -(s.gradient.dot(step) + 0.5 * step.dot(h_step));
+    s.Scatter(x_trial);
+    double trial_cost = 0.0;
+    const bool evaluated = timed_evaluate(s.trial_values, s.trial_gradient, &trial_cost);
+    const double rho = evaluated && model_decrease > 0.0 ? (cost - trial_cost) / model_decrease : -1.0;
+    if (options.log_iterations) {
+      std::fprintf(stderr, "chain solver %3d: cost %.6e -> %.6e, model decrease %.3e, rho %.3f, lambda %.2e, |dx| %.3e\n",
+                   summary.iterations, cost, evaluated ? trial_cost : NAN, model_decrease, rho, lambda, step.norm());
+    }
+    if (evaluated && rho > kMinRelativeDecrease) {
+      ++summary.successful_steps;
+      const double change = cost - trial_cost;
+      x.swap(x_trial);
+      std::swap(s.values, s.trial_values);
+      s.gradient.swap(s.trial_gradient);
+      cost = trial_cost;
+      s.x_evaluated = x;
+      lambda *= std::max(1.0 / 3.0, 1.0 - std::pow(2.0 * rho - 1.0, 3));
+      lambda = std::max(lambda, 1e-16);
+      nu = 2.0;
+      if (change <= options.function_tolerance * cost) {
+        summary.converged = true;
+        summary.termination = "function tolerance";
+      } else if (gradient_converged(x, s.gradient)) {
+        summary.converged = true;
+        summary.termination = "gradient tolerance";
+      }
+    } else {
+      ++summary.unsuccessful_steps;
+      s.Scatter(x);
+      lambda *= nu;
+      nu *= 2.0;
+    }
+  }
+  if (!summary.converged) summary.termination = "iteration limit (" + std::to_string(options.max_iterations) + ")";
+  s.Scatter(x);
+  summary.final_cost = cost + fixed_cost;
+  summary.total_s = SecondsSince(start);
+  return summary;
+}
+
+Eigen::VectorXd ChainSolver::Impl::H_undamped_times(const Eigen::VectorXd& v) {
+  std::copy(values.begin(), values.end(), H.valuePtr());
+  return H.selfadjointView<Eigen::Lower>() * v;
+}
+
+bool ChainSolver::Impl::FactorizeAtCurrentValues(std::string* error) {
+  Eigen::VectorXd x;
+  Gather(x);
+  if (!evaluated_at_current || x_evaluated.size() != x.size() || x_evaluated != x) {
+    double cost = 0.0;
+    int failed = -1;
+    if (!Evaluate(values, gradient, &cost, &failed)) {
+      *error = "a residual block failed to evaluate or gave a non-finite residual or Jacobian (" +
+               DefaultDescription(failed, residuals[failed]) + ")";
+      return false;
+    }
+    x_evaluated = x;
+    evaluated_at_current = true;
+  }
+  if (!Factorize(values, 0.0)) {
+    *error = "the information matrix J^T J is not positive definite (an unobservable direction: gauge "
+             "freedom or too few factors)";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace pushgraph::graph

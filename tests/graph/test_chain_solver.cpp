@@ -1,0 +1,332 @@
+// The chain solver (chain_solver.h) against Ceres: the same minimum on random chains with robust
+// losses and bounds, on simulated pushes (a square and the non-convex notched block) and on a real
+// MIT recording; its covariances against SparseMarginals on the problem; its errors (a factor
+// that is not finite is named with its step); the incremental mode at every step.
+#include <pushgraph/graph/chain_solver.h>
+#include <pushgraph/graph/estimator.h>
+#include <pushgraph/graph/factors.h>
+#include <pushgraph/graph/incremental.h>
+#include <pushgraph/graph/marginals.h>
+#include <pushgraph/io/mit_push.h>
+#include <pushgraph/limit_surface/simulator.h>
+
+#include "graph/push_generator.h"
+
+#include <ceres/ceres.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace pushgraph::graph {
+namespace {
+
+using geometry::Pose2;
+using geometry::Vec2;
+
+// A chain of n poses with pose measurements (every third under a Huber loss, some outliers),
+// constant-velocity factors, and a bounded 2-vector shared by every tenth pose through a
+// measurement whose unconstrained optimum lies outside its box.
+struct RandomChain {
+  std::vector<std::array<double, 3>> poses;
+  std::array<double, 2> shared{0.0, 0.0};
+  ceres::Problem problem;
+
+  RandomChain(int n, unsigned seed, double bound = 0.1) : poses(n) {
+    std::mt19937_64 rng(seed);
+    std::normal_distribution<double> noise(0.0, 1.0);
+    for (int i = 0; i < n; ++i) {
+      const double t = 0.01 * i;
+      const Pose2 truth{0.05 * t, 0.02 * std::sin(3 * t), 0.3 * t};
+      Pose2 measured{truth.x + 0.005 * noise(rng), truth.y + 0.005 * noise(rng), truth.theta + 0.05 * noise(rng)};
+      if (i % 17 == 5) measured.x += 0.05;  // outlier
+      poses[i] = {measured.x + 0.01 * noise(rng), measured.y, measured.theta};
+      ceres::LossFunction* loss = i % 3 == 0 ? new ceres::HuberLoss(1.0) : nullptr;
+      problem.AddResidualBlock(new PoseMeasurementFactor(measured, 0.005, 0.05), loss, poses[i].data());
+      if (i >= 2) {
+        problem.AddResidualBlock(new ConstantVelocityFactor(0.01, 0.01, 0.05, 0.5), nullptr, poses[i - 2].data(),
+                                 poses[i - 1].data(), poses[i].data());
+      }
+    }
+    problem.AddResidualBlock(new VectorMeasurementFactor(Vec2(0.3, -0.2), 0.1), nullptr, shared.data());
+    for (int i = 0; i < n; i += 10) {
+      // |x_i - shared| small: the shared block is tied to many poses (the border of the band).
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<Tie, 2, 3, 2>(new Tie), nullptr, poses[i].data(),
+                               shared.data());
+    }
+    problem.SetParameterLowerBound(shared.data(), 0, -bound);
+    problem.SetParameterUpperBound(shared.data(), 0, bound);
+  }
+  struct Tie {
+    template <class T>
+    bool operator()(const T* x, const T* s, T* r) const {
+      r[0] = (x[0] * 0.0 + s[0] - T(0.05)) / T(0.5);
+      r[1] = (x[1] * 0.0 + s[1] + T(0.05)) / T(0.5);
+      return true;
+    }
+  };
+};
+
+ceres::Solver::Options TightCeres() {
+  ceres::Solver::Options o;
+  o.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  o.max_num_iterations = 500;
+  o.function_tolerance = 1e-14;
+  o.gradient_tolerance = 1e-14;
+  o.parameter_tolerance = 1e-14;
+  return o;
+}
+
+ChainSolverOptions TightChain() {
+  ChainSolverOptions o;
+  o.max_iterations = 500;
+  o.function_tolerance = 1e-14;
+  o.gradient_tolerance = 1e-14;
+  o.parameter_tolerance = 1e-14;
+  return o;
+}
+
+TEST(ChainSolver, SameMinimumAsCeresOnRandomChainsWithLosses) {
+  for (unsigned seed : {1u, 2u, 3u}) {
+    RandomChain a(300, seed, 1.0), b(300, seed, 1.0);  // bounds inactive at the minimum
+    ceres::Solver::Summary ceres_summary;
+    ceres::Solve(TightCeres(), &a.problem, &ceres_summary);
+    ChainSolver solver(b.problem);
+    const ChainSolverSummary s = solver.Solve(TightChain());
+    EXPECT_TRUE(s.converged) << s.termination;
+    EXPECT_NEAR(s.final_cost, ceres_summary.final_cost, 1e-9 * ceres_summary.final_cost);
+    double worst = 0.0;
+    for (std::size_t i = 0; i < a.poses.size(); ++i) {
+      for (int k = 0; k < 3; ++k) worst = std::max(worst, std::abs(a.poses[i][k] - b.poses[i][k]));
+    }
+    EXPECT_LT(worst, 1e-6) << "seed " << seed;
+    EXPECT_NEAR(b.shared[0], a.shared[0], 1e-6);
+    EXPECT_NEAR(b.shared[1], a.shared[1], 1e-6);
+    // The factor is banded: a 300-pose chain with a shared border has no dense fill.
+    EXPECT_LT(s.factor_nonzeros, 20L * s.unknowns);
+  }
+}
+
+// With the bound active: the Karush-Kuhn-Tucker conditions (zero gradient in every free
+// unknown, the bounded one on its bound with the gradient pushing outward). Ceres' projected
+// LM stops early on this problem (its cost 2e-8 relative above ours, gradient not zero), so
+// the oracle is the optimality conditions, not Ceres.
+TEST(ChainSolver, ActiveBoundsMeetTheOptimalityConditions) {
+  for (unsigned seed : {1u, 2u, 3u}) {
+    RandomChain b(300, seed, 0.1);
+    ChainSolver solver(b.problem);
+    const ChainSolverSummary s = solver.Solve(TightChain());
+    EXPECT_TRUE(s.converged) << s.termination;
+    EXPECT_DOUBLE_EQ(b.shared[0], 0.1);
+    ceres::Problem::EvaluateOptions eval;
+    for (auto& p : b.poses) eval.parameter_blocks.push_back(p.data());
+    eval.parameter_blocks.push_back(b.shared.data());
+    std::vector<double> gradient;
+    double cost = 0.0;
+    b.problem.Evaluate(eval, &cost, nullptr, &gradient, nullptr);
+    const std::size_t bounded = gradient.size() - 2;
+    EXPECT_LT(gradient[bounded], -1.0);  // the cost would fall beyond the upper bound
+    double worst = 0.0;
+    for (std::size_t i = 0; i < gradient.size(); ++i) {
+      if (i != bounded) worst = std::max(worst, std::abs(gradient[i]));
+    }
+    // The information is about 4e4 per unknown (sigma 5 mm): 1e-3 is a step below 1e-7.
+    EXPECT_LT(worst, 1e-3) << "seed " << seed;
+  }
+}
+
+TEST(ChainSolver, CovariancesFromItsFactorEqualSparseMarginalsOnTheProblem) {
+  RandomChain chain(200, 7);
+  ChainSolver solver(chain.problem);
+  solver.Solve(TightChain());
+  SparseMarginals from_solver, from_problem;
+  ASSERT_TRUE(from_solver.Compute(solver)) << from_solver.error();
+  ASSERT_TRUE(from_problem.Compute(chain.problem)) << from_problem.error();
+  for (std::size_t i = 0; i < chain.poses.size(); i += 7) {
+    const Eigen::MatrixXd a = from_solver.Covariance(chain.poses[i].data());
+    const Eigen::MatrixXd b = from_problem.Covariance(chain.poses[i].data());
+    EXPECT_LT((a - b).norm(), 1e-9 * b.norm()) << "pose " << i;
+  }
+  const Eigen::MatrixXd a = from_solver.Covariance(chain.shared.data());
+  const Eigen::MatrixXd b = from_problem.Covariance(chain.shared.data());
+  EXPECT_LT((a - b).norm(), 1e-9 * b.norm());
+}
+
+// r = (x - 2) while x <= 1; fails to evaluate (or gives NaN) beyond: the solver must reject
+// those steps and stop at the edge, never return NaN.
+class FailsBeyondOne : public ceres::SizedCostFunction<1, 1> {
+ public:
+  explicit FailsBeyondOne(bool nan) : nan_(nan) {}
+  bool Evaluate(double const* const* p, double* r, double** J) const override {
+    if (p[0][0] > 1.0) {
+      if (!nan_) return false;
+      r[0] = NAN;
+      if (J && J[0]) J[0][0] = 1.0;
+      return true;
+    }
+    r[0] = p[0][0] - 2.0;
+    if (J && J[0]) J[0][0] = 1.0;
+    return true;
+  }
+
+ private:
+  bool nan_;
+};
+
+TEST(ChainSolver, StepsThatFailToEvaluateAreRejected) {
+  for (bool nan : {false, true}) {
+    double x = 0.0;
+    ceres::Problem problem;
+    problem.AddResidualBlock(new FailsBeyondOne(nan), nullptr, &x);
+    ChainSolver solver(problem);
+    const ChainSolverSummary s = solver.Solve();
+    EXPECT_TRUE(std::isfinite(x));
+    EXPECT_LE(x, 1.0);
+    EXPECT_GT(x, 0.9);
+    EXPECT_GT(s.unsuccessful_steps, 0);
+  }
+}
+
+TEST(ChainSolver, NamesTheFactorThatIsNotFiniteAtTheStart) {
+  double x = 3.0, y[2] = {0.0, 0.0};
+  ceres::Problem problem;
+  problem.AddResidualBlock(new VectorMeasurementFactor(Vec2(0, 0), 1.0), nullptr, y);
+  const ceres::ResidualBlockId bad = problem.AddResidualBlock(new FailsBeyondOne(true), nullptr, &x);
+  ChainSolverOptions options;
+  options.describe = [&](ceres::ResidualBlockId id) { return id == bad ? std::string("the D factor at step 17") : "other"; };
+  ChainSolver solver(problem);
+  try {
+    solver.Solve(options);
+    FAIL() << "no error";
+  } catch (const GraphError& e) {
+    EXPECT_NE(std::string(e.what()).find("the D factor at step 17"), std::string::npos) << e.what();
+  }
+  // Without a description: its position in the problem.
+  ChainSolver plain(problem);
+  try {
+    plain.Solve();
+    FAIL() << "no error";
+  } catch (const GraphError& e) {
+    EXPECT_NE(std::string(e.what()).find("residual block 1"), std::string::npos) << e.what();
+  }
+}
+
+// Both solvers to tight tolerances on the same trajectory: the same minimum.
+void ExpectSameMinimum(const limit_surface::Trajectory& traj, Model model, const char* what, double state_tolerance = 1e-6) {
+  EstimatorConfig cfg;
+  if (traj.measurement_sigmas) cfg = ApplyMeasurementSigmas(cfg, *traj.measurement_sigmas);
+  cfg.function_tolerance = 1e-12;
+  cfg.max_iterations = 500;
+  cfg.diagnostics = false;
+  cfg.solver = EstimatorConfig::Solver::kCeres;
+  const EstimationResult ceres_result = Estimate(traj, model, Mode::kBatch, cfg);
+  cfg.solver = EstimatorConfig::Solver::kChain;
+  const EstimationResult chain_result = Estimate(traj, model, Mode::kBatch, cfg);
+  EXPECT_EQ(chain_result.solver.name, "chain");
+  EXPECT_EQ(ceres_result.solver.name, "ceres");
+  EXPECT_NEAR(chain_result.solver.final_cost, ceres_result.solver.final_cost, 1e-6 * ceres_result.solver.final_cost) << what;
+  ASSERT_EQ(chain_result.states.size(), ceres_result.states.size());
+  double worst = 0.0;
+  for (std::size_t i = 0; i < chain_result.states.size(); ++i) {
+    const StateEstimate& a = chain_result.states[i];
+    const StateEstimate& b = ceres_result.states[i];
+    worst = std::max({worst, (a.object_pose.vector() - b.object_pose.vector()).cwiseAbs().maxCoeff(),
+                      (a.finger_pose.vector() - b.finger_pose.vector()).cwiseAbs().maxCoeff()});
+    if (a.contact && b.contact) worst = std::max(worst, (*a.contact - *b.contact).cwiseAbs().maxCoeff());
+    ASSERT_EQ(a.object_pose_cov.has_value(), b.object_pose_cov.has_value());
+    if (a.object_pose_cov) {
+      EXPECT_LT((*a.object_pose_cov - *b.object_pose_cov).norm(), 1e-3 * b.object_pose_cov->norm()) << what << " step " << i;
+    }
+  }
+  EXPECT_LT(worst, state_tolerance) << what;
+  std::printf("[same minimum] %s: %zu steps, cost %.9g (chain) %.9g (ceres), worst state difference %.2g, "
+              "iterations %d / %d\n",
+              what, chain_result.states.size(), chain_result.solver.final_cost, ceres_result.solver.final_cost, worst,
+              chain_result.solver.iterations, ceres_result.solver.iterations);
+}
+
+TEST(ChainSolver, SameMinimumAsCeresOnSimulatedPushes) {
+  testing::PushSpec spec;
+  spec.contact_offset = 0.02;
+  spec.duration = 1.5;
+  const limit_surface::Trajectory square = testing::GeneratePush(spec);
+  ExpectSameMinimum(square, Model::kQs, "square, QS");
+  ExpectSameMinimum(square, Model::kCp, "square, CP");
+  limit_surface::PushPlan plan;
+  plan.object = geometry::LoadShapeJson(std::string(PUSHGRAPH_SOURCE_DIR) + "/data/shapes/notched_block.json");
+  plan.finger = geometry::Shape::Disk(0.005);
+  plan.mass = 0.5;
+  plan.mu_surface = 0.3;
+  plan.mu_contact = 0.4;
+  plan.waypoints = limit_surface::StraightPushPath(plan, 0.7, 0.01, 0.005, 0.05);
+  plan.noise = limit_surface::DefaultNoise(limit_surface::NoiseKind::kGaussian);
+  plan.seed = 3;
+  ExpectSameMinimum(limit_surface::Simulate(plan).trajectory, Model::kQs, "notched block, QS");
+}
+
+TEST(ChainSolver, SameMinimumAsCeresOnARealRecording) {
+  const std::string file = std::string(PUSHGRAPH_SHARED_DIR) +
+                           "/data/mit-push/abs/rect1/motion_surface=abs_shape=rect1_a=0_v=75_i=2.000_s=0.800_t=0.349.h5";
+  if (!std::filesystem::exists(file)) GTEST_SKIP() << "no MIT data at " << file;
+  io::MitReadOptions options;
+  options.trim_to_contact = true;
+  const io::MitRecording rec = io::ReadMitPush(file, options);
+  limit_surface::ObjectDescription object;
+  object.shape = geometry::Shape::Box(0.09, 0.09);
+  object.mass = 0.8374;
+  object.mu_surface = 0.35;
+  limit_surface::FingerDescription finger;
+  finger.shape = geometry::Shape::Disk(0.00235);
+  finger.mu_contact = 0.2;
+  limit_surface::Trajectory t = io::MitToTrajectory(rec, object, finger);
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> n(0.0, 1.0);
+  for (auto& s : t.measured.object_pose) s.pose = {s.pose.x + 0.005 * n(rng), s.pose.y + 0.005 * n(rng), s.pose.theta + 0.05 * n(rng)};
+  for (auto& s : t.measured.finger_pose) s.pose = {s.pose.x + 0.005 * n(rng), s.pose.y + 0.005 * n(rng), s.pose.theta};
+  ExpectSameMinimum(t, Model::kQs, "MIT rect1, QS");
+}
+
+TEST(ChainSolver, IncrementalAtEveryStepMatchesBatch) {
+  testing::PushSpec spec;
+  spec.contact_offset = 0.02;
+  spec.duration = 0.8;
+  const limit_surface::Trajectory traj = testing::GeneratePush(spec);
+  EstimatorConfig cfg;
+  cfg.diagnostics = false;
+  cfg.solver = EstimatorConfig::Solver::kChain;
+  const EstimationResult batch = Estimate(traj, Model::kQs, Mode::kBatch, cfg);
+  cfg.incremental_update_every_steps = 1;
+  const EstimationResult inc = Estimate(traj, Model::kQs, Mode::kIncremental, cfg);
+  EXPECT_EQ(inc.solver.updates, static_cast<int>(inc.states.size()) - 2);  // the first takes three steps
+  EXPECT_EQ(inc.solver.update_times_s.size(), static_cast<std::size_t>(inc.solver.updates));
+  for (double t : inc.solver.update_times_s) EXPECT_GT(t, 0.0);
+  EXPECT_EQ(inc.solver.name, "chain");
+  const double b = batch.metrics.at("object_position_rms"), i = inc.metrics.at("object_position_rms");
+  std::printf("[incremental every step] %d updates, object RMS %.3f mm (batch %.3f)\n", inc.solver.updates, 1e3 * i, 1e3 * b);
+  EXPECT_LT(i, 1.05 * b);
+  EXPECT_LT(i, 0.3 * inc.metrics.at("measured_object_position_rms"));
+}
+
+TEST(ChainSolver, ConfigSelectsTheSolverAndTheUpdateRate) {
+  EXPECT_EQ(ParseEstimatorConfig(R"({"solver": "ceres"})").solver, EstimatorConfig::Solver::kCeres);
+  EXPECT_EQ(ParseEstimatorConfig(R"({"solver": "chain"})").solver, EstimatorConfig::Solver::kChain);
+  EXPECT_EQ(EstimatorConfig{}.solver, EstimatorConfig::Solver::kCeres);
+  EXPECT_EQ(ParseEstimatorConfig(R"({"incremental_update_every_steps": 1})").incremental_update_every_steps, 1);
+  for (const char* bad : {R"({"solver": "gtsam"})", R"({"incremental_update_every_steps": 0})",
+                          R"({"incremental_update_every_steps": 1.5})"}) {
+    try {
+      ParseEstimatorConfig(bad, "cfg.json");
+      ADD_FAILURE() << bad;
+    } catch (const GraphError& e) {
+      EXPECT_NE(std::string(e.what()).find("cfg.json"), std::string::npos) << e.what();
+    }
+  }
+}
+
+}  // namespace
+}  // namespace pushgraph::graph
