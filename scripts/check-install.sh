@@ -17,4 +17,10 @@ cmake -S examples -B "$work/examples" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUIL
   -DPUSHGRAPH_EXAMPLES_DATA_DIR="$prefix/share/pushgraph" >/dev/null
 cmake --build "$work/examples" -j"$(nproc)" >/dev/null
 ctest --test-dir "$work/examples" --output-on-failure
-echo "check-install: consumer project, examples and installed tool passed (prefix $prefix)"
+# The Python package, when built: importable from the installed prefix alone.
+if grep -q '^PUSHGRAPH_BUILD_PYTHON:BOOL=ON' "$build/CMakeCache.txt"; then
+  site=$(ls -d "$prefix"/lib/python3*/*-packages | head -1)
+  py=$(grep "^Python3_EXECUTABLE" "$build/CMakeCache.txt" | cut -d= -f2)
+  (cd "$work" && PYTHONPATH="$site" "$py" -c "import pushgraph; assert pushgraph.Shape.box(1, 2).area == 2")
+fi
+echo "check-install: consumer project, examples, installed tool and Python package passed (prefix $prefix)"

@@ -9,6 +9,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libtinyobjloader-dev nlohmann-json3-dev libcli11-dev libhdf5-dev
   python3  # scripts/check-docs.py, run by the docs tests
+  python3-dev pybind11-dev python3-numpy python3-pytest  # the Python package (python/) and its tests
+  python3-matplotlib  # examples/python/estimate_push.py draws with it
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -1,0 +1,81 @@
+#pragma once
+// Internal to the Python module: NumPy array checks and conversions shared by the binding files.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <pushgraph/geometry/pose.h>
+#include <pushgraph/geometry/shape.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace pushgraph::python {
+
+namespace py = pybind11;
+
+/// Any array-like of numbers, converted to C-contiguous float64 (a copy only when needed).
+using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+/// `a` as an (N, columns) array; a single row (columns,) is taken as N = 1 when `allow_row`.
+/// Throws ValueError naming `what` and the shape it got.
+inline Array Rows(const py::handle& object, int columns, const char* what, bool allow_row = true) {
+  Array a = Array::ensure(object);
+  if (!a) throw py::type_error(std::string(what) + ": expected an array of numbers");
+  if (allow_row && a.ndim() == 1 && a.shape(0) == columns) a = a.reshape({py::ssize_t(1), py::ssize_t(columns)});
+  if (a.ndim() != 2 || a.shape(1) != columns) {
+    std::string shape = "(";
+    for (py::ssize_t i = 0; i < a.ndim(); ++i) shape += (i ? ", " : "") + std::to_string(a.shape(i));
+    shape += a.ndim() == 1 ? ",)" : ")";
+    throw py::value_error(std::string(what) + ": expected an array of shape (N, " + std::to_string(columns) +
+                          "), got " + shape);
+  }
+  return a;
+}
+
+/// The first row of `a` (N, k) with a non-finite entry, or -1.
+inline py::ssize_t FirstNonFinite(const Array& a) {
+  const double* d = a.data();
+  const py::ssize_t n = a.shape(0), k = a.shape(1);
+  for (py::ssize_t i = 0; i < n; ++i) {
+    for (py::ssize_t j = 0; j < k; ++j) {
+      if (!std::isfinite(d[i * k + j])) return i;
+    }
+  }
+  return -1;
+}
+
+inline void CheckFinite(const Array& a, const char* what) {
+  const py::ssize_t bad = FirstNonFinite(a);
+  if (bad >= 0) throw py::value_error(std::string(what) + "[" + std::to_string(bad) + "] is not finite");
+}
+
+/// A new float64 array of the given shape (uninitialized).
+inline py::array_t<double> NewArray(std::vector<py::ssize_t> shape) { return py::array_t<double>(shape); }
+
+/// (x, y, theta) from a row.
+inline geometry::Pose2 PoseRow(const double* r) { return {r[0], r[1], r[2]}; }
+
+/// One pose from a sequence of three numbers (ValueError otherwise).
+inline geometry::Pose2 ToPose(const py::handle& object, const char* what) {
+  const Array a = Rows(object, 3, what);
+  if (a.shape(0) != 1) throw py::value_error(std::string(what) + ": expected one pose (x, y, theta)");
+  CheckFinite(a, what);
+  return PoseRow(a.data());
+}
+
+inline geometry::Vec2 ToVec2(const py::handle& object, const char* what) {
+  const Array a = Rows(object, 2, what);
+  if (a.shape(0) != 1) throw py::value_error(std::string(what) + ": expected one point (x, y)");
+  CheckFinite(a, what);
+  return {a.data()[0], a.data()[1]};
+}
+
+void RegisterGeometry(py::module_& m);
+void RegisterLimitSurface(py::module_& m);
+void RegisterTrajectory(py::module_& m);
+void RegisterEstimation(py::module_& m);
+void RegisterEvaluation(py::module_& m);
+
+}  // namespace pushgraph::python

@@ -1,0 +1,166 @@
+// Estimation from Python: batch and incremental over a trajectory dict, and the online
+// estimator fed sample by sample; results as dicts of NumPy arrays.
+#include "common.h"
+#include "convert.h"
+
+#include <pushgraph/graph/config.h>
+#include <pushgraph/graph/estimator.h>
+#include <pushgraph/graph/incremental.h>
+
+#include <cmath>
+#include <limits>
+
+namespace pushgraph::python {
+namespace {
+
+using namespace graph;
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+EstimatorConfig ConfigFor(const limit_surface::Trajectory& t, const std::string& config_json, bool apply_sigmas) {
+  EstimatorConfig cfg;
+  if (apply_sigmas && t.measurement_sigmas) cfg = ApplyMeasurementSigmas(cfg, *t.measurement_sigmas);
+  if (!config_json.empty()) cfg = ParseEstimatorConfig(config_json, "config", cfg);
+  return cfg;
+}
+
+struct Online {
+  limit_surface::Trajectory setup;
+  std::unique_ptr<OnlineEstimator> estimator;
+};
+
+py::dict StateToDict(const StateEstimate& s) {
+  py::dict d;
+  d["t"] = s.t;
+  d["object_pose"] = py::make_tuple(s.object_pose.x, s.object_pose.y, s.object_pose.theta);
+  d["finger_pose"] = py::make_tuple(s.finger_pose.x, s.finger_pose.y, s.finger_pose.theta);
+  d["contact"] = s.contact ? py::object(py::make_tuple(s.contact->x(), s.contact->y())) : py::none();
+  d["force"] = s.force ? py::object(py::make_tuple(s.force->x(), s.force->y())) : py::none();
+  return d;
+}
+
+}  // namespace
+
+py::dict ResultToDict(const EstimationResult& r) {
+  const py::ssize_t n = static_cast<py::ssize_t>(r.states.size());
+  py::array_t<double> t = NewArray({n}), object = NewArray({n, 3}), finger = NewArray({n, 3}), contact = NewArray({n, 2}),
+                      force = NewArray({n, 2}), object_cov = NewArray({n, 3, 3}), finger_cov = NewArray({n, 3, 3}),
+                      contact_cov = NewArray({n, 2, 2}), force_cov = NewArray({n, 2, 2});
+  auto put_cov = [](double* out, const auto& cov, int dim) {
+    for (int k = 0; k < dim * dim; ++k) out[k] = cov ? (*cov)(k / dim, k % dim) : kNaN;
+  };
+  for (py::ssize_t i = 0; i < n; ++i) {
+    const StateEstimate& s = r.states[i];
+    t.mutable_data()[i] = s.t;
+    for (int k = 0; k < 3; ++k) {
+      object.mutable_data()[3 * i + k] = s.object_pose.vector()[k];
+      finger.mutable_data()[3 * i + k] = s.finger_pose.vector()[k];
+    }
+    for (int k = 0; k < 2; ++k) {
+      contact.mutable_data()[2 * i + k] = s.contact ? (*s.contact)[k] : kNaN;
+      force.mutable_data()[2 * i + k] = s.force ? (*s.force)[k] : kNaN;
+    }
+    put_cov(object_cov.mutable_data() + 9 * i, s.object_pose_cov, 3);
+    put_cov(finger_cov.mutable_data() + 9 * i, s.finger_pose_cov, 3);
+    put_cov(contact_cov.mutable_data() + 4 * i, s.contact_cov, 2);
+    put_cov(force_cov.mutable_data() + 4 * i, s.force_cov, 2);
+  }
+  py::dict d;
+  d["model"] = ModelName(r.model);
+  d["mode"] = ModeName(r.mode);
+  d["t"] = t;
+  d["object_pose"] = object;
+  d["finger_pose"] = finger;
+  d["contact"] = contact;
+  d["force"] = force;
+  d["object_pose_cov"] = object_cov;
+  d["finger_pose_cov"] = finger_cov;
+  d["contact_cov"] = contact_cov;
+  d["force_cov"] = force_cov;
+  py::dict metrics;
+  for (const auto& [k, v] : r.metrics) metrics[k.c_str()] = v;
+  d["metrics"] = metrics;
+  py::list warnings;
+  for (const std::string& w : r.warnings) warnings.append(w);
+  d["warnings"] = warnings;
+  py::dict solver;
+  solver["name"] = r.solver.name;
+  solver["iterations"] = r.solver.iterations;
+  solver["time_s"] = r.solver.time_s;
+  solver["final_cost"] = r.solver.final_cost;
+  solver["updates"] = r.solver.updates;
+  solver["mean_update_time_s"] = r.solver.mean_update_time_s;
+  solver["max_update_time_s"] = r.solver.max_update_time_s;
+  solver["covariance"] = r.solver.covariance_status;
+  py::array_t<double> updates = NewArray({static_cast<py::ssize_t>(r.solver.update_times_s.size())});
+  std::copy(r.solver.update_times_s.begin(), r.solver.update_times_s.end(), updates.mutable_data());
+  solver["update_times_s"] = updates;
+  d["solver"] = solver;
+  d["c"] = r.c ? py::object(py::float_(*r.c)) : py::none();
+  d["c_sigma"] = r.c_sigma ? py::object(py::float_(*r.c_sigma)) : py::none();
+  d["mu"] = r.mu ? py::object(py::float_(*r.mu)) : py::none();
+  d["mu_sigma"] = r.mu_sigma ? py::object(py::float_(*r.mu_sigma)) : py::none();
+  return d;
+}
+
+void RegisterEstimation(py::module_& m) {
+  using namespace pybind11::literals;
+  m.def(
+      "_estimate",
+      [](const py::handle& trajectory, const std::string& model, const std::string& mode, const std::string& config_json,
+         bool apply_sigmas) {
+        const limit_surface::Trajectory t = TrajectoryFromDict(trajectory);
+        const Model parsed_model = ParseModel(model);
+        const Mode parsed_mode = ParseMode(mode);
+        const EstimatorConfig cfg = ConfigFor(t, config_json, apply_sigmas);
+        EstimationResult r;
+        {
+          py::gil_scoped_release release;
+          r = Estimate(t, parsed_model, parsed_mode, cfg);
+        }
+        return ResultToDict(r);
+      },
+      "trajectory"_a, "model"_a, "mode"_a, "config_json"_a, "apply_measurement_sigmas"_a);
+  m.def("_check_config", [](const std::string& config_json) { ValidateConfig(ParseEstimatorConfig(config_json, "config")); });
+
+  py::class_<Online>(m, "_OnlineEstimator")
+      .def(py::init([](const py::handle& setup, const std::string& model, const std::string& config_json, bool contact_point,
+                       bool force, double max_latency) {
+             auto o = std::make_unique<Online>();
+             o->setup = TrajectoryFromDict(setup);
+             OnlineStreams streams;
+             streams.contact_point = contact_point;
+             streams.force = force;
+             streams.max_latency = max_latency;
+             o->estimator = std::make_unique<OnlineEstimator>(o->setup, ParseModel(model),
+                                                              ConfigFor(o->setup, config_json, true), streams);
+             return o;
+           }),
+           "setup"_a, "model"_a, "config_json"_a, "contact_point"_a, "force"_a, "max_latency"_a)
+      .def("add_object_pose",
+           [](Online& o, double t, const py::handle& pose) { return o.estimator->AddObjectPose(t, ToPose(pose, "pose")); })
+      .def("add_finger_pose",
+           [](Online& o, double t, const py::handle& pose) { return o.estimator->AddFingerPose(t, ToPose(pose, "pose")); })
+      .def("add_contact_point",
+           [](Online& o, double t, const py::handle& p) { return o.estimator->AddContactPoint(t, ToVec2(p, "point")); })
+      .def("add_force", [](Online& o, double t, const py::handle& f) { return o.estimator->AddForce(t, ToVec2(f, "force")); })
+      .def("update_due", [](const Online& o) { return o.estimator->UpdateDue(); })
+      .def("update",
+           [](Online& o, double until) {
+             py::gil_scoped_release release;
+             return o.estimator->Update(until);
+           },
+           "until"_a = INFINITY)
+      .def("latest_state", [](const Online& o) { return StateToDict(o.estimator->LatestState()); })
+      .def_property_readonly("dropped_late_samples", [](const Online& o) { return o.estimator->DroppedLateSamples(); })
+      .def("finish", [](Online& o) {
+        EstimationResult r;
+        {
+          py::gil_scoped_release release;
+          r = o.estimator->Finish();
+        }
+        return ResultToDict(r);
+      });
+}
+
+}  // namespace pushgraph::python

@@ -1,0 +1,155 @@
+# Trajectories, the simulator, the MIT reader and estimation from Python: the numbers the C++
+# tool writes to the last bit, the incremental and online modes, errors, threads.
+import concurrent.futures
+import json
+import subprocess
+
+import numpy as np
+import pytest
+
+import pushgraph as pg
+from conftest import SHARED_DIR, TOOL
+
+
+def test_trajectory_round_trip(push, tmp_path):
+    m = push["measured"]
+    assert m["object_pose"]["pose"].shape[1] == 3 and m["force"]["force"].shape[1] == 2
+    assert push["ground_truth"] is not None and push["measurement_sigmas"]["object_trans"] > 0
+    path = tmp_path / "push.json"
+    pg.save_trajectory(push, str(path))
+    again = pg.load_trajectory(str(path))
+    for stream, value in [("object_pose", "pose"), ("finger_pose", "pose"), ("contact_point", "point"), ("force", "force")]:
+        np.testing.assert_array_equal(again["measured"][stream]["t"], m[stream]["t"])
+        np.testing.assert_array_equal(again["measured"][stream][value], m[stream][value])
+    assert again["object"]["mass"] == push["object"]["mass"]
+
+
+def test_bad_trajectory_dicts_name_the_key(push):
+    bad = dict(push)
+    bad["measured"] = dict(push["measured"], camera={"t": [0.0], "pose": [[0, 0, 0]]})
+    with pytest.raises(ValueError, match="unknown stream 'camera'"):
+        pg.estimate(bad)
+    bad = dict(push)
+    bad["measured"] = dict(push["measured"], force={"t": [0.0, 1.0], "force": [[0, 0]]})
+    with pytest.raises(ValueError, match="2 times and 1 values"):
+        pg.estimate(bad)
+    with pytest.raises(TypeError, match="expected a dict"):
+        pg.estimate([1, 2, 3])
+    with pytest.raises(pg.GraphError, match="model"):
+        pg.estimate(push, model="qs2")
+    with pytest.raises(pg.GraphError, match="sigma_typo"):
+        pg.estimate(push, config={"sigma_typo": 1})
+    unsorted = dict(push)
+    unsorted["measured"] = dict(push["measured"])
+    op = push["measured"]["object_pose"]
+    unsorted["measured"]["object_pose"] = {"t": op["t"][::-1].copy(), "pose": op["pose"][::-1].copy()}
+    with pytest.raises(pg.GraphError):
+        pg.estimate(unsorted)
+
+
+def test_batch_estimate_equals_the_command_line_tool_to_the_last_bit(push, tmp_path):
+    path = tmp_path / "push.json"
+    pg.save_trajectory(push, str(path))
+    out = tmp_path / "result.json"
+    subprocess.run([TOOL, "estimate", str(path), "--model", "qs", "-o", str(out)], check=True, capture_output=True)
+    cli = json.load(open(out))
+    r = pg.estimate(pg.load_trajectory(str(path)), model="qs")
+    assert len(cli["states"]) == len(r["t"])
+    for i, s in enumerate(cli["states"]):
+        assert s["t"] == r["t"][i]
+        assert s["object_pose"] == list(r["object_pose"][i])
+        assert s["finger_pose"] == list(r["finger_pose"][i])
+        if "force" in s:
+            assert s["force"] == list(r["force"][i])
+        else:
+            assert np.all(np.isnan(r["force"][i]))
+        assert np.array(s["object_pose_cov"]).tolist() == r["object_pose_cov"][i].tolist()
+    assert cli["metrics"]["object_position_rms"] == r["metrics"]["object_position_rms"]
+    assert r["metrics"]["object_position_rms"] < 0.3 * r["metrics"]["measured_object_position_rms"]
+
+
+def test_incremental_every_step_and_the_chain_solver(push):
+    batch = pg.estimate(push, model="qs")
+    inc = pg.estimate(push, model="qs", mode="incremental",
+                      config={"solver": "chain", "incremental_update_every_steps": 5, "covariance": False})
+    assert inc["solver"]["name"] == "chain"
+    assert inc["solver"]["update_times_s"].shape == (inc["solver"]["updates"],)
+    assert np.all(inc["solver"]["update_times_s"] > 0)
+    assert np.all(np.isnan(inc["object_pose_cov"]))
+    assert inc["metrics"]["object_position_rms"] < 1.1 * batch["metrics"]["object_position_rms"]
+
+
+def test_online_estimator_fed_from_python(push):
+    setup = {"object": push["object"], "finger": push["finger"],
+             "measured": {}, "measurement_sigmas": push["measurement_sigmas"]}
+    online = pg.OnlineEstimator(setup, model="qs", contact_point=True, force=True)
+    m = push["measured"]
+    samples = []
+    for stream, value in [("object_pose", "pose"), ("finger_pose", "pose"), ("contact_point", "point"), ("force", "force")]:
+        for t, v in zip(m[stream]["t"], m[stream][value]):
+            samples.append((t, stream, v))
+    samples.sort(key=lambda s: s[0])
+    add = {"object_pose": online.add_object_pose, "finger_pose": online.add_finger_pose,
+           "contact_point": online.add_contact_point, "force": online.add_force}
+    updates = 0
+    for k, (t, stream, v) in enumerate(samples):
+        add[stream](t, v)
+        if (k + 1 == len(samples) or samples[k + 1][0] > t) and online.update_due():
+            online.update()
+            updates += 1
+            state = online.latest_state()
+            assert len(state["object_pose"]) == 3
+    with pytest.raises(pg.GraphError, match="not after the previous"):
+        online.add_force(0.0, (1.0, 0.0))
+    result = online.finish()
+    assert updates > 3 and len(result["t"]) > 100
+    assert np.all(np.isfinite(result["object_pose"]))
+
+
+def test_estimates_run_in_threads(push):
+    config = {"covariance": False, "diagnostics": False}
+    alone = [pg.estimate(push, model=m, config=config) for m in ("cp", "qs")]
+    with concurrent.futures.ThreadPoolExecutor(2) as pool:
+        together = list(pool.map(lambda m: pg.estimate(push, model=m, config=config), ("cp", "qs")))
+    for a, b in zip(alone, together):
+        np.testing.assert_array_equal(a["object_pose"], b["object_pose"])
+
+
+def test_mit_recording():
+    f = SHARED_DIR / "data/mit-push/abs/rect1/motion_surface=abs_shape=rect1_a=0_v=75_i=2.000_s=0.800_t=0.349.h5"
+    if not f.exists():
+        pytest.skip("no MIT data at %s" % f)
+    t, fault = pg.read_mit_push(str(f), pg.Shape.box(0.09, 0.09), 0.8374, 0.35, pg.Shape.disk(0.00235))
+    assert "frozen" in fault and t["measured"]["force"]["t"].size == 0
+    assert t["measured"]["object_pose"]["t"].size > 100
+    with pytest.raises(pg.IoError, match="nothing.h5"):
+        pg.read_mit_push(str(f.parent / "nothing.h5"), pg.Shape.box(0.09, 0.09), 0.8, 0.35, pg.Shape.disk(0.00235))
+
+
+def test_evaluation_tables_as_dicts(notched_block):
+    out = pg.evaluate(simulate=2, sim_object=notched_block, sim_finger=pg.Shape.disk(0.005), protocols="table1,runtime",
+                      jobs=2)
+    ids = [t["id"] for t in out["tables"]]
+    assert "table1" in ids and "runtime" in ids
+    table1 = next(t for t in out["tables"] if t["id"] == "table1")
+    assert table1["rows"] and set(table1["columns"]) == set(table1["rows"][0])
+    assert len(out["trajectories"]) == 2 and all(t["error"] == "" for t in out["trajectories"])
+    with pytest.raises(pg.GraphError, match="nothing to evaluate"):
+        pg.evaluate()
+    with pytest.raises(ValueError, match="sim_object"):
+        pg.evaluate(simulate=1)
+
+
+def test_simulate_along_waypoints_with_chosen_noise_and_an_occlusion(notched_block):
+    finger = pg.Shape.disk(0.005)
+    t = pg.simulate(notched_block, finger, waypoints=[[-0.08, 0.0], [0.0, 0.0]], sigmas={"object": (0.005, 0.05), "force": 0.5},
+                    occlusions=[[0.5, 0.9]], seed=2)
+    assert t["measurement_sigmas"]["object_trans"] == 0.005 and t["measurement_sigmas"]["force"] == 0.5
+    ts = t["measured"]["object_pose"]["t"]
+    assert not np.any((ts > 0.5) & (ts < 0.9)) and np.any(ts > 0.9)
+    with pytest.raises(ValueError, match="unknown key 'camera'"):
+        pg.simulate(notched_block, finger, sigmas={"camera": 0.1})
+    with pytest.raises(ValueError, match="noise is 'none'"):
+        pg.simulate(notched_block, finger, noise="none", sigmas={"force": 0.1})
+    with pytest.raises(pg.LimitSurfaceError):
+        pg.simulate(notched_block, finger, waypoints=[[0.0, 0.0]])
