@@ -16,6 +16,7 @@
 #include <CGAL/Polygon_2_algorithms.h>
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 namespace pushgraph::geometry {
@@ -194,6 +195,12 @@ CoreResult QueryCore(const Shape::Impl& m, const Vec2& p, EdgeIndex::Span span) 
 void CheckPoint(const Vec2& p) {
   if (!std::isfinite(p.x()) || !std::isfinite(p.y()))
     throw GeometryError("query point is not finite: (" + std::to_string(p.x()) + ", " + std::to_string(p.y()) + ")");
+  if (std::abs(p.x()) > kMaxQueryCoordinate || std::abs(p.y()) > kMaxQueryCoordinate) {
+    char text[160];
+    std::snprintf(text, sizeof text, "query point (%g, %g) is outside the supported range +-%g (docs/geometry.md, Limits)",
+                  p.x(), p.y(), kMaxQueryCoordinate);
+    throw GeometryError(text);
+  }
 }
 
 PointQuery Finish(const Shape::Impl& m, const Vec2& p, const CoreResult& core) {

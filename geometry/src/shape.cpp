@@ -61,6 +61,12 @@ void CleanRing(Ring* ring, int polygon, int ring_index) {
   for (std::size_t i = 0; i < ring->size(); ++i) {
     if (!std::isfinite((*ring)[i].x()) || !std::isfinite((*ring)[i].y()))
       Fail("coordinate is not finite", polygon, ring_index, static_cast<int>(i));
+    if (std::abs((*ring)[i].x()) > kMaxCoordinate || std::abs((*ring)[i].y()) > kMaxCoordinate) {
+      std::ostringstream text;
+      text << "coordinate (" << (*ring)[i].x() << ", " << (*ring)[i].y() << ") is outside the supported range +-"
+           << kMaxCoordinate << " (scale the shape: docs/geometry.md, Limits)";
+      Fail(text.str(), polygon, ring_index, static_cast<int>(i));
+    }
   }
   if (ring->size() >= 4 && ring->front() == ring->back()) ring->pop_back();
   const int n = static_cast<int>(ring->size());
@@ -287,6 +293,11 @@ Shape Shape::FromPolygons(std::vector<Polygon> polygons, double radius) {
     text << radius;  // 6 significant digits: -1e-09, not -0.000000
     throw GeometryError("rounding radius must be finite and >= 0, got " + text.str());
   }
+  if (radius > kMaxCoordinate) {
+    std::ostringstream text;
+    text << "rounding radius " << radius << " is above the supported " << kMaxCoordinate << " (docs/geometry.md, Limits)";
+    throw GeometryError(text.str());
+  }
   if (polygons.empty()) throw GeometryError("shape has no polygons");
   const int np = static_cast<int>(polygons.size());
   for (int p = 0; p < np; ++p) {
@@ -313,6 +324,13 @@ Shape Shape::FromPolygons(std::vector<Polygon> polygons, double radius) {
     }
   }
   std::shared_ptr<Impl> impl = BuildShapeImpl(std::move(polygons), radius);
+  const Vec2 size = impl->core_bounds.max - impl->core_bounds.min;
+  if (std::max(size.x(), size.y()) + 2.0 * radius < kMinExtent) {
+    std::ostringstream text;
+    text << "the shape is " << std::max(size.x(), size.y()) + 2.0 * radius << " across, below the supported "
+         << kMinExtent << " (scale the shape: docs/geometry.md, Limits)";
+    throw GeometryError(text.str());
+  }
   if (!impl->degenerate_core) {
     CheckEdgeIntersections(*impl);
     CheckNesting(impl->polygons);
@@ -368,6 +386,7 @@ const Ring& Shape::ring(int polygon, int ring) const {
 }
 Shape Shape::WithRadius(double radius) const {
   if (!std::isfinite(radius) || radius < 0.0) throw GeometryError("rounding radius must be finite and >= 0");
+  if (radius > kMaxCoordinate) throw GeometryError("rounding radius is above the supported 1e6 (docs/geometry.md, Limits)");
   if (impl().degenerate_core && radius <= 0.0) throw GeometryError("a point or segment core needs a rounding radius > 0");
   // The same core (validated when this shape was made) and its index; only the radius differs.
   auto copy = std::make_shared<Impl>(impl());

@@ -1,6 +1,7 @@
 // Shape JSON reading and writing (nlohmann_json), with errors that name the file, the JSON
 // path and the polygon/vertex.
 //   {"polygons": [{"outer": [[x, y], ...], "holes": [[[x, y], ...], ...]}, ...], "radius": 0.0}
+#include <pushgraph/geometry/json_check.h>
 #include <pushgraph/geometry/shape.h>
 #include <pushgraph/geometry/file_output.h>
 
@@ -49,6 +50,7 @@ Shape ParseShapeJson(const std::string& text, const std::string& source) {
   } catch (const json::exception& e) {  // syntax errors, and numbers that overflow a double
     Fail(source, std::string("malformed JSON: ") + e.what());
   }
+  if (const std::string dup = FindDuplicateJsonKey(text); !dup.empty()) Fail(source, dup);
   if (!doc.is_object()) Fail(source, "top level must be an object with \"polygons\"");
   CheckKeys(doc, {"polygons", "radius"}, source, "the shape");
   if (!doc.contains("polygons")) Fail(source, "missing field \"polygons\"");

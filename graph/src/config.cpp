@@ -1,4 +1,6 @@
 #include <pushgraph/graph/config.h>
+
+#include <pushgraph/geometry/json_check.h>
 #include <pushgraph/graph/factors.h>
 
 #include <nlohmann/json.hpp>
@@ -127,6 +129,7 @@ EstimatorConfig ParseEstimatorConfig(const std::string& json_text, const std::st
   } catch (const Json::parse_error& e) {
     throw GraphError(source + ": invalid JSON: " + e.what());
   }
+  if (const std::string dup = geometry::FindDuplicateJsonKey(json_text); !dup.empty()) throw GraphError(source + ": " + dup);
   if (!j.is_object()) throw GraphError(source + ": the configuration must be a JSON object");
   EstimatorConfig cfg = base;
   const auto doubles = DoubleFields();

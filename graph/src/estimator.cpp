@@ -109,6 +109,20 @@ void CheckFinite(bool ok, const std::string& stream, std::size_t i) {
   if (!ok) throw GraphError("trajectory: non-finite value in streams." + stream + "[" + std::to_string(i) + "]");
 }
 
+// The supported magnitudes (docs/estimation.md): times within +-1e11 s (epoch time stamps, about
+// 1.7e9 s, are fine; their double resolution is 2.4e-7 s), positions within the geometry's
+// +-1e6 m, forces within +-1e9 N (a plausible but wrong force is a sensor fault, DropForceSpikes;
+// one beyond this is a corrupt value).
+constexpr double kMaxTime = 1e11, kMaxForce = 1e9;
+void CheckRange(double t, double value, double bound, const std::string& stream, std::size_t i, const char* what) {
+  if (std::abs(t) > kMaxTime || std::abs(value) > bound) {
+    std::ostringstream text;
+    text << "trajectory: streams." << stream << "[" << i << "] is out of the supported range (t = " << t << " s, "
+         << what << " " << value << "; |t| <= 1e11 s, positions within 1e6 m, forces within 1e9 N)";
+    throw GraphError(text.str());
+  }
+}
+
 template <class Sample>
 void CheckSorted(const std::vector<Sample>& s, const std::string& stream) {
   for (std::size_t i = 1; i < s.size(); ++i) {
@@ -171,6 +185,21 @@ void ValidateTrajectory(const limit_surface::Trajectory& traj) {
   }
   for (std::size_t i = 0; i < m.force.size(); ++i) {
     CheckFinite(std::isfinite(m.force[i].t) && m.force[i].force.allFinite(), "force", i);
+  }
+  for (std::size_t i = 0; i < m.object_pose.size(); ++i) {
+    const auto& s = m.object_pose[i];
+    CheckRange(s.t, std::max(std::abs(s.pose.x), std::abs(s.pose.y)), geometry::kMaxCoordinate, "object_pose", i, "|position|");
+  }
+  for (std::size_t i = 0; i < m.finger_pose.size(); ++i) {
+    const auto& s = m.finger_pose[i];
+    CheckRange(s.t, std::max(std::abs(s.pose.x), std::abs(s.pose.y)), geometry::kMaxCoordinate, "finger_pose", i, "|position|");
+  }
+  for (std::size_t i = 0; i < m.contact_point.size(); ++i) {
+    const auto& s = m.contact_point[i];
+    CheckRange(s.t, s.point.cwiseAbs().maxCoeff(), geometry::kMaxCoordinate, "contact_point", i, "|position|");
+  }
+  for (std::size_t i = 0; i < m.force.size(); ++i) {
+    CheckRange(m.force[i].t, m.force[i].force.cwiseAbs().maxCoeff(), kMaxForce, "force", i, "|force|");
   }
   CheckSorted(m.object_pose, "object_pose");
   CheckSorted(m.finger_pose, "finger_pose");
@@ -1062,9 +1091,67 @@ std::string TransformText(const ShapeTransform& t) {
 
 }  // namespace
 
+namespace {
+
+// A force no sensor of this push could have measured (a corrupted byte: 1e5 N in a 1 kg push):
+// above 50 times the larger of the stream's 95th percentile and the object's friction limit
+// mu m g (when known), and above 1 N. Quasi-static pushing needs at most about f_max; the
+// factor leaves room for impacts and miscalibration. Returns the trajectory without them, or
+// nullopt when there is none; `note` says how many, the first one and the bound.
+std::optional<limit_surface::Trajectory> DropForceSpikes(const limit_surface::Trajectory& traj, std::string* note) {
+  const auto& forces = traj.measured.force;
+  if (forces.size() < 8) return std::nullopt;
+  std::vector<double> magnitude(forces.size());
+  for (std::size_t i = 0; i < forces.size(); ++i) magnitude[i] = forces[i].force.norm();
+  std::vector<double> sorted = magnitude;
+  const std::size_t k = sorted.size() * 95 / 100;
+  std::nth_element(sorted.begin(), sorted.begin() + k, sorted.end());
+  double scale = sorted[k];
+  if (traj.object.mass > 0.0 && traj.object.mu_surface > 0.0) {
+    scale = std::max(scale, traj.object.mu_surface * traj.object.mass * limit_surface::kStandardGravity);
+  }
+  const double bound = std::max(50.0 * scale, 1.0);
+  limit_surface::Trajectory out = traj;
+  out.measured.force.clear();
+  int dropped = 0;
+  std::size_t first = 0;
+  for (std::size_t i = 0; i < forces.size(); ++i) {
+    if (magnitude[i] > bound) {
+      if (dropped++ == 0) first = i;
+      continue;
+    }
+    out.measured.force.push_back(forces[i]);
+  }
+  if (dropped == 0) return std::nullopt;
+  char text[320];
+  std::snprintf(text, sizeof text,
+                "%d force sample%s left out as sensor faults (|f| above %.3g N, 50 times the stream's 95th percentile "
+                "or the object's friction limit); the first: force[%zu] at t = %.9g s, |f| = %.3g N",
+                dropped, dropped == 1 ? "" : "s", bound, first, forces[first].t, magnitude[first]);
+  *note = text;
+  return out;
+}
+
+EstimationResult EstimateValidated(const limit_surface::Trajectory& trajectory, Model model, Mode mode,
+                                   const EstimatorConfig& config);
+
+}  // namespace
+
 EstimationResult Estimate(const limit_surface::Trajectory& trajectory, Model model, Mode mode,
                           const EstimatorConfig& config) {
   ValidateConfig(config);
+  internal::ValidateTrajectory(trajectory);
+  std::string note;
+  const std::optional<limit_surface::Trajectory> repaired = DropForceSpikes(trajectory, &note);
+  EstimationResult r = EstimateValidated(repaired ? *repaired : trajectory, model, mode, config);
+  if (repaired) r.warnings.insert(r.warnings.begin(), note);
+  return r;
+}
+
+namespace {
+
+EstimationResult EstimateValidated(const limit_surface::Trajectory& trajectory, Model model, Mode mode,
+                                   const EstimatorConfig& config) {
   using Align = EstimatorConfig::AlignShape;
   // The shape against the recording: the check, then registration where asked or needed.
   ShapeAlignment alignment;
@@ -1256,5 +1343,7 @@ EstimationResult Estimate(const limit_surface::Trajectory& trajectory, Model mod
   result.warnings.insert(result.warnings.begin(), warnings.begin(), warnings.end());
   return result;
 }
+
+}  // namespace
 
 }  // namespace pushgraph::graph

@@ -1,5 +1,7 @@
 // MIT pushing dataset reader (HDF5 C++ API and JSON), with the repairs listed in mit_push.h.
 #include <pushgraph/io/mit_push.h>
+
+#include <pushgraph/geometry/json_check.h>
 #include <pushgraph/io/trajectory_json.h>  // IoError
 
 #include <H5Cpp.h>
@@ -8,7 +10,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <cstdint>
 #include <fstream>
+#include <iterator>
 #include <set>
 #include <sstream>
 
@@ -23,12 +29,40 @@ constexpr const char* kDatasets[3] = {"tip_pose", "object_pose", "ft_wrench"};
 
 std::vector<Row>& Slot(Raw& raw, int k) { return k == 0 ? raw.tip : k == 1 ? raw.object : raw.ft; }
 
+// Why HDF5 could not open a file, from its first bytes: not HDF5 at all, or truncated (the
+// superblock's end-of-file address beyond the file's size; HDF5 File Format Specification,
+// Sec. II.A, superblock versions 0-3, 8-byte offsets), else corrupt.
+std::string DescribeUnopenableH5(const std::string& path) {
+  if (!std::filesystem::exists(path)) return "no such file";
+  std::ifstream in(path, std::ios::binary);
+  unsigned char head[48] = {};
+  in.read(reinterpret_cast<char*>(head), sizeof head);
+  const std::streamsize got = in.gcount();
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (got < 8 || std::memcmp(head, "\x89HDF\r\n\x1a\n", 8) != 0) {
+    return "not an HDF5 file (no HDF5 signature in its first bytes; " + std::to_string(ec ? 0 : size) + " bytes)";
+  }
+  const int version = head[8];
+  const int eof_at = version == 0 ? 40 : version == 1 ? 44 : (version == 2 || version == 3) ? 28 : -1;
+  if (eof_at > 0 && got >= eof_at + 8 && !ec) {
+    std::uint64_t eof = 0;
+    for (int b = 7; b >= 0; --b) eof = (eof << 8) | head[eof_at + b];
+    if (eof > size) {
+      return "truncated: the file has " + std::to_string(size) + " bytes, its HDF5 superblock says " + std::to_string(eof);
+    }
+  }
+  return "a corrupt HDF5 file (" + std::to_string(ec ? 0 : size) + " bytes; the HDF5 library cannot open it)";
+}
+
 Raw ReadH5(const std::string& path) {
   H5::Exception::dontPrint();
   Raw raw;
+  std::string stage = "open";
   try {
     H5::H5File file(path, H5F_ACC_RDONLY);
     for (int k = 0; k < 3; ++k) {
+      stage = std::string("dataset '") + kDatasets[k] + "'";
       if (!file.nameExists(kDatasets[k])) throw IoError(path + ": missing dataset '" + std::string(kDatasets[k]) + "'");
       H5::DataSet ds = file.openDataSet(kDatasets[k]);
       H5::DataSpace space = ds.getSpace();
@@ -46,7 +80,8 @@ Raw ReadH5(const std::string& path) {
       if (dims[0] > 0) ds.read(rows.data(), H5::PredType::NATIVE_DOUBLE);
     }
   } catch (const H5::Exception& e) {
-    throw IoError(path + ": cannot read HDF5: " + e.getDetailMsg());
+    if (stage == "open") throw IoError(path + ": cannot open: " + DescribeUnopenableH5(path));
+    throw IoError(path + ": cannot read " + stage + " (truncated or corrupt HDF5: " + e.getDetailMsg() + ")");
   }
   return raw;
 }
@@ -54,12 +89,14 @@ Raw ReadH5(const std::string& path) {
 Raw ReadJson(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw IoError(path + ": cannot open file");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   nlohmann::json doc;
   try {
-    doc = nlohmann::json::parse(in);
+    doc = nlohmann::json::parse(text);
   } catch (const nlohmann::json::exception& e) {
     throw IoError(path + ": malformed JSON: " + e.what());
   }
+  if (const std::string dup = geometry::FindDuplicateJsonKey(text); !dup.empty()) throw IoError(path + ": " + dup);
   if (!doc.is_object()) throw IoError(path + ": top level must be an object with tip_pose, object_pose, ft_wrench");
   Raw raw;
   for (int k = 0; k < 3; ++k) {

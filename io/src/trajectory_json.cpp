@@ -3,6 +3,8 @@
 #include <pushgraph/geometry/file_output.h>
 #include <pushgraph/io/trajectory_json.h>
 
+#include <pushgraph/geometry/json_check.h>
+
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -186,6 +188,7 @@ Trajectory ParseTrajectoryJson(const std::string& text, const std::string& sourc
   } catch (const json::exception& e) {
     throw IoError(source + ": malformed JSON: " + e.what());
   }
+  if (const std::string dup = geometry::FindDuplicateJsonKey(text); !dup.empty()) throw IoError(source + ": " + dup);
   const Reader r(source, notes);
   r.CheckKeys(doc, {"format", "object", "finger", "streams", "ground_truth", "measurement_sigmas"}, "top level");
   const json& format = r.Require(doc, "format", "top level");

@@ -159,6 +159,10 @@ struct PushingModel::Impl {
       throw LimitSurfaceError("PushingSpec.mu_surface must be > 0 (got " + std::to_string(s.mu_surface) + ")");
     if (s.mu_contact < 0.0)
       throw LimitSurfaceError("PushingSpec.mu_contact must be >= 0 (got " + std::to_string(s.mu_contact) + ")");
+    if (s.mass > kMaxMass) throw LimitSurfaceError("PushingSpec.mass " + std::to_string(s.mass) + " kg is above the supported 1e6 kg");
+    if (s.mu_surface > kMaxFriction || s.mu_contact > kMaxFriction)
+      throw LimitSurfaceError("PushingSpec.mu_surface and mu_contact must be at most 10 (got " + std::to_string(s.mu_surface) +
+                              ", " + std::to_string(s.mu_contact) + ")");
     if (!(s.contact_tolerance > 0.0)) throw LimitSurfaceError("PushingSpec.contact_tolerance must be > 0");
     if (!(s.penetration_tolerance > 0.0)) throw LimitSurfaceError("PushingSpec.penetration_tolerance must be > 0");
     return MakeQuerier(s);

@@ -27,6 +27,9 @@ void CheckScalars(const SupportSpec& spec) {
   if (!std::isfinite(spec.mu) || spec.mu <= 0.0) Fail("mu must be finite and > 0, got " + Number(spec.mu));
   if (!std::isfinite(spec.gravity) || spec.gravity <= 0.0)
     Fail("gravity must be finite and > 0, got " + Number(spec.gravity));
+  if (spec.mass > kMaxMass) Fail("mass " + Number(spec.mass) + " kg is above the supported " + Number(kMaxMass) + " kg");
+  if (spec.mu > kMaxFriction) Fail("mu " + Number(spec.mu) + " is above the supported " + Number(kMaxFriction));
+  if (spec.gravity > kMaxGravity) Fail("gravity " + Number(spec.gravity) + " is above the supported " + Number(kMaxGravity));
   if (!(spec.relative_tolerance >= 1e-15 && spec.relative_tolerance <= 1e-2))
     Fail("relative_tolerance must lie in [1e-15, 1e-2]");
   if (spec.region.empty()) Fail("the region is an empty shape");

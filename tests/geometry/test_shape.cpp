@@ -50,6 +50,34 @@ Ring Square(double x0, double y0, double side) {
 // ---------------------------------------------------------------------------------------------
 // Normalization and accessors.
 
+// Beyond the documented magnitudes squared distances overflow or underflow: a side of 1e300 gave
+// distance 0 and normal (0, 0), a side of 1e-300 a non-unit normal. Refused, saying which limit.
+TEST(ShapeConstruction, MagnitudesOutsideTheSupportedRangeAreRefused) {
+  auto message = [](const std::function<void()>& f) {
+    try {
+      f();
+    } catch (const GeometryError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message([] { Shape::Box(1e300, 1e300); }).find("outside the supported range"), std::string::npos);
+  EXPECT_NE(message([] { Shape::Box(1e-300, 1e-300); }).find("below the supported"), std::string::npos);
+  EXPECT_NE(message([] { Shape::Disk(1e300); }).find("above the supported"), std::string::npos);
+  EXPECT_NE(message([] { Shape::Box(1.0, 1.0).WithRadius(1e9); }).find("above the supported"), std::string::npos);
+  const Shape unit = Shape::Box(1.0, 1.0);
+  EXPECT_NE(message([&] { QueryPoint(unit, Vec2(1e300, 0.0)); }).find("outside the supported range"), std::string::npos);
+  // The largest and smallest supported shapes still answer exactly, with unit normals.
+  const Shape big = Shape::Box(2e6, 2e6);
+  const PointQuery q = QueryPoint(big, Vec2(2e6, 0.5e6));
+  EXPECT_EQ(q.signed_distance, 1e6);
+  EXPECT_EQ(q.normal, Vec2(1.0, 0.0));
+  const Shape tiny = Shape::Box(2e-9, 2e-9);
+  const PointQuery t = QueryPoint(tiny, Vec2(3e-9, 1e-9));
+  EXPECT_NEAR(t.signed_distance, 2e-9, 1e-24);  // 3e-9 - 1e-9, rounded once
+  EXPECT_NEAR(t.normal.norm(), 1.0, 1e-15);
+}
+
 TEST(ShapeConstruction, NormalizesOrientation) {
   Ring outer_cw = Square(0, 0, 4);
   std::reverse(outer_cw.begin(), outer_cw.end());

@@ -1,5 +1,6 @@
 // Shape JSON: round trips (bit-exact coordinates) and every malformed-input case, with errors
 // that name the file (or source name) and what is wrong.
+#include <pushgraph/geometry/json_check.h>
 #include <pushgraph/geometry/shape.h>
 
 #include <gtest/gtest.h>
@@ -188,6 +189,20 @@ TEST(ShapeJson, FileErrorsNameTheFile) {
     ADD_FAILURE() << "save into a missing directory succeeded";
   } catch (const std::exception& e) {
     EXPECT_NE(std::string(e.what()).find(unwritable), std::string::npos) << e.what();
+  }
+}
+
+TEST(ShapeJson, DuplicateKeysAreRefusedWithTheirPlace) {
+  EXPECT_EQ(FindDuplicateJsonKey(R"({"a": 1, "b": {"c": [1, {"d": 2, "d": 3}]}})"), "duplicate key \"d\" in /b/c/1");
+  EXPECT_EQ(FindDuplicateJsonKey(R"({"radius": 1, "radius": 2})"), "duplicate key \"radius\" in the top-level object");
+  EXPECT_EQ(FindDuplicateJsonKey(R"({"a": {"x": 1}, "b": {"x": 1}, "c": [{"x": 1}, {"x": 2}]})"), "");
+  EXPECT_EQ(FindDuplicateJsonKey("{not json"), "");
+  try {
+    ParseShapeJson(R"({"polygons": [{"outer": [[0, 0], [1, 0], [0, 1]]}], "radius": 0, "radius": 0.5})", "s.json");
+    ADD_FAILURE() << "accepted";
+  } catch (const GeometryError& e) {
+    EXPECT_NE(std::string(e.what()).find("s.json"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("duplicate key \"radius\""), std::string::npos) << e.what();
   }
 }
 

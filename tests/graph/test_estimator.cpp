@@ -50,6 +50,8 @@ TEST(Estimator, ConfigParsingNamesBadKeys) {
     return std::string("no error");
   };
   EXPECT_NE(message(R"({"sigma_typo": 1})").find("sigma_typo"), std::string::npos);
+  EXPECT_NE(message(R"({"force_sigma": 0.5, "force_sigma": 5})").find("cfg.json: duplicate key \"force_sigma\""),
+            std::string::npos);
   EXPECT_NE(message(R"({"force_sigma": -1})").find("force_sigma"), std::string::npos);
   EXPECT_NE(message(R"({"losses": {"force": {"type": "tukey"}}})").find("tukey"), std::string::npos);
   EXPECT_NE(message(R"({"max_iterations": 2.5})").find("max_iterations"), std::string::npos);
@@ -195,6 +197,26 @@ TEST(Estimator, MeasurementSigmasSetTheMeasurementFactors) {
   EXPECT_THROW(ApplyMeasurementSigmas(EstimatorConfig{}, s), GraphError);
 }
 
+// A corrupted force byte (1e5 N in a 0.8 kg push) is a sensor fault: left out with a warning
+// naming it, so the estimate is the one without it (with it, LM chases the spike).
+TEST(Estimator, ForceSpikesAreLeftOutAsSensorFaults) {
+  limit_surface::Trajectory traj = GeneratePush(OffsetPush(4));
+  EstimatorConfig cfg = ApplyMeasurementSigmas(EstimatorConfig{}, *traj.measurement_sigmas);
+  cfg.covariance = false;
+  cfg.diagnostics = false;
+  const EstimationResult clean = Estimate(traj, Model::kQs, Mode::kBatch, cfg);
+  const std::size_t k = traj.measured.force.size() / 2;
+  traj.measured.force[k].force = Vec2(1e5, -3e4);
+  const EstimationResult r = Estimate(traj, Model::kQs, Mode::kBatch, cfg);
+  ASSERT_FALSE(r.warnings.empty());
+  EXPECT_NE(r.warnings[0].find("1 force sample left out as sensor faults"), std::string::npos) << r.warnings[0];
+  EXPECT_NE(r.warnings[0].find("force[" + std::to_string(k) + "]"), std::string::npos) << r.warnings[0];
+  EXPECT_NEAR(r.metrics.at("object_position_rms"), clean.metrics.at("object_position_rms"),
+              0.05 * clean.metrics.at("object_position_rms"));
+  // Ordinary forces, however large for a light object, stay: nothing left out.
+  for (const std::string& w : clean.warnings) EXPECT_EQ(w.find("sensor fault"), std::string::npos) << w;
+}
+
 TEST(Estimator, BadTrajectoriesGetClearErrors) {
   limit_surface::Trajectory t = GeneratePush(OffsetPush(1, 0.3));
   auto message = [](const limit_surface::Trajectory& tr) {
@@ -230,6 +252,15 @@ TEST(Estimator, BadTrajectoriesGetClearErrors) {
   auto other_clock = t;
   for (auto& f : other_clock.measured.force) f.t += 1e6;
   EXPECT_NE(message(other_clock).find("streams.force starts"), std::string::npos) << message(other_clock);
+  auto far = t;
+  far.measured.contact_point[2].point.x() = 1e300;  // a corrupt value: refused, naming the sample
+  EXPECT_NE(message(far).find("streams.contact_point[2] is out of the supported range"), std::string::npos)
+      << message(far);
+  auto epoch = t;  // epoch time stamps are ordinary
+  for (auto* s : {&epoch.measured.object_pose, &epoch.measured.finger_pose}) for (auto& x : *s) x.t += 1.7e9;
+  for (auto& x : epoch.measured.contact_point) x.t += 1.7e9;
+  for (auto& x : epoch.measured.force) x.t += 1.7e9;
+  EXPECT_EQ(message(epoch), "no error");
   EXPECT_EQ(message(t), "no error");
 }
 

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <iomanip>
 
 namespace {
@@ -176,8 +177,17 @@ TEST_F(MitPush, BrokenFilesGetClearErrors) {
   expect_error(empty, "object_pose");
   const std::string garbage = (dir_ / "garbage.h5").string();
   std::ofstream(garbage) << "not hdf5";
-  expect_error(garbage, "cannot read HDF5");
-  expect_error((dir_ / "absent.h5").string(), "cannot read HDF5");
+  expect_error(garbage, "not an HDF5 file");
+  expect_error((dir_ / "absent.h5").string(), "cannot open: no such file");
+  // A download cut short: named as truncated, with the sizes (it said only "H5Fopen failed").
+  const std::string whole = (dir_ / "whole.h5").string(), cut = (dir_ / "cut.h5").string();
+  WriteH5(whole, sets);
+  {
+    std::ifstream in(whole, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::ofstream(cut, std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  }
+  expect_error(cut, "truncated: the file has");
 }
 
 }  // namespace

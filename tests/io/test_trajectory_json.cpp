@@ -111,6 +111,10 @@ TEST(TrajectoryJson, BadInputNamesFileAndPath) {
   std::string point_finger = Doc("{}");
   point_finger.replace(point_finger.find(", \"radius\": 0.00235"), 19, "");
   ExpectError(point_finger, "finger.shape");
+  // A key given twice would silently keep the last value: refused, with where it is.
+  std::string twice = Doc("{}");
+  twice.replace(twice.find("\"mass\""), 6, "\"mass\": 5, \"mass\"");
+  ExpectError(twice, "duplicate key \"mass\" in /object");
 }
 
 }  // namespace

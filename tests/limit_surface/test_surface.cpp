@@ -35,6 +35,24 @@ Load NoteDiskLoad(double R, double d) {
 // Twist of the centre of pressure whose rotation centre is q (relative to it), omega > 0.
 Twist RotationAbout(const Vec2& q, double omega = 1.0) { return {q.y() * omega, -q.x() * omega, omega}; }
 
+TEST(LimitSurfaceRanges, AbsurdMassesAndFrictionsAreRefused) {
+  SupportSpec spec;
+  spec.region = Shape::Box(0.1, 0.1);
+  spec.mass = 1e308;
+  spec.mu = 0.3;
+  EXPECT_THROW(MakeSupport(spec), LimitSurfaceError);
+  spec.mass = 1.0;
+  spec.mu = 1e5;
+  try {
+    MakeSupport(spec);
+    ADD_FAILURE() << "accepted";
+  } catch (const LimitSurfaceError& e) {
+    EXPECT_NE(std::string(e.what()).find("above the supported 10"), std::string::npos) << e.what();
+  }
+  spec.mu = 10.0;  // the bound itself is fine
+  EXPECT_GT(Summarize(MakeSupport(spec)).f_max, 0.0);
+}
+
 TEST(LimitSurfaceDisk, SpecialValues) {
   const double R = 0.7;
   const Support s = UniformSupport(Shape::Disk(R));  // mu = N = 1

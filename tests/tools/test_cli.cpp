@@ -8,8 +8,10 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 
@@ -226,6 +228,56 @@ TEST_F(CliTest, UnknownSubcommandsSeedsAndIgnoredSigmasAreNamed) {
   r = Exec("simulate -o " + out + " --duration 0.1 --noise none --sigma-force 5");
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("--sigma-force 5 is given with --noise none"), std::string::npos) << r.err;
+  // Physical flags outside the supported ranges: the flag is named (it was "support: mu must be ...").
+  const std::string shape = (fs::path(PUSHGRAPH_SOURCE_DIR) / "data/shapes/notched_block.json").string();
+  r = Exec("limit-surface " + shape + " --mass 1e308 --mu 0.3");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--mass: must be a finite number in (0, 1e6] (kg), got 1e308"), std::string::npos) << r.err;
+  r = Exec("limit-surface " + shape + " --mass 1 --mu -1");
+  EXPECT_NE(r.err.find("--mu: must be a finite number in (0, 10], got -1"), std::string::npos) << r.err;
+  r = Exec("simulate -o " + out + " --mu-surface 20");
+  EXPECT_NE(r.err.find("--mu-surface: must be a finite number in (0, 10], got 20"), std::string::npos) << r.err;
+}
+
+// An evaluation killed mid-run keeps every finished trajectory's row (rows.jsonl.partial, written
+// after each); --resume runs only the rest and ends with the rows of an uninterrupted run.
+TEST_F(CliTest, AKilledEvaluationResumesWithoutRedoingFinishedTrajectories) {
+  const fs::path killed = dir_ / "killed", straight = dir_ / "straight";
+  const std::string args = " evaluate --simulate 6 --protocol table1 -q -j 1 --out ";
+  const std::string start = std::string(PUSHGRAPH_TOOL) + args + killed.string() + " 2>/dev/null & echo $! > " +
+                            (dir_ / "pid").string();
+  ASSERT_EQ(std::system(start.c_str()), 0);
+  const fs::path partial = killed / "rows.jsonl.partial";
+  auto lines = [](const fs::path& p) {
+    std::ifstream in(p);
+    return static_cast<int>(std::count(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>(), '\n'));
+  };
+  for (int wait = 0; wait < 600 && lines(partial) < 3; ++wait) std::system("sleep 0.1");  // header + 2 rows
+  std::ifstream pid_file(dir_ / "pid");
+  int pid = 0;
+  pid_file >> pid;
+  ASSERT_GT(pid, 0);
+  std::system(("kill -9 " + std::to_string(pid) + " 2>/dev/null; sleep 0.2").c_str());
+  ASSERT_GE(lines(partial), 3) << "no rows were written before the kill";
+  EXPECT_FALSE(fs::exists(killed / "rows.jsonl"));
+  ToolRun r = Exec(args + killed.string() + " --resume");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("trajectories already done"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(partial));
+  r = Exec(args + straight.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto text = [](const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  };
+  EXPECT_EQ(text(killed / "table1.csv"), text(straight / "table1.csv"));
+  EXPECT_EQ(lines(killed / "rows.jsonl"), 7);
+  // Another run's folder is not taken for this one's.
+  r = Exec(" evaluate --simulate 5 --protocol table1 -q -j 1 --out " + killed.string() + " --resume");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("was written by a run with other settings"), std::string::npos) << r.err;
 }
 
 }  // namespace

@@ -1,5 +1,7 @@
 #include "cli_common.h"
 
+#include <pushgraph/limit_surface/support.h>
+
 #include <algorithm>
 #include <cctype>
 #include <charconv>
@@ -183,9 +185,9 @@ graph::EstimatorConfig::AlignShape ParseAlignShape(const std::string& value) {
   throw CliError("--align-shape: expected auto, on or off, got " + value);
 }
 
-CLI::Validator FiniteNumber(double min, bool inclusive, const std::string& rule) {
+CLI::Validator FiniteNumber(double min, bool inclusive, const std::string& rule, double max) {
   return CLI::Validator(
-      [min, inclusive, rule](std::string& text) -> std::string {
+      [min, inclusive, rule, max](std::string& text) -> std::string {
         std::size_t used = 0;
         double v = 0.0;
         try {
@@ -194,12 +196,20 @@ CLI::Validator FiniteNumber(double min, bool inclusive, const std::string& rule)
           used = 0;
         }
         const bool number = used > 0 && used == text.size();
-        if (!number || !std::isfinite(v) || (inclusive ? !(v >= min) : !(v > min))) {
+        if (!number || !std::isfinite(v) || (inclusive ? !(v >= min) : !(v > min)) || v > max) {
           return "must be a finite number " + rule + ", got " + text;
         }
         return std::string();
       },
       rule);
+}
+
+CLI::Validator MassValue() {
+  return FiniteNumber(0.0, false, "in (0, 1e6] (kg)", limit_surface::kMaxMass);
+}
+
+CLI::Validator FrictionValue(bool zero_allowed) {
+  return FiniteNumber(0.0, zero_allowed, zero_allowed ? "in [0, 10]" : "in (0, 10]", limit_surface::kMaxFriction);
 }
 
 }  // namespace pushgraph::cli

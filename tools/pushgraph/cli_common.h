@@ -41,7 +41,12 @@ std::vector<double> ParseNumbers(const std::string& text, std::size_t count, con
 /// A CLI11 check for a finite number above `min` (or at least `min` when `inclusive`): rejects
 /// NaN and infinities, which CLI11's range checks let through, with a short message ("must be a
 /// finite number > 0 (kg), got nan"). `rule` is shown in the message and the help.
-CLI::Validator FiniteNumber(double min, bool inclusive, const std::string& rule);
+CLI::Validator FiniteNumber(double min, bool inclusive, const std::string& rule, double max = INFINITY);
+/// The physical flags, with the library's supported ranges (limit_surface/support.h): a mass in
+/// (0, 1e6] kg, a friction coefficient in (0, 10] (`zero_allowed`: [0, 10], finger friction).
+/// The message names the flag: "--mass: must be a finite number in (0, 1e6] (kg), got 1e308".
+CLI::Validator MassValue();
+CLI::Validator FrictionValue(bool zero_allowed);
 /// The --align-shape option of estimate and evaluate: auto, on or off (empty: not given, the
 /// configuration's value stands).
 void AddAlignShapeOption(CLI::App* sub, std::string* value);

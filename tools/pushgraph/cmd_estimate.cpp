@@ -173,12 +173,11 @@ void RegisterEstimate(CLI::App& app) {
   sub->add_option("--config", opts->config, "Estimator configuration JSON (sigmas, losses, window; docs/estimation.md)");
   sub->add_option("--object", opts->object, "Object shape JSON (required for MIT recordings; overrides a trajectory's)");
   sub->add_option("--finger", opts->finger, "Finger (probe) shape JSON (required for MIT recordings)");
-  sub->add_option("--mass", opts->mass, "Object mass in kg (required for MIT recordings)")
-      ->check(FiniteNumber(0.0, false, "> 0 (kg)"));
+  sub->add_option("--mass", opts->mass, "Object mass in kg (required for MIT recordings)")->check(MassValue());
   sub->add_option("--mu", opts->mu, "Object-table friction coefficient (required for MIT recordings)")
-      ->check(FiniteNumber(0.0, true, ">= 0"));
+      ->check(FrictionValue(true));
   sub->add_option("--mu-contact", opts->mu_contact, "Finger-object friction coefficient (MIT recordings)")
-      ->check(FiniteNumber(0.0, true, ">= 0"))
+      ->check(FrictionValue(true))
       ->capture_default_str();
   sub->add_option("--add-noise", opts->add_noise,
                   "Add the paper's noise (5 mm, 0.05 rad, 0.5 N per axis) to the clean streams, which stay as ground truth")

@@ -6,17 +6,21 @@
 // and writes files.
 #include "cli_common.h"
 
+#include <pushgraph/geometry/json_check.h>
 #include <pushgraph/io/evaluation.h>
 #include <pushgraph/io/footprint.h>
 #include <pushgraph/io/trajectory_json.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <iterator>
 #include <memory>
+#include <set>
 #include <sstream>
 
 #include <unistd.h>
@@ -49,6 +53,7 @@ struct EvaluateOptions {
   std::vector<std::string> merge;
   bool quiet = false;
   bool allow_failures = false;
+  bool resume = false;
   std::string align_shape;  // empty: the estimator configuration's (default auto)
 };
 
@@ -81,12 +86,14 @@ geometry::Shape ConfigShape(const nlohmann::json& j, const fs::path& base, const
 void LoadEvaluationConfig(const std::string& path, io::EvaluationOptions* options) {
   std::ifstream in(path);
   if (!in) throw CliError("--config " + path + ": cannot open file");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   nlohmann::json j;
   try {
-    j = nlohmann::json::parse(in);
+    j = nlohmann::json::parse(text);
   } catch (const nlohmann::json::exception& e) {
     throw CliError("--config " + path + ": malformed JSON: " + e.what());
   }
+  if (const std::string dup = geometry::FindDuplicateJsonKey(text); !dup.empty()) throw CliError("--config " + path + ": " + dup);
   if (!j.is_object()) throw CliError("--config " + path + ": expected a JSON object");
   const fs::path base = fs::path(path).parent_path();
   try {
@@ -224,28 +231,64 @@ void RunEvaluate(const EvaluateOptions& o) {
   const std::vector<io::EvaluationItem> items = io::ShardItems(all, shard, shards);
   const std::string settings = options.SettingsJson();
 
-  std::cerr << "evaluate: " << items.size() << " of " << all.size() << " trajectories";
-  if (shards > 1) std::cerr << " (shard " << shard << "/" << shards << ")";
-  std::cerr << ", protocols " << o.protocols << "\n";
-  Progress progress(o.quiet);
-  const std::vector<io::EvaluationRow> rows =
-      io::RunEvaluation(items, options, o.jobs, [&](int done, int total, int failed, const io::EvaluationRow& row) {
-        progress.Update(done, total, failed, row);
-      });
-  int failed = 0;
-  for (const io::EvaluationRow& r : rows) failed += r.error.empty() ? 0 : 1;
-
   std::error_code ec;
   fs::create_directories(o.out, ec);
   if (ec) throw CliError("--out " + o.out + ": cannot create folder (" + ec.message() + ")");
-  io::RowsHeader header{shard, shards, static_cast<int>(all.size()), settings};
+  const io::RowsHeader header{shard, shards, static_cast<int>(all.size()), settings};
+  const std::string rows_path =
+      (fs::path(o.out) / (shards > 1 ? "rows-" + std::to_string(shard) + "-of-" + std::to_string(shards) + ".jsonl"
+                                     : std::string("rows.jsonl"))).string();
+  // Every finished trajectory's row is in this file at once (rewritten atomically after each):
+  // a killed run loses nothing, and --resume skips what it holds.
+  const std::string partial_path = rows_path + ".partial";
+  std::vector<io::EvaluationRow> done_rows;
+  std::vector<io::EvaluationItem> todo = items;
+  if (o.resume) {
+    for (const std::string& path : {partial_path, rows_path}) {
+      if (!fs::exists(path)) continue;
+      io::RowsHeader previous;
+      std::vector<io::EvaluationRow> previous_rows = io::ReadRows(path, &previous);
+      if (previous.settings_json != settings || previous.shard != shard || previous.shards != shards) {
+        throw CliError("--resume: " + path + " was written by a run with other settings, inputs or shards; "
+                       "run without --resume (or with another --out) to start over");
+      }
+      for (io::EvaluationRow& r : previous_rows) {
+        if (r.error.empty()) done_rows.push_back(std::move(r));  // failed ones run again
+      }
+      break;
+    }
+    std::set<int> done;
+    for (const io::EvaluationRow& r : done_rows) done.insert(r.index);
+    todo.clear();
+    for (const io::EvaluationItem& item : items) {
+      if (!done.count(item.index)) todo.push_back(item);
+    }
+    std::cerr << "evaluate: --resume: " << done_rows.size() << " trajectories already done in " << o.out << "\n";
+  }
+
+  std::cerr << "evaluate: " << todo.size() << " of " << all.size() << " trajectories";
+  if (shards > 1) std::cerr << " (shard " << shard << "/" << shards << ")";
+  std::cerr << ", protocols " << o.protocols << "\n";
+  Progress progress(o.quiet);
+  std::vector<io::EvaluationRow> finished = done_rows;
+  io::WriteRows(partial_path, header, finished);
+  const std::vector<io::EvaluationRow> new_rows =
+      io::RunEvaluation(todo, options, o.jobs, [&](int done, int total, int failed, const io::EvaluationRow& row) {
+        progress.Update(done, total, failed, row);
+        finished.push_back(row);
+        io::WriteRows(partial_path, header, finished);
+      });
+  std::vector<io::EvaluationRow> rows = done_rows;
+  rows.insert(rows.end(), new_rows.begin(), new_rows.end());
+  std::sort(rows.begin(), rows.end(), [](const io::EvaluationRow& a, const io::EvaluationRow& b) { return a.index < b.index; });
+  int failed = 0;
+  for (const io::EvaluationRow& r : rows) failed += r.error.empty() ? 0 : 1;
+
+  io::WriteRows(rows_path, header, rows);
+  fs::remove(partial_path, ec);
   if (shards > 1) {
-    const std::string path =
-        (fs::path(o.out) / ("rows-" + std::to_string(shard) + "-of-" + std::to_string(shards) + ".jsonl")).string();
-    io::WriteRows(path, header, rows);
-    std::cerr << "evaluate: shard rows written to " << path << "; combine with `pushgraph evaluate merge DIR...`\n";
+    std::cerr << "evaluate: shard rows written to " << rows_path << "; combine with `pushgraph evaluate merge DIR...`\n";
   } else {
-    io::WriteRows((fs::path(o.out) / "rows.jsonl").string(), header, rows);
     PrintTables(o.out, rows, settings);
   }
   if (failed > 0) std::cerr << "evaluate: " << failed << " of " << rows.size() << " trajectories failed (listed above)\n";
@@ -266,9 +309,11 @@ void RegisterEvaluate(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--sim-object", o->sim_object, "Shape of the simulated pushes' object")->capture_default_str();
   cmd->add_option("--sim-finger", o->sim_finger, "Finger of the simulated pushes")->capture_default_str();
-  cmd->add_option("--sim-mass", o->sim_mass, "Simulated object's mass (kg)")->capture_default_str();
-  cmd->add_option("--sim-mu", o->sim_mu, "Simulated object-table friction")->capture_default_str();
-  cmd->add_option("--sim-mu-contact", o->sim_mu_contact, "Simulated finger-object friction")->capture_default_str();
+  cmd->add_option("--sim-mass", o->sim_mass, "Simulated object's mass (kg)")->check(MassValue())->capture_default_str();
+  cmd->add_option("--sim-mu", o->sim_mu, "Simulated object-table friction")->check(FrictionValue(false))->capture_default_str();
+  cmd->add_option("--sim-mu-contact", o->sim_mu_contact, "Simulated finger-object friction")
+      ->check(FrictionValue(true))
+      ->capture_default_str();
   cmd->add_option("--protocol", o->protocols, "table1,table2,fig5,occlusion,consistency,runtime or all")
       ->capture_default_str();
   cmd->add_option("--plots", o->plots,
@@ -276,9 +321,11 @@ void RegisterEvaluate(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--object", o->object, "Object shape JSON for every MIT recording (with --finger --mass --mu)");
   cmd->add_option("--finger", o->finger, "Probe shape JSON for every MIT recording");
-  cmd->add_option("--mass", o->mass, "Object mass (kg) for every MIT recording");
-  cmd->add_option("--mu", o->mu, "Object-table friction for every MIT recording");
-  cmd->add_option("--mu-contact", o->mu_contact, "Finger-object friction with --object")->capture_default_str();
+  cmd->add_option("--mass", o->mass, "Object mass (kg) for every MIT recording")->check(MassValue());
+  cmd->add_option("--mu", o->mu, "Object-table friction for every MIT recording")->check(FrictionValue(false));
+  cmd->add_option("--mu-contact", o->mu_contact, "Finger-object friction with --object")
+      ->check(FrictionValue(true))
+      ->capture_default_str();
   cmd->add_option("--mesh-dir", o->mesh_dir,
                   "Folder with the dataset's NAME.obj and tip.obj (default: an obj/ folder beside or above each recording)");
   cmd->add_option("--config", o->config, "Evaluation config JSON: objects, mesh_dir, estimator (docs/evaluation.md)");
@@ -297,6 +344,9 @@ void RegisterEvaluate(CLI::App& app) {
   cmd->add_option("--merge", o->merge, "Merge the rows of shard folders/files instead of evaluating")
       ->expected(1, -1);
   cmd->add_flag("-q,--quiet", o->quiet, "No progress display");
+  cmd->add_flag("--resume", o->resume,
+                "Continue a killed or partly failed run in the same --out: trajectories already in its rows file are "
+                "not run again (the settings, inputs and shard must be the same)");
   cmd->add_flag("--allow-failures", o->allow_failures,
                 "Exit with status 0 when some (not all) trajectories fail; they are left out of the tables");
   AddAlignShapeOption(cmd, &o->align_shape);

@@ -22,9 +22,11 @@ void RegisterMitImport(CLI::App& app) {
   cmd->add_option("RECORDING", a->recording, "Recording (.h5 or .json)")->required();
   cmd->add_option("--object", a->object, "Object shape JSON (e.g. from pushgraph footprint)")->required();
   cmd->add_option("--finger", a->finger, "Finger shape JSON")->required();
-  cmd->add_option("--mass", a->mass, "Object mass (kg)")->required();
-  cmd->add_option("--mu-surface", a->mu_surface, "Object-table friction coefficient")->required();
-  cmd->add_option("--mu-contact", a->mu_contact, "Finger-object friction coefficient")->capture_default_str();
+  cmd->add_option("--mass", a->mass, "Object mass (kg)")->required()->check(MassValue());
+  cmd->add_option("--mu-surface", a->mu_surface, "Object-table friction coefficient")->required()->check(FrictionValue(false));
+  cmd->add_option("--mu-contact", a->mu_contact, "Finger-object friction coefficient")
+      ->check(FrictionValue(true))
+      ->capture_default_str();
   cmd->add_flag("--trim", a->trim, "Keep only the contact phase");
   cmd->add_option("-o,--output", a->output, "Trajectory JSON to write")->required();
   cmd->callback([a] {

@@ -197,9 +197,13 @@ void RegisterSimulate(CLI::App& app) {
   cmd->add_option("--object", o->object_path, "Object shape JSON (also the support region; uniform pressure)")
       ->capture_default_str();
   cmd->add_option("--finger", o->finger_path, "Finger shape JSON (any shape)")->capture_default_str();
-  cmd->add_option("--mass", o->mass, "Object mass in kg (> 0)")->capture_default_str();
-  cmd->add_option("--mu-surface", o->mu_surface, "Object-table friction coefficient (> 0)")->capture_default_str();
-  cmd->add_option("--mu-contact", o->mu_contact, "Finger-object friction coefficient (>= 0)")->capture_default_str();
+  cmd->add_option("--mass", o->mass, "Object mass in kg (> 0)")->check(MassValue())->capture_default_str();
+  cmd->add_option("--mu-surface", o->mu_surface, "Object-table friction coefficient (> 0)")
+      ->check(FrictionValue(false))
+      ->capture_default_str();
+  cmd->add_option("--mu-contact", o->mu_contact, "Finger-object friction coefficient (>= 0)")
+      ->check(FrictionValue(true))
+      ->capture_default_str();
   cmd->add_option("--surface", o->surface, "Limit surface model: exact or ellipsoid (the paper's Eq. 3)")
       ->check(CLI::IsMember({"exact", "ellipsoid"}))
       ->capture_default_str();

@@ -28,6 +28,12 @@ using geometry::Vec2;
 
 /// Standard gravity, m/s^2.
 inline constexpr double kStandardGravity = 9.80665;
+/// The supported ranges (docs/limit_surface.md): mass in (0, kMaxMass] kg, friction coefficients
+/// in [0, kMaxFriction], gravity in (0, kMaxGravity] m/s^2. Beyond them no pushing experiment
+/// exists and products like mu m g |r| overflow or lose their meaning: refused.
+inline constexpr double kMaxMass = 1e6;
+inline constexpr double kMaxFriction = 10.0;
+inline constexpr double kMaxGravity = 1e3;
 
 /// Thrown for invalid input (negative mass, NaN, empty region, negative pressure, ...);
 /// what() names the offending field.

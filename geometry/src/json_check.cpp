@@ -1,0 +1,85 @@
+// Duplicate keys by nlohmann_json's SAX interface: a stack of the open containers, each object
+// with the keys seen so far.
+#include <pushgraph/geometry/json_check.h>
+
+#include <nlohmann/json.hpp>
+
+#include <set>
+#include <string>
+#include <vector>
+
+namespace pushgraph::geometry {
+namespace {
+
+class DuplicateFinder : public nlohmann::json_sax<nlohmann::json> {
+ public:
+  std::string found;
+
+  bool null() override { return Value(); }
+  bool boolean(bool) override { return Value(); }
+  bool number_integer(number_integer_t) override { return Value(); }
+  bool number_unsigned(number_unsigned_t) override { return Value(); }
+  bool number_float(number_float_t, const string_t&) override { return Value(); }
+  bool string(string_t&) override { return Value(); }
+  bool binary(binary_t&) override { return Value(); }
+  bool start_object(std::size_t) override {
+    Open(true);
+    return true;
+  }
+  bool key(string_t& k) override {
+    Container& c = stack_.back();
+    if (!c.keys.insert(k).second) {
+      found = "duplicate key \"" + k + "\" in " + (Pointer().empty() ? std::string("the top-level object") : Pointer());
+      return false;  // stop: the first one is enough
+    }
+    c.current = k;
+    return true;
+  }
+  bool end_object() override { return Close(); }
+  bool start_array(std::size_t) override {
+    Open(false);
+    return true;
+  }
+  bool end_array() override { return Close(); }
+  bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception&) override { return false; }
+
+ private:
+  struct Container {
+    bool object = true;
+    std::set<std::string> keys;
+    std::string current;  // the key (object) or index (array) being read
+    std::size_t index = 0;
+  };
+  // A value ends: in an array the next one has the next index.
+  bool Value() {
+    if (!stack_.empty() && !stack_.back().object) stack_.back().current = std::to_string(stack_.back().index++);
+    return true;
+  }
+  void Open(bool object) {
+    if (!stack_.empty() && !stack_.back().object) stack_.back().current = std::to_string(stack_.back().index++);
+    Container c;
+    c.object = object;
+    stack_.push_back(std::move(c));
+  }
+  bool Close() {
+    stack_.pop_back();
+    return true;
+  }
+  // The JSON pointer of the innermost open object.
+  std::string Pointer() const {
+    std::string p;
+    for (std::size_t i = 0; i + 1 < stack_.size(); ++i) p += "/" + stack_[i].current;
+    return p;
+  }
+  std::vector<Container> stack_;
+};
+
+}  // namespace
+
+std::string FindDuplicateJsonKey(const std::string& text) {
+  DuplicateFinder finder;
+  nlohmann::json::sax_parse(text, &finder, nlohmann::json::input_format_t::json, /*strict=*/false);
+  return finder.found;
+}
+
+}  // namespace pushgraph::geometry
