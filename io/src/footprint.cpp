@@ -15,6 +15,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 namespace pushgraph::io {
 namespace {
@@ -122,8 +123,37 @@ std::vector<double> ReadVertexCoordinates(const std::string& path, std::size_t e
   int line_number = 0;
   while (std::getline(in, line)) {
     ++line_number;
+    // A NUL byte: a binary or corrupt file that the OBJ parser would read as another shape.
+    if (const std::size_t nul = line.find('\0'); nul != std::string::npos) {
+      throw IoError(path + ":" + std::to_string(line_number) + ": a NUL byte at column " + std::to_string(nul + 1) +
+                    " (a binary or corrupt file, not a text OBJ)");
+    }
     const char* c = line.c_str();
     while (*c == ' ' || *c == '\t') ++c;
+    if (c[0] == 'f' && (c[1] == ' ' || c[1] == '\t')) {
+      // Faces: at least three vertex references, each an existing vertex (1-based, or negative
+      // from the end); a file cut mid-face would otherwise become a different mesh.
+      std::istringstream refs(c + 2);
+      std::string ref;
+      int count = 0;
+      const long vertices = static_cast<long>(out.size() / 3);
+      while (refs >> ref && ref[0] != '#') {
+        char* end = nullptr;
+        const long index = std::strtol(ref.c_str(), &end, 10);
+        const bool ok = end != ref.c_str() && (*end == '\0' || *end == '/') && index != 0 &&
+                        (index > 0 ? index <= vertices : -index <= vertices);
+        if (!ok) {
+          throw IoError(path + ":" + std::to_string(line_number) + ": face vertex '" + ref + "' is not one of the " +
+                        std::to_string(vertices) + " vertices defined before it: '" + line + "'");
+        }
+        ++count;
+      }
+      if (count < 3) {
+        throw IoError(path + ":" + std::to_string(line_number) + ": a face needs at least 3 vertices, this one has " +
+                      std::to_string(count) + " (a truncated file?): '" + line + "'");
+      }
+      continue;
+    }
     if (c[0] != 'v' || (c[1] != ' ' && c[1] != '\t')) continue;
     c += 2;
     for (int k = 0; k < 3; ++k) {

@@ -355,8 +355,8 @@ own frame (metres). Immutable; copies share their acceleration structures.
             return io::MeshFootprint(path, o);
           },
           "path"_a, "up"_a = "z", "object"_a = "", "scale"_a = 1.0,
-          "The footprint of an OBJ or STL mesh: the union of its triangles projected along `up` ('x', 'y', 'z', "
-          "'-z', ...), holes kept; `scale` 0.001 for a mesh in millimetres.")
+          "The footprint of an OBJ mesh: the exact union of its triangles projected along `up` ('x', 'y' or 'z'), "
+          "holes kept; `object` picks one object/group of the file; `scale` 0.001 for a mesh in millimetres.")
       .def("to_json", &geometry::ShapeToJson, "indent"_a = 2)
       .def("save_json", [](const Shape& s, const std::string& path) { geometry::SaveShapeJson(s, path); }, "path"_a)
       .def_property_readonly("radius", &Shape::radius)

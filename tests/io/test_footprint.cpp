@@ -144,6 +144,14 @@ TEST_F(Footprint, ClearErrors) {
   expect_error(Write("abc.obj", "v 0 0 0\nv 1 0 abc\nv 0 1 0\nf 1 2 3\n"), {}, "abc.obj:2: vertex coordinate 3 is missing or not a number");
   expect_error(Write("short.obj", "v 0 0 0\nv 1 0\nv 0 1 0\nf 1 2 3\n"), {}, "short.obj:2: vertex coordinate 3");
   expect_error(Write("tail.obj", "v 0 0 0 x\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), {}, "tail.obj:1: unexpected text");
+  // A NUL byte, a face cut short, a face before its vertices: named with the line, not read as
+  // another shape.
+  static const char kWithNul[] = "v 0 0 0\nv 1 0 0\nv 0 1\0 0\nf 1 2 3\n";
+  const std::string with_nul(kWithNul, sizeof kWithNul - 1);
+  expect_error(Write("nul.obj", with_nul), {}, "nul.obj:3: a NUL byte at column 6");
+  expect_error(Write("cut.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4"), {},
+               "cut.obj:6: a face needs at least 3 vertices, this one has 2");
+  expect_error(Write("early.obj", "v 0 0 0\nv 1 0 0\nf 1 2 3\nv 0 1 0\n"), {}, "early.obj:3: face vertex '3'");
   // Comments, a weight and vertex colours after the coordinates are fine.
   EXPECT_NO_THROW(io::MeshFootprint(Write("colours.obj", "v 0 0 0 1 0 0 # red\nv 1 0 0 1.0\nv 0 1 0\nf 1 2 3\n"), {}));
 }
