@@ -2,9 +2,12 @@
 
 #include <pushgraph/graph/incremental.h>
 
+#include <pushgraph/limit_surface/support.h>
+
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <deque>
 #include <chrono>
 #include <iostream>
 #include <limits>
@@ -375,6 +378,14 @@ struct OnlineEstimator::Impl {
   double last_seen[4] = {-INFINITY, -INFINITY, -INFINITY, -INFINITY};  // per stream, dropped samples included
   std::size_t seen[4] = {0, 0, 0, 0};
   int dropped_late = 0;
+  // Force sensor faults (the batch rule, Estimate's DropForceSpikes): a force above 50 times the
+  // larger of the recent forces' 95th percentile and mu m g (and above 1 N) is left out.
+  std::deque<double> recent_force;  // |f| of the newest accepted samples (at most kRecentForces)
+  static constexpr std::size_t kRecentForces = 512;
+  double recent_p95 = 0.0;  // of recent_force, refreshed every 32 samples (a selection of 512: ~2 us)
+  std::size_t since_p95 = 0;
+  int dropped_faults = 0;
+  std::string first_fault;
   bool finished = false;
   bool declared[4] = {true, true, false, false};
   double max_latency = 0.2;
@@ -497,11 +508,40 @@ bool OnlineEstimator::AddContactPoint(double t, const geometry::Vec2& point) {
   return true;
 }
 bool OnlineEstimator::AddForce(double t, const geometry::Vec2& force) {
-  if (!impl_->Accept(3, "force", impl_->seen[3], t, force.allFinite())) return false;
-  impl_->traj.measured.force.push_back({t, force});
+  Impl& m = *impl_;
+  const std::size_t index = m.seen[3];
+  if (!m.Accept(3, "force", m.seen[3], t, force.allFinite())) return false;
+  const double magnitude = force.norm();
+  double scale = 0.0;
+  if (m.traj.object.mass > 0.0 && m.traj.object.mu_surface > 0.0) {
+    scale = m.traj.object.mu_surface * m.traj.object.mass * limit_surface::kStandardGravity;
+  }
+  if (m.recent_force.size() >= 8) {
+    if (m.since_p95 == 0) {
+      std::vector<double> sorted(m.recent_force.begin(), m.recent_force.end());
+      const std::size_t k = sorted.size() * 95 / 100;
+      std::nth_element(sorted.begin(), sorted.begin() + k, sorted.end());
+      m.recent_p95 = sorted[k];
+    }
+    m.since_p95 = (m.since_p95 + 1) % 32;
+    scale = std::max(scale, m.recent_p95);
+  }
+  if (scale > 0.0 && magnitude > std::max(50.0 * scale, 1.0)) {
+    if (m.dropped_faults++ == 0) {
+      char text[200];
+      std::snprintf(text, sizeof text, "force[%zu] at t = %.9g s, |f| = %.3g N (bound %.3g N)", index, t, magnitude,
+                    std::max(50.0 * scale, 1.0));
+      m.first_fault = text;
+    }
+    return false;
+  }
+  m.recent_force.push_back(magnitude);
+  if (m.recent_force.size() > Impl::kRecentForces) m.recent_force.pop_front();
+  m.traj.measured.force.push_back({t, force});
   return true;
 }
 int OnlineEstimator::DroppedLateSamples() const { return impl_->dropped_late; }
+int OnlineEstimator::DroppedFaultySamples() const { return impl_->dropped_faults; }
 
 bool OnlineEstimator::UpdateDue() const {
   const Impl& m = *impl_;
@@ -557,7 +597,14 @@ EstimationResult OnlineEstimator::Finish() {
   if (m.newest_t > m.last_update_t) Update(m.newest_t);  // the end: wait for nobody
   m.finished = true;
   if (m.smoother.next_step == 0) throw GraphError("OnlineEstimator::Finish: no measurements were added");
-  return m.smoother.Finish();
+  EstimationResult r = m.smoother.Finish();
+  if (m.dropped_faults > 0) {
+    r.warnings.insert(r.warnings.begin(), std::to_string(m.dropped_faults) + " force sample" +
+                                              (m.dropped_faults == 1 ? "" : "s") +
+                                              " left out as sensor faults (50 times the recent forces or the object's "
+                                              "friction limit); the first: " + m.first_fault);
+  }
+  return r;
 }
 
 }  // namespace pushgraph::graph

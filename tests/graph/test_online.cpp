@@ -173,6 +173,33 @@ TEST(Online, LeavesOutForcesWithoutAScale) {
   for (const StateEstimate& s : r.states) EXPECT_FALSE(s.force || s.force_cov);
 }
 
+// A corrupted force sample (1e5 N) arriving online is a sensor fault as in batch: AddForce
+// returns false, it is counted, and Finish() warns about it; the estimate is the one without it.
+TEST(Online, ForceSpikesAreLeftOutAsSensorFaults) {
+  const limit_surface::Trajectory t = GeneratePush(OffsetPush(22, 1.0));
+  limit_surface::Trajectory spiked = t;
+  const std::size_t k = spiked.measured.force.size() / 2;
+  spiked.measured.force[k].force = Vec2(1e5, 0.0);
+  auto run = [](const limit_surface::Trajectory& traj, int* faults) {
+    OnlineEstimator online(SetupOf(traj), Model::kQs, {}, StreamsOf(traj));
+    Feed(traj, online, [&] {
+      if (online.UpdateDue()) online.Update();
+    });
+    *faults = online.DroppedFaultySamples();
+    return online.Finish();
+  };
+  int clean_faults = -1, faults = -1;
+  const EstimationResult clean = run(t, &clean_faults);
+  const EstimationResult r = run(spiked, &faults);
+  EXPECT_EQ(clean_faults, 0);
+  EXPECT_EQ(faults, 1);
+  ASSERT_FALSE(r.warnings.empty());
+  EXPECT_NE(r.warnings[0].find("1 force sample left out as sensor faults"), std::string::npos) << r.warnings[0];
+  EXPECT_NE(r.warnings[0].find("force[" + std::to_string(k) + "]"), std::string::npos) << r.warnings[0];
+  EXPECT_NEAR(r.metrics.at("object_position_rms"), clean.metrics.at("object_position_rms"),
+              0.05 * clean.metrics.at("object_position_rms"));
+}
+
 TEST(Online, RefusesBadAndLateSamples) {
   const limit_surface::Trajectory t = GeneratePush(OffsetPush(3, 0.3));
   const limit_surface::Trajectory setup = SetupOf(t);

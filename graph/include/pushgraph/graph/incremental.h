@@ -115,8 +115,12 @@ class OnlineEstimator {
   bool AddObjectPose(double t, const geometry::Pose2& pose);
   bool AddFingerPose(double t, const geometry::Pose2& pose);
   bool AddContactPoint(double t, const geometry::Vec2& point);
+  /// Also false for a force no sensor of this push could have measured (above 50 times the larger
+  /// of the recent forces' 95th percentile and mu m g, and above 1 N): a sensor fault, left out;
+  /// DroppedFaultySamples() counts them and Finish()'s warnings name the first.
   bool AddForce(double t, const geometry::Vec2& force);
   int DroppedLateSamples() const;
+  int DroppedFaultySamples() const;
 
   /// True once incremental_update_every object measurements up to the settled time (see
   /// Update) arrived since the last update, or, while the object stream is silent (occlusion),
