@@ -21,7 +21,16 @@ using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
 /// `a` as an (N, columns) array; a single row (columns,) is taken as N = 1 when `allow_row`.
 /// Throws ValueError naming `what` and the shape it got.
 inline Array Rows(const py::handle& object, int columns, const char* what, bool allow_row = true) {
-  Array a = Array::ensure(object);
+  // Real numbers only: NumPy would cast complex numbers (dropping the imaginary part, a warning
+  // at most), booleans and None (to NaN) without complaint.
+  const py::array raw = py::array::ensure(object);
+  if (!raw) throw py::type_error(std::string(what) + ": expected an array of numbers");
+  const char kind = raw.dtype().kind();
+  if (kind != 'f' && kind != 'i' && kind != 'u') {
+    throw py::type_error(std::string(what) + ": expected real numbers, got an array of dtype " +
+                         std::string(py::str(raw.dtype())));
+  }
+  Array a = Array::ensure(raw);
   if (!a) throw py::type_error(std::string(what) + ": expected an array of numbers");
   if (allow_row && a.ndim() == 1 && a.shape(0) == columns) a = a.reshape({py::ssize_t(1), py::ssize_t(columns)});
   if (a.ndim() != 2 || a.shape(1) != columns) {
@@ -31,6 +40,17 @@ inline Array Rows(const py::handle& object, int columns, const char* what, bool 
     throw py::value_error(std::string(what) + ": expected an array of shape (N, " + std::to_string(columns) +
                           "), got " + shape);
   }
+  return a;
+}
+
+/// A 1-D array of real numbers (times); TypeError / ValueError naming `what` otherwise.
+inline Array Vector(const py::handle& object, const char* what) {
+  const py::array raw = py::array::ensure(object);
+  if (!raw || (raw.dtype().kind() != 'f' && raw.dtype().kind() != 'i' && raw.dtype().kind() != 'u')) {
+    throw py::type_error(std::string(what) + ": expected a 1-D array of real numbers");
+  }
+  Array a = Array::ensure(raw);
+  if (a.ndim() != 1) throw py::value_error(std::string(what) + ": expected a 1-D array, got " + std::to_string(a.ndim()) + " dimensions");
   return a;
 }
 

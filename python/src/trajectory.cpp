@@ -65,8 +65,7 @@ std::vector<Sample> StreamFrom(const py::dict& streams, const char* name, const 
     if (key != "t" && key != value_name) throw py::value_error(at + ": unknown key '" + key + "' (t, " + value_name + ")");
   }
   if (!d.contains("t") || !d.contains(value_name)) throw py::value_error(at + ": needs 't' and '" + value_name + "'");
-  const Array t = Array::ensure(d["t"]);
-  if (!t || t.ndim() != 1) throw py::value_error(at + "['t']: expected a 1-D array of times");
+  const Array t = Vector(d["t"], (at + "['t']").c_str());
   const Array v = Rows(d[value_name], columns, (at + "['" + value_name + "']").c_str(), false);
   if (v.shape(0) != t.shape(0)) {
     throw py::value_error(at + ": " + std::to_string(t.shape(0)) + " times and " + std::to_string(v.shape(0)) + " values");

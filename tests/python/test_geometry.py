@@ -73,8 +73,9 @@ def test_query_arrays_shapes_dtypes_and_bad_arrays(notched_block):
         notched_block.signed_distance(bad)
     with pytest.raises(ValueError, match=r"expected an array of shape \(N, 2\)"):
         notched_block.signed_distance(np.zeros((4, 3)))
-    with pytest.raises(TypeError):
-        notched_block.signed_distance([["a", "b"]])
+    for bad in ([["a", "b"]], [[1j, 0.0]], [[True, False]], np.array([[None, 1.0]], dtype=object)):
+        with pytest.raises(TypeError, match="points: expected"):
+            notched_block.signed_distance(bad)
     with pytest.raises(ValueError, match="need a pose"):
         notched_block.query(pts, jacobians=True)
 
