@@ -15,6 +15,7 @@
 #include <limits>
 #include <numeric>
 #include <unordered_map>
+#include <unordered_set>
 
 namespace pushgraph::graph {
 namespace {
@@ -22,9 +23,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double SecondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-// A block used by more residual blocks than this is shared by the trajectory (c, mu, the shape
-// frame): ordered last, it borders the band instead of filling it.
-constexpr int kSharedBlockDegree = 32;
 // Ceres' defaults: the smallest relative decrease of an accepted step, and the clamp of
 // diag(J^T J) in the damping.
 constexpr double kMinRelativeDecrease = 1e-3;
@@ -42,26 +40,26 @@ ChainSolver::Impl::Impl(ceres::Problem& p) : problem(&p) {
   problem->GetParameterBlocks(&all);
   std::vector<ceres::ResidualBlockId> ids;
   problem->GetResidualBlocks(&ids);
-  std::unordered_map<const double*, int> degree;
+  std::unordered_set<const double*> used;
   std::vector<std::vector<double*>> params(ids.size());
   for (std::size_t k = 0; k < ids.size(); ++k) {
     problem->GetParameterBlocksForResidualBlock(ids[k], &params[k]);
-    for (double* b : params[k]) ++degree[b];
+    used.insert(params[k].begin(), params[k].end());
   }
-  // Time order (insertion order), shared blocks last.
-  std::vector<double*> chain, shared;
+  // Offsets in the order the blocks were added (time order for the estimator); the elimination
+  // order is AMD's, chosen once with the symbolic analysis.
+  std::vector<double*> variable;
   for (double* b : all) {
     const int size = problem->ParameterBlockSize(b);
-    if (problem->IsParameterBlockConstant(b) || !degree.count(b) || size == 0) {
+    if (problem->IsParameterBlockConstant(b) || !used.count(b) || size == 0) {
       fixed[b] = size;
       continue;
     }
     if (problem->GetManifold(b) != nullptr) throw GraphError("ChainSolver: a parameter block has a manifold (not supported)");
-    (degree[b] > kSharedBlockDegree ? shared : chain).push_back(b);
+    variable.push_back(b);
   }
-  chain.insert(chain.end(), shared.begin(), shared.end());
   int offset = 0;
-  for (double* b : chain) {
+  for (double* b : variable) {
     Block block;
     block.ptr = b;
     block.offset = offset;

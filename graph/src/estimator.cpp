@@ -170,6 +170,24 @@ void CheckNoClockJump(const std::vector<Sample>& s, const std::string& stream, d
   }
 }
 
+}  // namespace
+
+double Percentile95(std::vector<double> values) {
+  const std::size_t k = values.size() * 95 / 100;
+  std::nth_element(values.begin(), values.begin() + k, values.end());
+  return values[k];
+}
+
+double ForceFaultBound(double force_p95, const limit_surface::ObjectDescription& object) {
+  double scale = force_p95;
+  if (object.mass > 0.0 && object.mu_surface > 0.0) {
+    scale = std::max(scale, object.mu_surface * object.mass * limit_surface::kStandardGravity);
+  }
+  return std::max(50.0 * scale, 1.0);
+}
+
+namespace {
+
 void ValidateTrajectory(const limit_surface::Trajectory& traj) {
   if (traj.object.shape.empty()) throw GraphError("trajectory: object.shape is missing or empty");
   if (traj.finger.shape.empty()) throw GraphError("trajectory: finger.shape is missing or empty");
@@ -1103,14 +1121,7 @@ std::optional<limit_surface::Trajectory> DropForceSpikes(const limit_surface::Tr
   if (forces.size() < 8) return std::nullopt;
   std::vector<double> magnitude(forces.size());
   for (std::size_t i = 0; i < forces.size(); ++i) magnitude[i] = forces[i].force.norm();
-  std::vector<double> sorted = magnitude;
-  const std::size_t k = sorted.size() * 95 / 100;
-  std::nth_element(sorted.begin(), sorted.begin() + k, sorted.end());
-  double scale = sorted[k];
-  if (traj.object.mass > 0.0 && traj.object.mu_surface > 0.0) {
-    scale = std::max(scale, traj.object.mu_surface * traj.object.mass * limit_surface::kStandardGravity);
-  }
-  const double bound = std::max(50.0 * scale, 1.0);
+  const double bound = internal::ForceFaultBound(internal::Percentile95(magnitude), traj.object);
   limit_surface::Trajectory out = traj;
   out.measured.force.clear();
   int dropped = 0;
@@ -1159,7 +1170,6 @@ EstimationResult EstimateValidated(const limit_surface::Trajectory& trajectory, 
   RegistrationOptions options = RegistrationOptionsFor(config);
   options.estimate_scale = config.align_scale;
   std::optional<RegistrationResult> registration;
-  internal::ValidateTrajectory(trajectory);
   try {
     alignment.check = CheckShapeFit(trajectory, options);
     alignment.checked = true;

@@ -242,6 +242,12 @@ Diagnostics Diagnose(const limit_surface::Trajectory& trajectory, Model model, c
                      const EstimationResult& result, const FrameState* frame);
 
 ceres::Solver::Options SolverOptions(int max_iterations, double function_tolerance);
+/// The 95th percentile of `values` (non-empty).
+double Percentile95(std::vector<double> values);
+/// A force sample above this is a sensor fault (docs/estimation.md, Input checks): 50 times the
+/// larger of the forces' 95th percentile and the object's mu m g (when known), at least 1 N.
+/// Used by the batch estimator (all forces) and OnlineEstimator (the newest 512).
+double ForceFaultBound(double force_p95, const limit_surface::ObjectDescription& object);
 /// Diagnostics level from the environment, read once: PUSHGRAPH_SOLVER_LOG=1 prints every solve's
 /// Ceres report and why a factor evaluation failed, =2 also the per-iteration trace; unset: 0.
 int SolverLogLevel();

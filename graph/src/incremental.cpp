@@ -2,8 +2,6 @@
 
 #include <pushgraph/graph/incremental.h>
 
-#include <pushgraph/limit_surface/support.h>
-
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
@@ -512,25 +510,18 @@ bool OnlineEstimator::AddForce(double t, const geometry::Vec2& force) {
   const std::size_t index = m.seen[3];
   if (!m.Accept(3, "force", m.seen[3], t, force.allFinite())) return false;
   const double magnitude = force.norm();
-  double scale = 0.0;
-  if (m.traj.object.mass > 0.0 && m.traj.object.mu_surface > 0.0) {
-    scale = m.traj.object.mu_surface * m.traj.object.mass * limit_surface::kStandardGravity;
-  }
+  const bool known_object = m.traj.object.mass > 0.0 && m.traj.object.mu_surface > 0.0;
   if (m.recent_force.size() >= 8) {
-    if (m.since_p95 == 0) {
-      std::vector<double> sorted(m.recent_force.begin(), m.recent_force.end());
-      const std::size_t k = sorted.size() * 95 / 100;
-      std::nth_element(sorted.begin(), sorted.begin() + k, sorted.end());
-      m.recent_p95 = sorted[k];
-    }
+    if (m.since_p95 == 0) m.recent_p95 = internal::Percentile95({m.recent_force.begin(), m.recent_force.end()});
     m.since_p95 = (m.since_p95 + 1) % 32;
-    scale = std::max(scale, m.recent_p95);
   }
-  if (scale > 0.0 && magnitude > std::max(50.0 * scale, 1.0)) {
+  // Before 8 forces arrived only the object's friction limit bounds them (when known).
+  const bool judged = known_object || m.recent_force.size() >= 8;
+  const double bound = internal::ForceFaultBound(m.recent_p95, m.traj.object);
+  if (judged && magnitude > bound) {
     if (m.dropped_faults++ == 0) {
       char text[200];
-      std::snprintf(text, sizeof text, "force[%zu] at t = %.9g s, |f| = %.3g N (bound %.3g N)", index, t, magnitude,
-                    std::max(50.0 * scale, 1.0));
+      std::snprintf(text, sizeof text, "force[%zu] at t = %.9g s, |f| = %.3g N (bound %.3g N)", index, t, magnitude, bound);
       m.first_fault = text;
     }
     return false;

@@ -19,6 +19,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <mutex>
 #include <random>
 #include <regex>
@@ -27,6 +28,7 @@
 #include <thread>
 
 #include <glob.h>
+#include <unistd.h>
 
 namespace pushgraph::io {
 namespace {
@@ -843,6 +845,27 @@ std::vector<EvaluationRow> RunEvaluation(const std::vector<EvaluationItem>& item
 // ---------------------------------------------------------------------------------------------
 // Rows files.
 
+namespace {
+nlohmann::json RowJson(const EvaluationRow& r) {
+  nlohmann::json j = {{"index", r.index}, {"name", r.name}, {"group", r.group}, {"steps", r.steps}};
+  if (!r.error.empty()) j["error"] = r.error;
+  j["stats"] = r.stats;
+  if (r.health > 0.0) j["health"] = r.health;
+  if (!r.worst_factor.empty()) j["worst_factor"] = r.worst_factor;
+  if (!r.notes.empty()) j["notes"] = r.notes;
+  return j;
+}
+}  // namespace
+
+void AppendRow(const std::string& path, const EvaluationRow& row) {
+  const std::string line = RowJson(row).dump() + "\n";
+  FILE* f = std::fopen(path.c_str(), "a");
+  if (f == nullptr) throw IoError(path + ": cannot append a row");
+  const bool ok = std::fwrite(line.data(), 1, line.size(), f) == line.size() && std::fflush(f) == 0 && ::fsync(fileno(f)) == 0;
+  std::fclose(f);
+  if (!ok) throw IoError(path + ": cannot append a row (disk full?)");
+}
+
 void WriteRows(const std::string& path, const RowsHeader& header, const std::vector<EvaluationRow>& rows) {
   std::ostringstream out;
   nlohmann::json h = {{"pushgraph_evaluation_rows", 1},
@@ -851,25 +874,24 @@ void WriteRows(const std::string& path, const RowsHeader& header, const std::vec
                       {"items_total", header.items_total},
                       {"settings", nlohmann::json::parse(header.settings_json)}};
   out << h.dump() << "\n";
-  for (const EvaluationRow& r : rows) {
-    nlohmann::json j = {{"index", r.index}, {"name", r.name}, {"group", r.group}, {"steps", r.steps}};
-    if (!r.error.empty()) j["error"] = r.error;
-    j["stats"] = r.stats;
-    if (r.health > 0.0) j["health"] = r.health;
-    if (!r.worst_factor.empty()) j["worst_factor"] = r.worst_factor;
-    if (!r.notes.empty()) j["notes"] = r.notes;
-    out << j.dump() << "\n";
-  }
+  for (const EvaluationRow& r : rows) out << RowJson(r).dump() << "\n";
   if (const std::string error = geometry::WriteFileAtomically(path, out.str()); !error.empty()) throw IoError(error);
 }
 
-std::vector<EvaluationRow> ReadRows(const std::string& path, RowsHeader* header) {
+std::vector<EvaluationRow> ReadRows(const std::string& path, RowsHeader* header, bool cut_last_line_ok) {
   std::ifstream in(path);
   if (!in) throw IoError(path + ": cannot open rows file");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (cut_last_line_ok && !text.empty() && text.back() != '\n') {
+    // A kill during an append leaves a partial last line: drop it unless it is complete JSON.
+    const std::size_t start = text.rfind('\n') + 1;  // npos + 1 == 0: a single line
+    if (start > 0 && !nlohmann::json::accept(text.substr(start))) text.erase(start);
+  }
+  std::istringstream lines(text);
   std::vector<EvaluationRow> rows;
   std::string line;
   int line_no = 0;
-  while (std::getline(in, line)) {
+  while (std::getline(lines, line)) {
     ++line_no;
     if (line.empty()) continue;
     const std::string at = path + ":" + std::to_string(line_no) + ": ";

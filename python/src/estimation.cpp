@@ -121,7 +121,6 @@ void RegisterEstimation(py::module_& m) {
         return ResultToDict(r);
       },
       "trajectory"_a, "model"_a, "mode"_a, "config_json"_a, "apply_measurement_sigmas"_a);
-  m.def("_check_config", [](const std::string& config_json) { ValidateConfig(ParseEstimatorConfig(config_json, "config")); });
 
   py::class_<Online>(m, "_OnlineEstimator")
       .def(py::init([](const py::handle& setup, const std::string& model, const std::string& config_json, bool contact_point,

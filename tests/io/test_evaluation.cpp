@@ -236,6 +236,17 @@ TEST_F(Evaluation, TablesFromSimulatedPushesAndShardsMergeBitIdentically) {
   WriteRows(foreign, {1, 2, 4, other.SettingsJson()}, {});
   EXPECT_THROW(MergeRows({shard_files[0], foreign}, &header), IoError);
   EXPECT_THROW(ReadRows(Write("garbage.jsonl", "{\"a\": 1}\n"), &header), IoError);
+  // Appended rows, the last one cut by a kill: dropped when asked (a resume), an error otherwise.
+  const std::string appended = (dir_ / "appended.jsonl").string();
+  WriteRows(appended, {0, 1, 3, "{}"}, {});
+  EvaluationRow row;
+  row.index = 1;
+  row.name = "sim-0001";
+  row.group = "sim";
+  AppendRow(appended, row);
+  std::ofstream(appended, std::ios::app) << "{\"index\": 2, \"na";
+  EXPECT_EQ(ReadRows(appended, &header, /*cut_last_line_ok=*/true).size(), 1u);
+  EXPECT_THROW(ReadRows(appended, &header), IoError);
 }
 
 TEST_F(Evaluation, RealMitRecordingWithFrozenForceHasNoForceRows) {

@@ -238,16 +238,16 @@ void RunEvaluate(const EvaluateOptions& o) {
   const std::string rows_path =
       (fs::path(o.out) / (shards > 1 ? "rows-" + std::to_string(shard) + "-of-" + std::to_string(shards) + ".jsonl"
                                      : std::string("rows.jsonl"))).string();
-  // Every finished trajectory's row is in this file at once (rewritten atomically after each):
-  // a killed run loses nothing, and --resume skips what it holds.
+  // Every finished trajectory's row is appended to this file at once (flushed to disk): a
+  // killed run loses nothing, and --resume skips what it holds.
   const std::string partial_path = rows_path + ".partial";
   std::vector<io::EvaluationRow> done_rows;
-  std::vector<io::EvaluationItem> todo = items;
+  std::vector<io::EvaluationItem> pending = items;
   if (o.resume) {
     for (const std::string& path : {partial_path, rows_path}) {
       if (!fs::exists(path)) continue;
       io::RowsHeader previous;
-      std::vector<io::EvaluationRow> previous_rows = io::ReadRows(path, &previous);
+      std::vector<io::EvaluationRow> previous_rows = io::ReadRows(path, &previous, /*cut_last_line_ok=*/path == partial_path);
       if (previous.settings_json != settings || previous.shard != shard || previous.shards != shards) {
         throw CliError("--resume: " + path + " was written by a run with other settings, inputs or shards; "
                        "run without --resume (or with another --out) to start over");
@@ -259,24 +259,22 @@ void RunEvaluate(const EvaluateOptions& o) {
     }
     std::set<int> done;
     for (const io::EvaluationRow& r : done_rows) done.insert(r.index);
-    todo.clear();
+    pending.clear();
     for (const io::EvaluationItem& item : items) {
-      if (!done.count(item.index)) todo.push_back(item);
+      if (!done.count(item.index)) pending.push_back(item);
     }
     std::cerr << "evaluate: --resume: " << done_rows.size() << " trajectories already done in " << o.out << "\n";
   }
 
-  std::cerr << "evaluate: " << todo.size() << " of " << all.size() << " trajectories";
+  std::cerr << "evaluate: " << pending.size() << " of " << all.size() << " trajectories";
   if (shards > 1) std::cerr << " (shard " << shard << "/" << shards << ")";
   std::cerr << ", protocols " << o.protocols << "\n";
   Progress progress(o.quiet);
-  std::vector<io::EvaluationRow> finished = done_rows;
-  io::WriteRows(partial_path, header, finished);
+  io::WriteRows(partial_path, header, done_rows);
   const std::vector<io::EvaluationRow> new_rows =
-      io::RunEvaluation(todo, options, o.jobs, [&](int done, int total, int failed, const io::EvaluationRow& row) {
+      io::RunEvaluation(pending, options, o.jobs, [&](int done, int total, int failed, const io::EvaluationRow& row) {
         progress.Update(done, total, failed, row);
-        finished.push_back(row);
-        io::WriteRows(partial_path, header, finished);
+        io::AppendRow(partial_path, row);
       });
   std::vector<io::EvaluationRow> rows = done_rows;
   rows.insert(rows.end(), new_rows.begin(), new_rows.end());

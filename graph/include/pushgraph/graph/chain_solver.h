@@ -1,14 +1,13 @@
 #pragma once
 // A Gauss-Newton solver for the push's chain-structured least-squares problems, with a
 // Levenberg-Marquardt safeguard. It takes a ceres::Problem as built (the same cost functions,
-// losses, constant blocks and bounds: one copy of every residual and Jacobian), orders the
-// unknowns by time (the order the blocks were added in, with the few blocks shared by the whole
-// trajectory, such as c, mu or the shape frame, last), and accumulates the normal equations
-// J^T J straight into a sparse matrix whose pattern is fixed once: every factor touches at most
-// three consecutive steps, so the matrix is block-banded (plus a dense border for the shared
-// blocks) and its Cholesky factor has no fill beyond that band. The factorization is Eigen's
-// SimplicialLLT with its symbolic analysis done once per problem and reused by every iteration
-// and by the covariances (SparseMarginals::Compute(const ChainSolver&)).
+// losses, constant blocks and bounds: one copy of every residual and Jacobian) and accumulates
+// the normal equations J^T J straight into a sparse matrix whose pattern is fixed once: every
+// factor touches at most three consecutive steps, so the matrix is block-banded (plus a dense
+// border for the blocks shared by the whole trajectory: c, mu, the shape frame). The
+// factorization is Eigen's SimplicialLLT with an AMD ordering (which keeps the factor within the
+// band and its border) and its symbolic analysis done once per problem, reused by every
+// iteration and by the covariances (SparseMarginals::Compute(ChainSolver&)).
 //
 //   ceres::Problem problem;                  // residual blocks added step by step, in time order
 //   ...

@@ -51,7 +51,7 @@ class SparseMarginals {
   bool Compute(ceres::Problem& problem);
   /// The same from a ChainSolver (after its Solve): its J^T J at the solution (no second
   /// evaluation when the values have not moved) and its symbolic factorization; the unknowns in
-  /// the solver's time order, so the factor is banded and the selected inverse costs O(n w^2).
+  /// the solver's fill-reducing order, so the factor is banded and the selected inverse costs O(n w^2).
   bool Compute(ChainSolver& solver);
 
   /// The marginal covariance of one parameter block (size x size); zero for a block held fixed

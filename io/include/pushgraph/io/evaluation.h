@@ -210,8 +210,12 @@ struct RowsHeader {
   std::string settings_json;
 };
 void WriteRows(const std::string& path, const RowsHeader& header, const std::vector<EvaluationRow>& rows);
-/// Throws IoError naming the file and line for malformed content.
-std::vector<EvaluationRow> ReadRows(const std::string& path, RowsHeader* header);
+/// Appends one row line to a rows file (WriteRows wrote its header) and flushes it to disk: a
+/// run's finished rows survive a kill (`pushgraph evaluate --resume`).
+void AppendRow(const std::string& path, const EvaluationRow& row);
+/// Throws IoError naming the file and line for malformed content. `cut_last_line_ok`: a last
+/// line without its newline that does not parse (an append cut by a kill) is left out instead.
+std::vector<EvaluationRow> ReadRows(const std::string& path, RowsHeader* header, bool cut_last_line_ok = false);
 
 /// Reads the rows files (files, or folders holding rows*.jsonl) of the shards of one run and
 /// checks they fit together: equal settings and shard count, every shard exactly once, no item
