@@ -67,7 +67,8 @@ struct ChainSolver::Impl {
   int n = 0;
   // The pattern (lower triangle); values copied in to factorize. The fill-reducing ordering
   // (AMD, computed once with the symbolic analysis) keeps the factor within the band and its
-  // border; on a 276-step push it has 27% fewer nonzeros than the plain time order.
+  // border; on a 276-step push it has 26% fewer nonzeros than the plain time order (40668 against
+  // 55083, PUSHGRAPH_SOLVER_LOG=1).
   Eigen::SparseMatrix<double> H;
   std::vector<double> values, trial_values;  // J^T J at the current point and at a trial point
   Eigen::VectorXd gradient, trial_gradient;
