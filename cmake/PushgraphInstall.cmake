@@ -3,9 +3,9 @@
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
-set(PUSHGRAPH_LIBRARY_TARGETS pushgraph_geometry pushgraph_limit_surface pushgraph_io)
+set(PUSHGRAPH_LIBRARY_TARGETS pushgraph_geometry pushgraph_limit_surface pushgraph_push pushgraph_io)
 if(TARGET pushgraph_graph)
-  list(APPEND PUSHGRAPH_LIBRARY_TARGETS pushgraph_graph)
+  list(APPEND PUSHGRAPH_LIBRARY_TARGETS pushgraph_graph pushgraph_evaluation)
 endif()
 
 install(TARGETS ${PUSHGRAPH_LIBRARY_TARGETS}
@@ -14,7 +14,7 @@ install(TARGETS ${PUSHGRAPH_LIBRARY_TARGETS}
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
   INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(TARGETS pushgraph RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
-foreach(module geometry limit_surface io graph)
+foreach(module geometry limit_surface push io graph evaluation)
   if(EXISTS ${PROJECT_SOURCE_DIR}/${module}/include)
     install(DIRECTORY ${PROJECT_SOURCE_DIR}/${module}/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
   endif()

@@ -4,8 +4,8 @@
 // graph), and compare with the simulator's ground truth.
 #include <pushgraph/geometry/shape.h>
 #include <pushgraph/graph/estimator.h>
-#include <pushgraph/limit_surface/noise.h>
-#include <pushgraph/limit_surface/simulator.h>
+#include <pushgraph/push/noise.h>
+#include <pushgraph/push/simulator.h>
 
 #include <algorithm>
 #include <cmath>
@@ -18,7 +18,7 @@ using namespace pushgraph;
 namespace ls = pushgraph::limit_surface;
 
 // The ground-truth state at time t (the simulator records every sample time of every stream).
-const ls::SimulationState& TruthAt(const ls::SimulationResult& sim, double t) {
+const push::SimulationState& TruthAt(const push::SimulationResult& sim, double t) {
   return *std::min_element(sim.states.begin(), sim.states.end(), [t](const auto& a, const auto& b) {
     return std::abs(a.t - t) < std::abs(b.t - t);
   });
@@ -32,20 +32,20 @@ int main() {
   try {
     // 1. A push: the finger starts 3 mm from the square's left side, 1.5 cm above its centre
     //    line (so the object turns while it slides), and pushes 5 cm to the right at 5 cm/s.
-    ls::PushPlan plan;
-    plan.object = geometry::Shape::Box(0.09, 0.09);
-    plan.finger = geometry::Shape::Disk(0.00235);
-    plan.mass = 0.8374;      // kg
-    plan.mu_surface = 0.25;  // object-table
-    plan.mu_contact = 0.3;   // finger-object
-    plan.waypoints = ls::StraightPushPath(plan, /*push_angle=*/0.0, /*offset=*/0.015, /*standoff=*/0.003,
+    push::PushPlan plan;
+    plan.object.shape = geometry::Shape::Box(0.09, 0.09);
+    plan.finger.shape = geometry::Shape::Disk(0.00235);
+    plan.object.mass = 0.8374;      // kg
+    plan.object.mu_surface = 0.25;  // object-table
+    plan.finger.mu_contact = 0.3;   // finger-object
+    plan.waypoints = push::StraightPushPath(plan, /*push_angle=*/0.0, /*offset=*/0.015, /*standoff=*/0.003,
                                           /*push_distance=*/0.05);
     plan.speed = 0.05;
     // Streams at the paper's rates (object 25 Hz, finger/contact/force 250 Hz) with Gaussian noise:
     // object 2 mm / 0.02 rad, finger 0.5 mm, contact 1 mm, force 0.05 N (DefaultNoise).
-    plan.noise = ls::DefaultNoise(ls::NoiseKind::kGaussian);
+    plan.noise = push::DefaultNoise(push::NoiseKind::kGaussian);
     plan.seed = 7;
-    const ls::SimulationResult sim = ls::Simulate(plan);
+    const push::SimulationResult sim = push::Simulate(plan);
     std::printf("simulated %.2f s: %d steps (%d sticking, %d sliding); %zu object and %zu force samples\n",
                 sim.states.back().t, sim.stats.steps, sim.stats.sticking_steps, sim.stats.sliding_steps,
                 sim.trajectory.measured.object_pose.size(), sim.trajectory.measured.force.size());
@@ -53,11 +53,11 @@ int main() {
     // 2. The estimator, told the measurement noise it will see (the defaults are the paper's
     //    5 mm / 0.5 N). The trajectory carries the shapes, mass and friction the factors need.
     graph::EstimatorConfig config;
-    config.object_pose_sigma_trans = plan.noise.object_pose.position.sigma;
-    config.object_pose_sigma_rot = plan.noise.object_pose.angle.sigma;
-    config.finger_pose_sigma_trans = plan.noise.finger_pose.position.sigma;
-    config.contact_sigma = plan.noise.contact_point.position.sigma;
-    config.force_sigma = plan.noise.force.position.sigma;
+    config.measurement.object_trans = plan.noise.object_pose.position.sigma;
+    config.measurement.object_rot = plan.noise.object_pose.angle.sigma;
+    config.measurement.finger_trans = plan.noise.finger_pose.position.sigma;
+    config.measurement.contact = plan.noise.contact_point.position.sigma;
+    config.measurement.force = plan.noise.force.position.sigma;
     const graph::EstimationResult result =
         graph::Estimate(sim.trajectory, graph::Model::kQs, graph::Mode::kBatch, config);
     std::printf("QS batch: %zu steps, %d LM iterations, %.3f s, final cost %.2f, covariance: %s\n\n",
@@ -70,7 +70,7 @@ int main() {
     const int stride = std::max<int>(1, static_cast<int>(result.states.size()) / 8);
     for (size_t i = 0; i < result.states.size(); i += stride) {
       const graph::StateEstimate& s = result.states[i];
-      const ls::SimulationState& truth = TruthAt(sim, s.t);
+      const push::SimulationState& truth = TruthAt(sim, s.t);
       std::printf("%6.3f  %6.2f %6.2f %6.2f  +- (%4.2f %4.2f %4.2f)     %6.2f %6.2f %6.2f  ", s.t,
                   1e3 * s.object_pose.x, 1e3 * s.object_pose.y, s.object_pose.theta * 180 / M_PI,
                   s.object_pose_cov ? 1e3 * TwoSigma(*s.object_pose_cov, 0) : NAN,

@@ -4,8 +4,8 @@
 // paper's occlusion of the object tracker in the middle of the push.
 #include <pushgraph/geometry/shape.h>
 #include <pushgraph/graph/incremental.h>
-#include <pushgraph/limit_surface/noise.h>
-#include <pushgraph/limit_surface/simulator.h>
+#include <pushgraph/push/noise.h>
+#include <pushgraph/push/simulator.h>
 
 #include <algorithm>
 #include <cmath>
@@ -18,7 +18,7 @@ namespace {
 using namespace pushgraph;
 namespace ls = pushgraph::limit_surface;
 
-const ls::SimulationState& TruthAt(const ls::SimulationResult& sim, double t) {
+const push::SimulationState& TruthAt(const push::SimulationResult& sim, double t) {
   return *std::min_element(sim.states.begin(), sim.states.end(), [t](const auto& a, const auto& b) {
     return std::abs(a.t - t) < std::abs(b.t - t);
   });
@@ -37,32 +37,32 @@ int main() {
   try {
     // 1. A recorded push stands in for the robot's sensors: the square and probe of
     //    estimate_push.cpp, with the camera occluded from 0.4 s to 0.8 s.
-    ls::PushPlan plan;
-    plan.object = geometry::Shape::Box(0.09, 0.09);
-    plan.finger = geometry::Shape::Disk(0.00235);
-    plan.mass = 0.8374;
-    plan.mu_surface = 0.25;
-    plan.mu_contact = 0.3;
-    plan.waypoints = ls::StraightPushPath(plan, 0.0, 0.015, 0.003, 0.05);
+    push::PushPlan plan;
+    plan.object.shape = geometry::Shape::Box(0.09, 0.09);
+    plan.finger.shape = geometry::Shape::Disk(0.00235);
+    plan.object.mass = 0.8374;
+    plan.object.mu_surface = 0.25;
+    plan.finger.mu_contact = 0.3;
+    plan.waypoints = push::StraightPushPath(plan, 0.0, 0.015, 0.003, 0.05);
     plan.speed = 0.05;
-    plan.noise = ls::DefaultNoise(ls::NoiseKind::kGaussian);
+    plan.noise = push::DefaultNoise(push::NoiseKind::kGaussian);
     plan.seed = 7;
-    const ls::SimulationResult sim = ls::Simulate(plan);
-    const ls::Streams& streams = sim.trajectory.measured;
+    const push::SimulationResult sim = push::Simulate(plan);
+    const push::Streams& streams = sim.trajectory.measured;
     const double occlusion_begin = 0.4, occlusion_end = 0.8;
 
     // 2. The estimator knows the shapes, mass and frictions (no samples yet), the noise, and
     //    which sensors will report.
-    ls::Trajectory setup;
+    push::Trajectory setup;
     setup.object = sim.trajectory.object;
     setup.finger = sim.trajectory.finger;
     setup.ground_truth = sim.trajectory.ground_truth;  // only for the final metrics
     graph::EstimatorConfig config;
-    config.object_pose_sigma_trans = plan.noise.object_pose.position.sigma;
-    config.object_pose_sigma_rot = plan.noise.object_pose.angle.sigma;
-    config.finger_pose_sigma_trans = plan.noise.finger_pose.position.sigma;
-    config.contact_sigma = plan.noise.contact_point.position.sigma;
-    config.force_sigma = plan.noise.force.position.sigma;
+    config.measurement.object_trans = plan.noise.object_pose.position.sigma;
+    config.measurement.object_rot = plan.noise.object_pose.angle.sigma;
+    config.measurement.finger_trans = plan.noise.finger_pose.position.sigma;
+    config.measurement.contact = plan.noise.contact_point.position.sigma;
+    config.measurement.force = plan.noise.force.position.sigma;
     graph::OnlineStreams sensors;
     sensors.contact_point = true;  // a tactile sensor
     sensors.force = true;          // a force/torque sensor
@@ -90,7 +90,7 @@ int main() {
       if (!stamp_complete || !online.UpdateDue()) continue;
       const double seconds = online.Update();
       const graph::StateEstimate now = online.LatestState();  // the filtered (causal) estimate
-      const ls::SimulationState& truth = TruthAt(sim, now.t);
+      const push::SimulationState& truth = TruthAt(sim, now.t);
       const bool occluded = now.t > occlusion_begin && now.t < occlusion_end;
       std::printf("%6.3f %6.1f ms %7d  %7.2f %7.2f %-8s %7.2f %7.2f\n", now.t, 1e3 * seconds, online.WindowSteps(),
                   1e3 * now.object_pose.x, 1e3 * now.object_pose.y, occluded ? "occluded" : "",

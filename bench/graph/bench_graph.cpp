@@ -19,8 +19,8 @@ namespace {
 
 using namespace pushgraph;
 
-const limit_surface::Trajectory& Push(int steps) {
-  static std::map<int, limit_surface::Trajectory> cache;
+const push::Trajectory& Push(int steps) {
+  static std::map<int, push::Trajectory> cache;
   auto it = cache.find(steps);
   if (it == cache.end()) {
     graph::testing::PushSpec s;
@@ -77,7 +77,7 @@ geometry::Shape SubdividedSquare(double side, int vertices) {
 }
 
 void BM_BatchQsDetailedObject(benchmark::State& state) {
-  limit_surface::Trajectory traj = Push(1000);
+  push::Trajectory traj = Push(1000);
   traj.object.shape = SubdividedSquare(0.09, static_cast<int>(state.range(0)));
   graph::EstimatorConfig cfg;
   cfg.covariance = false;
@@ -152,7 +152,7 @@ BENCHMARK(BM_IncrementalQsWithCovariance)->ArgsProduct({{500, 2000}, {0}, {0, 1}
 void BM_OnlineQs(benchmark::State& state) {
   const auto& traj = Push(static_cast<int>(state.range(0)));
   const std::vector<graph::testing::Arrival> samples = graph::testing::ArrivalOrder(traj);
-  limit_surface::Trajectory setup = graph::testing::SetupOf(traj);
+  push::Trajectory setup = graph::testing::SetupOf(traj);
   setup.ground_truth.reset();
   graph::EstimatorConfig cfg;
   cfg.covariance = false;

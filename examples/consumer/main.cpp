@@ -13,7 +13,7 @@ int main() {
   PointQueryJacobians J;
   const PointQuery q = QueryPoint(box, Pose2{0.0, 0.0, 0.1}, Vec2(0.1, 0.0), &J);
   const ShapePairResult r = QueryShapePair(box, Pose2{}, Shape::Disk(0.005), Pose2{-0.06, 0.0, 0.0});
-  pushgraph::limit_surface::Trajectory t;
+  pushgraph::push::Trajectory t;
   t.object.shape = box;
   t.object.mass = 0.8374;
   t.finger.shape = Shape::Disk(0.00235);

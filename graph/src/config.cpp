@@ -18,39 +18,45 @@ namespace {
 
 using Json = nlohmann::json;
 
-std::map<std::string, double EstimatorConfig::*> DoubleFields() {
+// The numeric keys and where they live (the measurement sigmas are the embedded
+// push::MeasurementSigmas).
+using DoubleField = double& (*)(EstimatorConfig&);
+#define PUSHGRAPH_FIELD(path) [](EstimatorConfig& c) -> double& { return c.path; }
+
+std::map<std::string, DoubleField> DoubleFields() {
   return {
-      {"object_pose_sigma_trans", &EstimatorConfig::object_pose_sigma_trans},
-      {"object_pose_sigma_rot", &EstimatorConfig::object_pose_sigma_rot},
-      {"finger_pose_sigma_trans", &EstimatorConfig::finger_pose_sigma_trans},
-      {"finger_pose_sigma_rot", &EstimatorConfig::finger_pose_sigma_rot},
-      {"contact_sigma", &EstimatorConfig::contact_sigma},
-      {"force_sigma", &EstimatorConfig::force_sigma},
-      {"contact_object_sigma", &EstimatorConfig::contact_object_sigma},
-      {"contact_finger_sigma", &EstimatorConfig::contact_finger_sigma},
-      {"touching_sigma", &EstimatorConfig::touching_sigma},
-      {"intersection_sigma", &EstimatorConfig::intersection_sigma},
-      {"accel_trans", &EstimatorConfig::accel_trans},
-      {"accel_rot", &EstimatorConfig::accel_rot},
-      {"quasi_static_sigma", &EstimatorConfig::quasi_static_sigma},
-      {"eps_velocity", &EstimatorConfig::eps_velocity},
-      {"eps_force", &EstimatorConfig::eps_force},
-      {"c", &EstimatorConfig::c},
-      {"c_scale", &EstimatorConfig::c_scale},
-      {"c_prior_sigma", &EstimatorConfig::c_prior_sigma},
-      {"mu_prior_sigma", &EstimatorConfig::mu_prior_sigma},
-      {"finger_angle_resolution", &EstimatorConfig::finger_angle_resolution},
-      {"force_prior_sigma", &EstimatorConfig::force_prior_sigma},
-      {"force_random_walk", &EstimatorConfig::force_random_walk},
-      {"limit_surface_sigma", &EstimatorConfig::limit_surface_sigma},
-      {"yu_quasi_static_sigma", &EstimatorConfig::yu_quasi_static_sigma},
-      {"random_walk_trans", &EstimatorConfig::random_walk_trans},
-      {"random_walk_rot", &EstimatorConfig::random_walk_rot},
-      {"contact_max_gap", &EstimatorConfig::contact_max_gap},
-      {"contact_force_threshold", &EstimatorConfig::contact_force_threshold},
-      {"function_tolerance", &EstimatorConfig::function_tolerance},
+      {"object_pose_sigma_trans", PUSHGRAPH_FIELD(measurement.object_trans)},
+      {"object_pose_sigma_rot", PUSHGRAPH_FIELD(measurement.object_rot)},
+      {"finger_pose_sigma_trans", PUSHGRAPH_FIELD(measurement.finger_trans)},
+      {"finger_pose_sigma_rot", PUSHGRAPH_FIELD(measurement.finger_rot)},
+      {"contact_sigma", PUSHGRAPH_FIELD(measurement.contact)},
+      {"force_sigma", PUSHGRAPH_FIELD(measurement.force)},
+      {"contact_object_sigma", PUSHGRAPH_FIELD(contact_object_sigma)},
+      {"contact_finger_sigma", PUSHGRAPH_FIELD(contact_finger_sigma)},
+      {"touching_sigma", PUSHGRAPH_FIELD(touching_sigma)},
+      {"intersection_sigma", PUSHGRAPH_FIELD(intersection_sigma)},
+      {"accel_trans", PUSHGRAPH_FIELD(accel_trans)},
+      {"accel_rot", PUSHGRAPH_FIELD(accel_rot)},
+      {"quasi_static_sigma", PUSHGRAPH_FIELD(quasi_static_sigma)},
+      {"eps_velocity", PUSHGRAPH_FIELD(eps_velocity)},
+      {"eps_force", PUSHGRAPH_FIELD(eps_force)},
+      {"c", PUSHGRAPH_FIELD(c)},
+      {"c_scale", PUSHGRAPH_FIELD(c_scale)},
+      {"c_prior_sigma", PUSHGRAPH_FIELD(c_prior_sigma)},
+      {"mu_prior_sigma", PUSHGRAPH_FIELD(mu_prior_sigma)},
+      {"finger_angle_resolution", PUSHGRAPH_FIELD(finger_angle_resolution)},
+      {"force_prior_sigma", PUSHGRAPH_FIELD(force_prior_sigma)},
+      {"force_random_walk", PUSHGRAPH_FIELD(force_random_walk)},
+      {"limit_surface_sigma", PUSHGRAPH_FIELD(limit_surface_sigma)},
+      {"yu_quasi_static_sigma", PUSHGRAPH_FIELD(yu_quasi_static_sigma)},
+      {"random_walk_trans", PUSHGRAPH_FIELD(random_walk_trans)},
+      {"random_walk_rot", PUSHGRAPH_FIELD(random_walk_rot)},
+      {"contact_max_gap", PUSHGRAPH_FIELD(contact_max_gap)},
+      {"contact_force_threshold", PUSHGRAPH_FIELD(contact_force_threshold)},
+      {"function_tolerance", PUSHGRAPH_FIELD(function_tolerance)},
   };
 }
+#undef PUSHGRAPH_FIELD
 
 std::map<std::string, int EstimatorConfig::*> IntFields() {
   return {
@@ -139,7 +145,7 @@ EstimatorConfig ParseEstimatorConfig(const std::string& json_text, const std::st
     const std::string& key = it.key();
     if (auto d = doubles.find(key); d != doubles.end()) {
       if (!it->is_number()) Fail(source, key, "expected a number");
-      cfg.*(d->second) = it->get<double>();
+      d->second(cfg) = it->get<double>();
     } else if (auto i = ints.find(key); i != ints.end()) {
       if (!it->is_number_integer()) Fail(source, key, "expected an integer");
       cfg.*(i->second) = it->get<int>();
@@ -205,25 +211,27 @@ EstimatorConfig LoadEstimatorConfig(const std::string& path, const EstimatorConf
   return ParseEstimatorConfig(ss.str(), path, base);
 }
 
-EstimatorConfig ApplyMeasurementSigmas(EstimatorConfig cfg, const limit_surface::MeasurementSigmas& s) {
+EstimatorConfig ApplyMeasurementSigmas(EstimatorConfig cfg, const push::MeasurementSigmas& s) {
   auto floor_at = [](double sigma, double least, const char* what) {
     if (!std::isfinite(sigma) || sigma < 0.0) {
       throw GraphError(std::string("measurement_sigmas.") + what + " must be finite and >= 0");
     }
     return std::max(sigma, least);
   };
-  cfg.object_pose_sigma_trans = floor_at(s.object_trans, 1e-4, "object_pose (translation)");
-  cfg.object_pose_sigma_rot = floor_at(s.object_rot, 1e-3, "object_pose (rotation)");
-  cfg.finger_pose_sigma_trans = floor_at(s.finger_trans, 1e-4, "finger_pose (translation)");
-  cfg.finger_pose_sigma_rot = floor_at(s.finger_rot, 1e-3, "finger_pose (rotation)");
-  cfg.contact_sigma = floor_at(s.contact, 1e-4, "contact_point");
-  cfg.force_sigma = floor_at(s.force, 1e-3, "force");
+  push::MeasurementSigmas& m = cfg.measurement;
+  m.object_trans = floor_at(s.object_trans, 1e-4, "object_pose (translation)");
+  m.object_rot = floor_at(s.object_rot, 1e-3, "object_pose (rotation)");
+  m.finger_trans = floor_at(s.finger_trans, 1e-4, "finger_pose (translation)");
+  m.finger_rot = floor_at(s.finger_rot, 1e-3, "finger_pose (rotation)");
+  m.contact = floor_at(s.contact, 1e-4, "contact_point");
+  m.force = floor_at(s.force, 1e-3, "force");
   return cfg;
 }
 
 void ValidateConfig(const EstimatorConfig& cfg) {
-  for (const auto& [key, member] : DoubleFields()) {
-    const double v = cfg.*member;
+  EstimatorConfig copy = cfg;  // the field accessors take a mutable config
+  for (const auto& [key, field] : DoubleFields()) {
+    const double v = field(copy);
     if (key == "c" || key == "finger_angle_resolution") {
       if (!(v >= 0.0) || !std::isfinite(v)) {
         throw GraphError("config key '" + key + "' must be finite and >= 0");

@@ -59,7 +59,7 @@ void CheckFrozen(const std::vector<Sample>& stream, const char* name, Value valu
 
 }  // namespace
 
-Diagnostics Diagnose(const limit_surface::Trajectory& traj, Model model, const EstimatorConfig& cfg,
+Diagnostics Diagnose(const push::Trajectory& traj, Model model, const EstimatorConfig& cfg,
                      const EstimationResult& result, const FrameState* frame) {
   Diagnostics d;
   GraphBuilder builder(traj, model, cfg);
@@ -197,7 +197,7 @@ Diagnostics Diagnose(const limit_surface::Trajectory& traj, Model model, const E
 
   // Sensor faults: frozen streams, and spikes (isolated residuals beyond 6 sigma).
   const auto& m = traj.measured;
-  auto pose_value = [](const limit_surface::PoseSample& s) { return std::vector<double>{s.pose.x, s.pose.y, s.pose.theta}; };
+  auto pose_value = [](const push::PoseSample& s) { return std::vector<double>{s.pose.x, s.pose.y, s.pose.theta}; };
   // A pose run is a fault when the estimate moves more than 1 mm or 0.01 rad meanwhile.
   auto moving = [&](double t0, double t1, bool object) {
     const auto lo = std::lower_bound(result.states.begin(), result.states.end(), t0, [](const StateEstimate& s, double t) { return s.t < t; });
@@ -211,9 +211,9 @@ Diagnostics Diagnose(const limit_surface::Trajectory& traj, Model model, const E
   CheckFrozen(m.finger_pose, "finger_pose", pose_value,
               [&](std::size_t i, std::size_t j) { return moving(m.finger_pose[i].t, m.finger_pose[j].t, false); }, &d.faults);
   CheckFrozen(m.contact_point, "contact_point",
-              [](const limit_surface::PointSample& s) { return std::vector<double>{s.point.x(), s.point.y()}; },
+              [](const push::PointSample& s) { return std::vector<double>{s.point.x(), s.point.y()}; },
               [](std::size_t, std::size_t) { return true; }, &d.faults);
-  CheckFrozen(m.force, "force", [](const limit_surface::ForceSample& s) { return std::vector<double>{s.force.x(), s.force.y()}; },
+  CheckFrozen(m.force, "force", [](const push::ForceSample& s) { return std::vector<double>{s.force.x(), s.force.y()}; },
               [&](std::size_t i, std::size_t) { return m.force[i].force.norm() >= cfg.contact_force_threshold; }, &d.faults);
   for (FactorType t : {FactorType::kObjectPose, FactorType::kFingerPose, FactorType::kContactPoint, FactorType::kForce}) {
     int count = 0, spikes = 0;

@@ -8,6 +8,7 @@
 #include <pushgraph/graph/shape_frame.h>
 #include <pushgraph/limit_surface/limit_surface.h>
 #include <pushgraph/limit_surface/support.h>
+#include <pushgraph/push/scoring.h>
 
 #include <Eigen/Cholesky>
 
@@ -51,25 +52,18 @@ std::string ModeName(Mode mode) { return mode == Mode::kBatch ? "batch" : "incre
 
 bool ModelHasForce(Model model) { return model == Model::kQs || model == Model::kYu; }
 
-QuasiStaticGeometry QuasiStaticGeometryFor(const limit_surface::Trajectory& traj,
+QuasiStaticGeometry QuasiStaticGeometryFor(const push::Trajectory& traj,
                                            const EstimatorConfig& cfg) {
   QuasiStaticGeometry g;
   if (traj.object.shape.empty()) throw GraphError("trajectory: object.shape is missing or empty");
-  // For uniform pressure c and the centre of pressure do not depend on mass or mu.
-  auto summarize = [&](const geometry::Shape& region) {
-    limit_surface::SupportSpec spec;
-    spec.region = region;
-    spec.mass = traj.object.mass > 0.0 ? traj.object.mass : 1.0;
-    spec.mu = traj.object.mu_surface > 0.0 ? traj.object.mu_surface : 1.0;
-    return limit_surface::Summarize(limit_surface::MakeSupport(spec));
-  };
-  limit_surface::Summary s;
+  const geometry::Shape& shape = traj.object.shape;
+  limit_surface::RegionGeometry s;
   try {
-    s = summarize(traj.object.shape);
+    s = limit_surface::RegionGeometryOf(shape, traj.object.pressure);
   } catch (const std::exception& first) {
     // Rounded polygons are not supported by the limit-surface module: use the core polygons.
-    if (traj.object.shape.radius() > 0.0 && !traj.object.shape.is_degenerate_core()) {
-      s = summarize(traj.object.shape.WithRadius(0.0));
+    if (shape.radius() > 0.0 && !shape.is_degenerate_core()) {
+      s = limit_surface::RegionGeometryOf(shape.WithRadius(0.0), traj.object.pressure);
     } else if (cfg.c > 0.0) {
       s.c = cfg.c;
     } else {
@@ -85,12 +79,12 @@ QuasiStaticGeometry QuasiStaticGeometryFor(const limit_surface::Trajectory& traj
 namespace internal {
 namespace {
 
-Pose2 InterpolatePose(const std::vector<limit_surface::PoseSample>& all, double t, double limit) {
+Pose2 InterpolatePose(const std::vector<push::PoseSample>& all, double t, double limit) {
   // Only the samples up to `limit`.
   const auto end = std::upper_bound(all.begin(), all.end(), limit,
-                                    [](double tt, const limit_surface::PoseSample& a) { return tt < a.t; });
+                                    [](double tt, const push::PoseSample& a) { return tt < a.t; });
   if (end == all.begin()) return all.front().pose;
-  return limit_surface::PoseAtClamped(all.begin(), end, t);
+  return push::PoseAtClamped(all.begin(), end, t);
 }
 
 template <class Sample>
@@ -178,7 +172,7 @@ double Percentile95(std::vector<double> values) {
   return values[k];
 }
 
-double ForceFaultBound(double force_p95, const limit_surface::ObjectDescription& object) {
+double ForceFaultBound(double force_p95, const push::ObjectDescription& object) {
   double scale = force_p95;
   if (object.mass > 0.0 && object.mu_surface > 0.0) {
     scale = std::max(scale, object.mu_surface * object.mass * limit_surface::kStandardGravity);
@@ -188,7 +182,7 @@ double ForceFaultBound(double force_p95, const limit_surface::ObjectDescription&
 
 namespace {
 
-void ValidateTrajectory(const limit_surface::Trajectory& traj) {
+void ValidateTrajectory(const push::Trajectory& traj) {
   if (traj.object.shape.empty()) throw GraphError("trajectory: object.shape is missing or empty");
   if (traj.finger.shape.empty()) throw GraphError("trajectory: finger.shape is missing or empty");
   const auto& m = traj.measured;
@@ -264,7 +258,7 @@ void ValidateTrajectory(const limit_surface::Trajectory& traj) {
 
 }  // namespace
 
-GraphBuilder::GraphBuilder(const limit_surface::Trajectory& trajectory, Model model,
+GraphBuilder::GraphBuilder(const push::Trajectory& trajectory, Model model,
                            const EstimatorConfig& config)
     : traj_(trajectory), model_(model), cfg_(config) {
   ValidateConfig(cfg_);
@@ -275,7 +269,7 @@ GraphBuilder::GraphBuilder(const limit_surface::Trajectory& trajectory, Model mo
   SetUpShapes();
 }
 
-GraphBuilder::GraphBuilder(const limit_surface::Trajectory& trajectory, Model model,
+GraphBuilder::GraphBuilder(const push::Trajectory& trajectory, Model model,
                            const EstimatorConfig& config, const OnlineStreams& streams)
     : traj_(trajectory), model_(model), cfg_(config), streams_(streams) {
   ValidateConfig(cfg_);
@@ -514,7 +508,7 @@ void GraphBuilder::Initialize(int i, double limit) {
       const Vec2 c = m.contact_point[s.contact].point;
       v.p[0] = c.x(); v.p[1] = c.y();
     } else if (!m.contact_point.empty() && !causal) {
-      const Vec2 c = limit_surface::StreamValueClamped(m.contact_point, s.t, [](const limit_surface::PointSample& a) { return Vec2(a.point); });
+      const Vec2 c = push::StreamValueClamped(m.contact_point, s.t, [](const push::PointSample& a) { return Vec2(a.point); });
       v.p[0] = c.x(); v.p[1] = c.y();
     } else if (causal && prev != nullptr && steps_[i - 1].in_contact) {
       v.p[0] = prev->p[0]; v.p[1] = prev->p[1];
@@ -526,7 +520,7 @@ void GraphBuilder::Initialize(int i, double limit) {
     if (s.force >= 0) {
       v.f[0] = m.force[s.force].force.x(); v.f[1] = m.force[s.force].force.y();
     } else if (!m.force.empty() && !causal) {
-      const Vec2 f = limit_surface::StreamValueClamped(m.force, s.t, [](const limit_surface::ForceSample& a) { return Vec2(a.force); });
+      const Vec2 f = push::StreamValueClamped(m.force, s.t, [](const push::ForceSample& a) { return Vec2(a.force); });
       v.f[0] = f.x(); v.f[1] = f.y();
     } else if (causal && prev != nullptr && steps_[i - 1].in_contact) {
       v.f[0] = prev->f[0]; v.f[1] = prev->f[1];
@@ -601,7 +595,7 @@ void GraphBuilder::AddKinematicFactors(ceres::Problem& problem, int i) {
   AddPoseMeasurementFactors(problem, i);  // M
   if (s.in_contact) {
     if (s.contact >= 0) {
-      Add(problem, FactorType::kContactPoint, new VectorMeasurementFactor(m.contact_point[s.contact].point, cfg_.contact_sigma),
+      Add(problem, FactorType::kContactPoint, new VectorMeasurementFactor(m.contact_point[s.contact].point, cfg_.measurement.contact),
           MakeLoss(cfg_.contact_loss), {v.p});
     }
     // C: contact point on both boundaries, finger touching the object.
@@ -645,12 +639,12 @@ void GraphBuilder::AddPoseMeasurementFactors(ceres::Problem& problem, int i) {
   StepVars& v = vars_[i];
   if (s.object >= 0) {
     Add(problem, FactorType::kObjectPose,
-        new PoseMeasurementFactor(m.object_pose[s.object].pose, cfg_.object_pose_sigma_trans, cfg_.object_pose_sigma_rot),
+        new PoseMeasurementFactor(m.object_pose[s.object].pose, cfg_.measurement.object_trans, cfg_.measurement.object_rot),
         MakeLoss(cfg_.object_pose_loss), {v.x});
   }
   if (s.finger >= 0) {
     Add(problem, FactorType::kFingerPose,
-        new PoseMeasurementFactor(m.finger_pose[s.finger].pose, cfg_.finger_pose_sigma_trans, cfg_.finger_pose_sigma_rot),
+        new PoseMeasurementFactor(m.finger_pose[s.finger].pose, cfg_.measurement.finger_trans, cfg_.measurement.finger_rot),
         MakeLoss(cfg_.finger_pose_loss), {v.e});
   }
 }
@@ -675,7 +669,7 @@ void GraphBuilder::AddDynamicFactors(ceres::Problem& problem, int i) {
   // Force: measurement, weak prior, quasi-static factor.
   {
     if (s.force >= 0) {
-      Add(problem, FactorType::kForce, new VectorMeasurementFactor(m.force[s.force].force, cfg_.force_sigma),
+      Add(problem, FactorType::kForce, new VectorMeasurementFactor(m.force[s.force].force, cfg_.measurement.force),
           MakeLoss(cfg_.force_loss), {v.f});
     }
     Add(problem, FactorType::kForcePrior, new VectorMeasurementFactor(Vec2::Zero(), cfg_.force_prior_sigma), nullptr, {v.f});
@@ -915,7 +909,7 @@ struct FrameSetup {
   std::optional<Eigen::Matrix3d> covariance;  // out
 };
 
-EstimationResult EstimateBatch(const limit_surface::Trajectory& traj, Model model, const EstimatorConfig& cfg,
+EstimationResult EstimateBatch(const push::Trajectory& traj, Model model, const EstimatorConfig& cfg,
                                FrameSetup* frame = nullptr) {
   internal::GraphBuilder builder(traj, model, cfg);
   if (frame) builder.EnableShapeFrame(frame->centroid, frame->sigma_centroid, frame->sigma_theta, frame->rotation);
@@ -988,12 +982,6 @@ EstimationResult EstimateBatch(const limit_surface::Trajectory& traj, Model mode
   return r;
 }
 
-// Ground truth: interpolation only between samples at most `gap` apart.
-bool GroundTruthPose(const std::vector<limit_surface::PoseSample>& s, double t, double gap, Eigen::Vector3d* out) {
-  return limit_surface::StreamValueAt(
-      s, t, gap, [](const limit_surface::PoseSample& a) { return Eigen::Vector3d(a.pose.vector()); }, out);
-}
-
 struct Accumulator {
   double sum = 0.0;
   int n = 0;
@@ -1005,39 +993,40 @@ struct Accumulator {
 
 }  // namespace
 
-std::map<std::string, double> ComputeMetrics(const limit_surface::Trajectory& traj,
+std::map<std::string, double> ComputeMetrics(const push::Trajectory& traj,
                                              const std::vector<StateEstimate>& states) {
   std::map<std::string, double> m;
   if (!traj.ground_truth) return m;
   const auto& gt = *traj.ground_truth;
-  const double gap = 0.1;
-  Accumulator op, orot, fp, frot, cp, fo, nees_o, nees_f, nees_c, nees_force;
-  auto pose_err = [](const Pose2& est, const Eigen::Vector3d& g) {
-    return Eigen::Vector3d(est.x - g.x(), est.y - g.y(), geometry::WrapAngle(est.theta - g.z()));
-  };
+  // Ground truth at the estimate's times, errors and moving rows: push/scoring.h's one rule.
+  Accumulator op, orot, op_moving, orot_moving, fp, frot, cp, fo, nees_o, nees_f, nees_c, nees_force;
   // Gauge-free NEES: covariance matrices here are well conditioned, LDLT is enough.
   auto nees = [](const auto& e, const auto& cov) { return e.dot(cov.ldlt().solve(e)); };
   for (const StateEstimate& s : states) {
     Eigen::Vector3d g;
-    if (GroundTruthPose(gt.object_pose, s.t, gap, &g)) {
-      const Eigen::Vector3d e = pose_err(s.object_pose, g);
+    if (push::TruthPoseAt(gt.object_pose, s.t, &g)) {
+      const Eigen::Vector3d e = push::PoseError(s.object_pose, g);
       op.Add(e.head<2>().squaredNorm());
       orot.Add(e.z() * e.z());
+      if (push::ObjectMovingAt(gt.object_pose, s.t)) {
+        op_moving.Add(e.head<2>().squaredNorm());
+        orot_moving.Add(e.z() * e.z());
+      }
       if (s.object_pose_cov) nees_o.Add(nees(e, *s.object_pose_cov));
     }
-    if (GroundTruthPose(gt.finger_pose, s.t, gap, &g)) {
-      const Eigen::Vector3d e = pose_err(s.finger_pose, g);
+    if (push::TruthPoseAt(gt.finger_pose, s.t, &g)) {
+      const Eigen::Vector3d e = push::PoseError(s.finger_pose, g);
       fp.Add(e.head<2>().squaredNorm());
       frot.Add(e.z() * e.z());
       if (s.finger_pose_cov) nees_f.Add(nees(e, *s.finger_pose_cov));
     }
     Vec2 v;
-    if (s.contact && limit_surface::StreamValueAt(gt.contact_point, s.t, gap, [](const limit_surface::PointSample& a) { return Vec2(a.point); }, &v)) {
+    if (s.contact && push::TruthPointAt(gt.contact_point, s.t, &v)) {
       const Vec2 e = *s.contact - v;
       cp.Add(e.squaredNorm());
       if (s.contact_cov) nees_c.Add(nees(e, *s.contact_cov));
     }
-    if (s.force && limit_surface::StreamValueAt(gt.force, s.t, gap, [](const limit_surface::ForceSample& a) { return Vec2(a.force); }, &v)) {
+    if (s.force && push::TruthForceAt(gt.force, s.t, &v)) {
       const Vec2 e = *s.force - v;
       fo.Add(e.squaredNorm());
       if (s.force_cov) nees_force.Add(nees(e, *s.force_cov));
@@ -1045,6 +1034,8 @@ std::map<std::string, double> ComputeMetrics(const limit_surface::Trajectory& tr
   }
   op.Put(m, "object_position_rms");
   orot.Put(m, "object_rotation_rms");
+  op_moving.Put(m, "object_position_moving_rms");
+  orot_moving.Put(m, "object_rotation_moving_rms");
   fp.Put(m, "finger_position_rms");
   frot.Put(m, "finger_rotation_rms");
   cp.Put(m, "contact_rms");
@@ -1058,31 +1049,27 @@ std::map<std::string, double> ComputeMetrics(const limit_surface::Trajectory& tr
   const auto& meas = traj.measured;
   for (const auto& s : meas.object_pose) {
     Eigen::Vector3d g;
-    if (GroundTruthPose(gt.object_pose, s.t, gap, &g)) {
-      const Eigen::Vector3d e = pose_err(s.pose, g);
+    if (push::TruthPoseAt(gt.object_pose, s.t, &g)) {
+      const Eigen::Vector3d e = push::PoseError(s.pose, g);
       mop.Add(e.head<2>().squaredNorm());
       morot.Add(e.z() * e.z());
     }
   }
   for (const auto& s : meas.finger_pose) {
     Eigen::Vector3d g;
-    if (GroundTruthPose(gt.finger_pose, s.t, gap, &g)) {
-      const Eigen::Vector3d e = pose_err(s.pose, g);
+    if (push::TruthPoseAt(gt.finger_pose, s.t, &g)) {
+      const Eigen::Vector3d e = push::PoseError(s.pose, g);
       mfp.Add(e.head<2>().squaredNorm());
       mfrot.Add(e.z() * e.z());
     }
   }
   for (const auto& s : meas.contact_point) {
     Vec2 v;
-    if (limit_surface::StreamValueAt(gt.contact_point, s.t, gap, [](const limit_surface::PointSample& a) { return Vec2(a.point); }, &v)) {
-      mcp.Add((s.point - v).squaredNorm());
-    }
+    if (push::TruthPointAt(gt.contact_point, s.t, &v)) mcp.Add((s.point - v).squaredNorm());
   }
   for (const auto& s : meas.force) {
     Vec2 v;
-    if (limit_surface::StreamValueAt(gt.force, s.t, gap, [](const limit_surface::ForceSample& a) { return Vec2(a.force); }, &v)) {
-      mfo.Add((s.force - v).squaredNorm());
-    }
+    if (push::TruthForceAt(gt.force, s.t, &v)) mfo.Add((s.force - v).squaredNorm());
   }
   mop.Put(m, "measured_object_position_rms");
   morot.Put(m, "measured_object_rotation_rms");
@@ -1116,13 +1103,13 @@ namespace {
 // mu m g (when known), and above 1 N. Quasi-static pushing needs at most about f_max; the
 // factor leaves room for impacts and miscalibration. Returns the trajectory without them, or
 // nullopt when there is none; `note` says how many, the first one and the bound.
-std::optional<limit_surface::Trajectory> DropForceSpikes(const limit_surface::Trajectory& traj, std::string* note) {
+std::optional<push::Trajectory> DropForceSpikes(const push::Trajectory& traj, std::string* note) {
   const auto& forces = traj.measured.force;
   if (forces.size() < 8) return std::nullopt;
   std::vector<double> magnitude(forces.size());
   for (std::size_t i = 0; i < forces.size(); ++i) magnitude[i] = forces[i].force.norm();
   const double bound = internal::ForceFaultBound(internal::Percentile95(magnitude), traj.object);
-  limit_surface::Trajectory out = traj;
+  push::Trajectory out = traj;
   out.measured.force.clear();
   int dropped = 0;
   std::size_t first = 0;
@@ -1143,17 +1130,17 @@ std::optional<limit_surface::Trajectory> DropForceSpikes(const limit_surface::Tr
   return out;
 }
 
-EstimationResult EstimateValidated(const limit_surface::Trajectory& trajectory, Model model, Mode mode,
+EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model model, Mode mode,
                                    const EstimatorConfig& config);
 
 }  // namespace
 
-EstimationResult Estimate(const limit_surface::Trajectory& trajectory, Model model, Mode mode,
+EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode mode,
                           const EstimatorConfig& config) {
   ValidateConfig(config);
   internal::ValidateTrajectory(trajectory);
   std::string note;
-  const std::optional<limit_surface::Trajectory> repaired = DropForceSpikes(trajectory, &note);
+  const std::optional<push::Trajectory> repaired = DropForceSpikes(trajectory, &note);
   EstimationResult r = EstimateValidated(repaired ? *repaired : trajectory, model, mode, config);
   if (repaired) r.warnings.insert(r.warnings.begin(), note);
   return r;
@@ -1161,7 +1148,7 @@ EstimationResult Estimate(const limit_surface::Trajectory& trajectory, Model mod
 
 namespace {
 
-EstimationResult EstimateValidated(const limit_surface::Trajectory& trajectory, Model model, Mode mode,
+EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model model, Mode mode,
                                    const EstimatorConfig& config) {
   using Align = EstimatorConfig::AlignShape;
   // The shape against the recording: the check, then registration where asked or needed.
@@ -1203,7 +1190,7 @@ EstimationResult EstimateValidated(const limit_surface::Trajectory& trajectory, 
     auto framed_cost = [&](const ShapeTransform& t, ShapeTransform* refined) {
       RegistrationResult r = *registration;
       r.transform = t;
-      limit_surface::Trajectory framed = trajectory;
+      push::Trajectory framed = trajectory;
       framed.object.shape = r.Apply(trajectory.object.shape);
       FrameSetup frame;
       frame.centroid = geometry::CoreCentroid(framed.object.shape);
@@ -1251,7 +1238,7 @@ EstimationResult EstimateValidated(const limit_surface::Trajectory& trajectory, 
       alignment.check.fits = true;
     }
     if (size_candidate) {
-      limit_surface::Trajectory sized = trajectory;
+      push::Trajectory sized = trajectory;
       sized.finger.shape = finger.WithRadius(sized_radius);
       const double sized_cost = EstimateBatch(sized, model, quick).solver.final_cost;
       size_wins = sized_cost < best_cost;
@@ -1263,8 +1250,8 @@ EstimationResult EstimateValidated(const limit_surface::Trajectory& trajectory, 
   }
   const bool align = registration && (config.align_shape == Align::kOn ||
                                       (config.align_shape == Align::kAuto && misfit && !size_wins && !identity_wins));
-  limit_surface::Trajectory aligned_trajectory;
-  const limit_surface::Trajectory* working = &trajectory;
+  push::Trajectory aligned_trajectory;
+  const push::Trajectory* working = &trajectory;
   if (registration) {
     alignment.suggested = true;
     alignment.transform = registration->transform;

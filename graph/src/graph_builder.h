@@ -103,11 +103,11 @@ class GraphBuilder {
                              std::vector<int> object_pose_blocks = {});
   /// Every block Add()s from now on is appended to `tags` (nullptr: stop).
   void RecordFactorTypes(std::vector<TaggedBlock>* tags) { tags_ = tags; }
-  GraphBuilder(const limit_surface::Trajectory& trajectory, Model model, const EstimatorConfig& config);
+  GraphBuilder(const push::Trajectory& trajectory, Model model, const EstimatorConfig& config);
   /// Online use (OnlineEstimator): `trajectory` starts with empty streams and grows as the
   /// caller appends measurements; steps come from AppendSteps. `streams` says which streams will
   /// arrive (contact gating, and the load factor runs when no force stream will).
-  GraphBuilder(const limit_surface::Trajectory& trajectory, Model model, const EstimatorConfig& config,
+  GraphBuilder(const push::Trajectory& trajectory, Model model, const EstimatorConfig& config,
                const OnlineStreams& streams);
 
   /// Appends a step for every time stamp in (last step, until] of the measurements not yet
@@ -192,7 +192,7 @@ class GraphBuilder {
   void AddDynamicFactors(ceres::Problem& problem, int i);
   void SetUpShapes();  ///< querier, quasi-static geometry, friction (both constructors)
 
-  const limit_surface::Trajectory& traj_;
+  const push::Trajectory& traj_;
   Model model_;
   EstimatorConfig cfg_;
   OnlineStreams streams_;  ///< which streams exist (batch: the non-empty ones)
@@ -238,7 +238,7 @@ struct FrameState {
 };
 /// The self-diagnosis of `result` (diagnostics.h), estimated on `trajectory` (the shape used)
 /// with `model` and `config`; `frame` when the shape frame was a variable.
-Diagnostics Diagnose(const limit_surface::Trajectory& trajectory, Model model, const EstimatorConfig& config,
+Diagnostics Diagnose(const push::Trajectory& trajectory, Model model, const EstimatorConfig& config,
                      const EstimationResult& result, const FrameState* frame);
 
 ceres::Solver::Options SolverOptions(int max_iterations, double function_tolerance);
@@ -247,7 +247,7 @@ double Percentile95(std::vector<double> values);
 /// A force sample above this is a sensor fault (docs/estimation.md, Input checks): 50 times the
 /// larger of the forces' 95th percentile and the object's mu m g (when known), at least 1 N.
 /// Used by the batch estimator (all forces) and OnlineEstimator (the newest 512).
-double ForceFaultBound(double force_p95, const limit_surface::ObjectDescription& object);
+double ForceFaultBound(double force_p95, const push::ObjectDescription& object);
 /// Diagnostics level from the environment, read once: PUSHGRAPH_SOLVER_LOG=1 prints every solve's
 /// Ceres report and why a factor evaluation failed, =2 also the per-iteration trace; unset: 0.
 int SolverLogLevel();

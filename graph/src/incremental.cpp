@@ -56,7 +56,7 @@ namespace {
 
 // The median spacing of the object stream's samples (0 with fewer than two); of the newest
 // `recent` only, when given (the online front end: constant cost per call).
-double MedianObjectPeriod(const std::vector<limit_surface::PoseSample>& obj,
+double MedianObjectPeriod(const std::vector<push::PoseSample>& obj,
                           std::size_t recent = std::numeric_limits<std::size_t>::max()) {
   std::vector<double> periods;
   const std::size_t first = obj.size() > recent ? obj.size() - recent : 0;
@@ -77,7 +77,7 @@ std::string Precise(double t) {
 // The fixed-lag smoother both front ends drive: steps join at updates, the window is re-solved,
 // steps older than the window are marginalized.
 struct FixedLagSmoother {
-  const limit_surface::Trajectory& traj;
+  const push::Trajectory& traj;
   EstimatorConfig cfg;
   internal::GraphBuilder builder;
   std::unique_ptr<ceres::Problem> problem;
@@ -91,7 +91,7 @@ struct FixedLagSmoother {
   double last_cost = 0.0;
 
   // online == nullptr: every step of the recorded `t` exists from the start.
-  FixedLagSmoother(const limit_surface::Trajectory& t, Model model, const EstimatorConfig& c,
+  FixedLagSmoother(const push::Trajectory& t, Model model, const EstimatorConfig& c,
                    const OnlineStreams* online)
       : traj(t), cfg(c),
         builder(online != nullptr ? internal::GraphBuilder(t, model, c, *online) : internal::GraphBuilder(t, model, c)) {
@@ -312,7 +312,7 @@ struct IncrementalEstimator::Impl {
   std::vector<double> triggers;
   std::size_t next_trigger = 0;
 
-  Impl(const limit_surface::Trajectory& traj, Model model, const EstimatorConfig& cfg)
+  Impl(const push::Trajectory& traj, Model model, const EstimatorConfig& cfg)
       : smoother(traj, model, cfg, nullptr) {
     const auto& obj = traj.measured.object_pose;
     const auto& steps = smoother.builder.steps();
@@ -345,7 +345,7 @@ struct IncrementalEstimator::Impl {
   }
 };
 
-IncrementalEstimator::IncrementalEstimator(const limit_surface::Trajectory& trajectory, Model model,
+IncrementalEstimator::IncrementalEstimator(const push::Trajectory& trajectory, Model model,
                                            const EstimatorConfig& config)
     : impl_(std::make_unique<Impl>(trajectory, model, config)) {}
 IncrementalEstimator::~IncrementalEstimator() = default;
@@ -368,7 +368,7 @@ EstimationResult IncrementalEstimator::Finish() {
 
 // Online: the samples are appended to an owned trajectory as they arrive.
 struct OnlineEstimator::Impl {
-  limit_surface::Trajectory traj;  // grows; the smoother's builder reads it
+  push::Trajectory traj;  // grows; the smoother's builder reads it
   FixedLagSmoother smoother;
   double last_update_t = -INFINITY;
   double newest_t = -INFINITY;
@@ -390,14 +390,14 @@ struct OnlineEstimator::Impl {
   static constexpr std::size_t kRecentPeriods = 64;  // object periods the schedule looks at
   double object_period = 0.0;  // median of the newest kRecentPeriods; updated per object sample
 
-  static const limit_surface::Trajectory& Empty(const limit_surface::Trajectory& setup) {
+  static const push::Trajectory& Empty(const push::Trajectory& setup) {
     const auto& m = setup.measured;
     if (!m.object_pose.empty() || !m.finger_pose.empty() || !m.contact_point.empty() || !m.force.empty()) {
       throw GraphError("OnlineEstimator: the setup trajectory must have empty streams (measurements arrive through Add*)");
     }
     return setup;
   }
-  Impl(const limit_surface::Trajectory& setup, Model model, const EstimatorConfig& cfg, const OnlineStreams& streams)
+  Impl(const push::Trajectory& setup, Model model, const EstimatorConfig& cfg, const OnlineStreams& streams)
       : traj(Empty(setup)), smoother(traj, model, cfg, &streams) {
     declared[2] = streams.contact_point;
     declared[3] = streams.force;
@@ -478,13 +478,13 @@ struct OnlineEstimator::Impl {
   int ObjectSamplesSince(double from, double to) const {
     const auto& obj = traj.measured.object_pose;
     auto after = [&](double t) {
-      return std::upper_bound(obj.begin(), obj.end(), t, [](double x, const limit_surface::PoseSample& a) { return x < a.t; });
+      return std::upper_bound(obj.begin(), obj.end(), t, [](double x, const push::PoseSample& a) { return x < a.t; });
     };
     return to > from ? static_cast<int>(after(to) - after(from)) : 0;
   }
 };
 
-OnlineEstimator::OnlineEstimator(const limit_surface::Trajectory& setup, Model model, const EstimatorConfig& config,
+OnlineEstimator::OnlineEstimator(const push::Trajectory& setup, Model model, const EstimatorConfig& config,
                                  const OnlineStreams& streams)
     : impl_(std::make_unique<Impl>(setup, model, config, streams)) {}
 OnlineEstimator::~OnlineEstimator() = default;

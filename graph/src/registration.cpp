@@ -312,7 +312,7 @@ bool SamePlacement(const Shape& outline, const std::vector<Vec2>& samples, const
 
 // A pose stream smoothed by the estimator's motion-only prior: pose measurements and the
 // white-noise-acceleration constant-velocity factor (factors.h), solved with Ceres.
-std::vector<limit_surface::PoseSample> Smoothed(const std::vector<limit_surface::PoseSample>& in, double sigma_t,
+std::vector<push::PoseSample> Smoothed(const std::vector<push::PoseSample>& in, double sigma_t,
                                                 double sigma_r, double accel_t, double accel_r) {
   const int n = static_cast<int>(in.size());
   if (n < 3) return in;
@@ -340,7 +340,7 @@ std::vector<limit_surface::PoseSample> Smoothed(const std::vector<limit_surface:
   options.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
-  std::vector<limit_surface::PoseSample> out = in;
+  std::vector<push::PoseSample> out = in;
   for (int i = 0; i < n; ++i) out[i].pose = {x[3 * i], x[3 * i + 1], x[3 * i + 2]};
   return out;
 }
@@ -348,7 +348,7 @@ std::vector<limit_surface::PoseSample> Smoothed(const std::vector<limit_surface:
 // The white noise of a pose stream from its own samples: the second difference of three
 // consecutive samples is sqrt(6) sigma for white noise on a smooth motion; robust through the
 // median absolute value (x 1.4826). Triples with uneven steps (gaps) are skipped.
-void StreamNoise(const std::vector<limit_surface::PoseSample>& s, double* trans, double* rot) {
+void StreamNoise(const std::vector<push::PoseSample>& s, double* trans, double* rot) {
   std::vector<double> dt, dx, da;
   for (std::size_t i = 1; i < s.size(); ++i) dt.push_back(s[i].t - s[i - 1].t);
   const double step = Median(dt);
@@ -366,16 +366,16 @@ void StreamNoise(const std::vector<limit_surface::PoseSample>& s, double* trans,
 }
 
 // Every recording's contacts, pooled, with each recording's span (s).
-Contacts PoolContacts(const std::vector<const limit_surface::Trajectory*>& recordings, const RegistrationOptions& o,
+Contacts PoolContacts(const std::vector<const push::Trajectory*>& recordings, const RegistrationOptions& o,
                       std::vector<double>* spans) {
   if (recordings.empty() || recordings.front() == nullptr) throw GraphError("registration: no recording");
-  const limit_surface::Trajectory& first = *recordings.front();
+  const push::Trajectory& first = *recordings.front();
   if (first.object.shape.empty()) throw GraphError("registration: the object shape is empty");
   Contacts pooled;
   pooled.recordings = static_cast<int>(recordings.size());
   spans->clear();
   for (std::size_t k = 0; k < recordings.size(); ++k) {
-    const limit_surface::Trajectory& traj = *recordings[k];
+    const push::Trajectory& traj = *recordings[k];
     if (traj.measured.object_pose.empty() || traj.measured.finger_pose.empty()) {
       throw GraphError("registration: recording " + std::to_string(k) + " has no object or no finger pose measurements");
     }
@@ -426,8 +426,8 @@ RegistrationOptions RegistrationOptionsFor(const EstimatorConfig& config) {
   RegistrationOptions o;
   o.contact_max_gap = config.contact_max_gap;
   o.contact_force_threshold = config.contact_force_threshold;
-  o.pose_sigma_trans = config.object_pose_sigma_trans;
-  o.pose_sigma_rot = config.object_pose_sigma_rot;
+  o.pose_sigma_trans = config.measurement.object_trans;
+  o.pose_sigma_rot = config.measurement.object_rot;
   o.accel_trans = config.accel_trans;
   o.accel_rot = config.accel_rot;
   return o;
@@ -518,8 +518,8 @@ namespace {
 
 // The contact samples of `fingers` against `objects` (both already smoothed or not), gated on
 // the trajectory's contact or force stream.
-ContactPath PathOf(const limit_surface::Trajectory& traj, const std::vector<limit_surface::PoseSample>& objects,
-                   const std::vector<limit_surface::PoseSample>& fingers, const RegistrationOptions& o) {
+ContactPath PathOf(const push::Trajectory& traj, const std::vector<push::PoseSample>& objects,
+                   const std::vector<push::PoseSample>& fingers, const RegistrationOptions& o) {
   const auto& m = traj.measured;
   const FingerDisk disk = FingerAsDisk(traj.finger.shape);
   auto nearest = [](const auto& stream, double t, int* index) {
@@ -531,7 +531,7 @@ ContactPath PathOf(const limit_surface::Trajectory& traj, const std::vector<limi
     return best;
   };
   ContactPath path;
-  for (const limit_surface::PoseSample& f : fingers) {
+  for (const push::PoseSample& f : fingers) {
     int k = -1;
     if (!m.contact_point.empty()) {
       if (nearest(m.contact_point, f.t, &k) > o.contact_max_gap) continue;
@@ -546,7 +546,7 @@ ContactPath PathOf(const limit_surface::Trajectory& traj, const std::vector<limi
       x = it->pose;
     } else {
       if (it == objects.begin() || it->t - (it - 1)->t > o.max_object_gap) continue;
-      x = limit_surface::PoseAtClamped(it - 1, it + 1, f.t);
+      x = push::PoseAtClamped(it - 1, it + 1, f.t);
     }
     const Pose2 rel = geometry::Between(x, f.pose);
     path.t.push_back(f.t);
@@ -556,7 +556,7 @@ ContactPath PathOf(const limit_surface::Trajectory& traj, const std::vector<limi
   return path;
 }
 
-std::vector<limit_surface::PoseSample> WithNoise(std::vector<limit_surface::PoseSample> s, double trans, double rot,
+std::vector<push::PoseSample> WithNoise(std::vector<push::PoseSample> s, double trans, double rot,
                                                  std::mt19937_64& rng) {
   std::normal_distribution<double> n(0.0, 1.0);
   for (auto& p : s) p.pose = {p.pose.x + trans * n(rng), p.pose.y + trans * n(rng), p.pose.theta + rot * n(rng)};
@@ -565,7 +565,7 @@ std::vector<limit_surface::PoseSample> WithNoise(std::vector<limit_surface::Pose
 
 }  // namespace
 
-ContactPath MeasuredContactPath(const limit_surface::Trajectory& traj, const RegistrationOptions& o) {
+ContactPath MeasuredContactPath(const push::Trajectory& traj, const RegistrationOptions& o) {
   const auto& m = traj.measured;
   // The raw noise: the recording's measurement sigmas, else the streams' own.
   double st = 0.0, sr = 0.0, ft = 0.0, unused = 0.0;
@@ -608,18 +608,18 @@ ContactPath MeasuredContactPath(const limit_surface::Trajectory& traj, const Reg
   return path;
 }
 
-ShapeFitCheck CheckShapeFit(const limit_surface::Trajectory& trajectory, const RegistrationOptions& options) {
+ShapeFitCheck CheckShapeFit(const push::Trajectory& trajectory, const RegistrationOptions& options) {
   std::vector<double> spans;
   const Contacts c = PoolContacts({&trajectory}, options, &spans);
   return CheckContacts(trajectory.object.shape, trajectory.finger.shape,
                        c.Subsampled(options.max_refine_samples, spans, options.correlation_time), options);
 }
 
-RegistrationResult RegisterShape(const limit_surface::Trajectory& trajectory, const RegistrationOptions& options) {
-  return RegisterShape(std::vector<const limit_surface::Trajectory*>{&trajectory}, options);
+RegistrationResult RegisterShape(const push::Trajectory& trajectory, const RegistrationOptions& options) {
+  return RegisterShape(std::vector<const push::Trajectory*>{&trajectory}, options);
 }
 
-RegistrationResult RegisterShape(const std::vector<const limit_surface::Trajectory*>& recordings,
+RegistrationResult RegisterShape(const std::vector<const push::Trajectory*>& recordings,
                                  const RegistrationOptions& o) {
   std::vector<double> spans;
   const Contacts all = PoolContacts(recordings, o, &spans);

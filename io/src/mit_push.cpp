@@ -240,9 +240,9 @@ MitRecording ReadMitPush(const std::string& path, const MitReadOptions& o) {
   return rec;
 }
 
-limit_surface::Trajectory MitToTrajectory(const MitRecording& rec, const limit_surface::ObjectDescription& object,
-                                          const limit_surface::FingerDescription& finger) {
-  limit_surface::Trajectory t;
+push::Trajectory MitToTrajectory(const MitRecording& rec, const push::ObjectDescription& object,
+                                          const push::FingerDescription& finger) {
+  push::Trajectory t;
   t.object = object;
   t.finger = finger;
   t.measured = rec.streams;

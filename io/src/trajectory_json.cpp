@@ -17,11 +17,11 @@ namespace pushgraph::io {
 namespace {
 
 using json = nlohmann::json;
-using limit_surface::ForceSample;
-using limit_surface::PointSample;
-using limit_surface::PoseSample;
-using limit_surface::Streams;
-using limit_surface::Trajectory;
+using push::ForceSample;
+using push::PointSample;
+using push::PoseSample;
+using push::Streams;
+using push::Trajectory;
 
 class Reader {
  public:
@@ -133,9 +133,9 @@ class Reader {
   }
 
   // {"object_pose": [trans, rot], "finger_pose": [trans, rot], "contact_point": s, "force": s}
-  limit_surface::MeasurementSigmas SigmasOf(const json& value, const std::string& path) const {
+  push::MeasurementSigmas SigmasOf(const json& value, const std::string& path) const {
     CheckKeys(value, {"object_pose", "finger_pose", "contact_point", "force"}, path);
-    limit_surface::MeasurementSigmas s;
+    push::MeasurementSigmas s;
     auto pair = [&](const char* key, double* trans, double* rot) {
       if (!value.contains(key)) return;
       const json& v = value[key];
@@ -158,7 +158,7 @@ class Reader {
 
 json ShapeJson(const geometry::Shape& shape) { return json::parse(geometry::ShapeToJson(shape, -1)); }
 
-json SigmasJson(const limit_surface::MeasurementSigmas& s) {
+json SigmasJson(const push::MeasurementSigmas& s) {
   return {{"object_pose", {s.object_trans, s.object_rot}},
           {"finger_pose", {s.finger_trans, s.finger_rot}},
           {"contact_point", s.contact},
@@ -229,10 +229,15 @@ Trajectory LoadTrajectoryJson(const std::string& path, std::vector<std::string>*
 
 // One stream row per line: readable, diff-friendly and still plain JSON.
 std::string TrajectoryToJson(const Trajectory& t, int indent) {
+  // The format holds what the estimator reads: uniform pressure under standard gravity.
+  if (t.object.pressure.kind != limit_surface::PressureKind::kUniform)
+    throw IoError("trajectory JSON: object.pressure must be uniform (the format has no other)");
+  if (t.object.gravity != limit_surface::kStandardGravity)
+    throw IoError("trajectory JSON: object.gravity must be the standard 9.80665 m/s^2 (the format has no field for it)");
   json object = {{"shape", ShapeJson(t.object.shape)},
                  {"mass", t.object.mass},
                  {"mu_surface", t.object.mu_surface},
-                 {"pressure", t.object.pressure}};
+                 {"pressure", "uniform"}};
   json finger = {{"shape", ShapeJson(t.finger.shape)}, {"mu_contact", t.finger.mu_contact}};
   if (indent < 0) {
     json doc = {{"format", kTrajectoryFormat}, {"object", object}, {"finger", finger}, {"streams", StreamsJson(t.measured)}};

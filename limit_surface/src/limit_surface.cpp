@@ -109,6 +109,16 @@ Summary Summarize(const Support& support) {
   return s;
 }
 
+RegionGeometry RegionGeometryOf(const geometry::Shape& region, const Pressure& pressure) {
+  SupportSpec spec;  // unit mass and friction: c and the centre of pressure do not depend on them
+  spec.region = region;
+  spec.pressure = pressure;
+  spec.mass = 1.0;
+  spec.mu = 1.0;
+  const Summary s = Summarize(MakeSupport(spec));
+  return {s.centre_of_pressure, s.c};
+}
+
 Twist MoveTwist(const Twist& twist, const Vec2& from, const Vec2& to) {
   const Vec2 v = Vec2(twist.vx, twist.vy) + twist.omega * CrossZ(to - from);
   return {v.x(), v.y(), twist.omega};

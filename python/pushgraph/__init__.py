@@ -13,7 +13,8 @@ C++ with the GIL released; trajectories and estimates are dicts of arrays.
     result["object_pose"], result["object_pose_cov"], result["metrics"]["object_position_rms"]
 
 Errors are exceptions with the C++ messages (what is wrong and where): GeometryError,
-LimitSurfaceError and GraphError are ValueErrors, IoError an OSError. docs/python.md has the
+LimitSurfaceError, PushError and GraphError are ValueErrors, IoError and EvaluationError
+OSErrors. docs/python.md has the
 whole API.
 """
 import json as _json
@@ -28,11 +29,13 @@ from ._pushgraph import (  # noqa: F401  (re-exported)
     OUTSIDE,
     VERTEX,
     DistanceField,
+    EvaluationError,
     GeometryError,
     GraphError,
     IoError,
     LimitSurface,
     LimitSurfaceError,
+    PushError,
     Shape,
     ShapePair,
     load_trajectory,

@@ -2,8 +2,8 @@
 import os
 from typing import Any, Dict, Optional, Sequence, Tuple, Union
 
-from ._pushgraph import (EDGE, INSIDE, ON_BOUNDARY, OUTSIDE, VERTEX, DistanceField, GeometryError, GraphError, IoError,
-                         LimitSurface, LimitSurfaceError, Shape, ShapePair, load_trajectory, read_mit_push,
+from ._pushgraph import (EDGE, INSIDE, ON_BOUNDARY, OUTSIDE, VERTEX, DistanceField, EvaluationError, GeometryError, GraphError, IoError,
+                         LimitSurface, LimitSurfaceError, PushError, Shape, ShapePair, load_trajectory, read_mit_push,
                          save_trajectory, simulate)
 
 __version__: str

@@ -3,13 +3,13 @@
 #include "common.h"
 
 #include <pushgraph/graph/estimator.h>
-#include <pushgraph/limit_surface/trajectory.h>
+#include <pushgraph/push/trajectory.h>
 
 namespace pushgraph::python {
 
-py::dict TrajectoryToDict(const limit_surface::Trajectory& trajectory);
+py::dict TrajectoryToDict(const push::Trajectory& trajectory);
 /// Throws ValueError / TypeError naming the key for a malformed dict.
-limit_surface::Trajectory TrajectoryFromDict(const py::handle& object);
+push::Trajectory TrajectoryFromDict(const py::handle& object);
 py::dict ResultToDict(const graph::EstimationResult& result);
 
 }  // namespace pushgraph::python

@@ -17,7 +17,7 @@ using namespace graph;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-EstimatorConfig ConfigFor(const limit_surface::Trajectory& t, const std::string& config_json, bool apply_sigmas) {
+EstimatorConfig ConfigFor(const push::Trajectory& t, const std::string& config_json, bool apply_sigmas) {
   EstimatorConfig cfg;
   if (apply_sigmas && t.measurement_sigmas) cfg = ApplyMeasurementSigmas(cfg, *t.measurement_sigmas);
   if (!config_json.empty()) cfg = ParseEstimatorConfig(config_json, "config", cfg);
@@ -25,7 +25,7 @@ EstimatorConfig ConfigFor(const limit_surface::Trajectory& t, const std::string&
 }
 
 struct Online {
-  limit_surface::Trajectory setup;
+  push::Trajectory setup;
   std::unique_ptr<OnlineEstimator> estimator;
 };
 
@@ -109,7 +109,7 @@ void RegisterEstimation(py::module_& m) {
       "_estimate",
       [](const py::handle& trajectory, const std::string& model, const std::string& mode, const std::string& config_json,
          bool apply_sigmas) {
-        const limit_surface::Trajectory t = TrajectoryFromDict(trajectory);
+        const push::Trajectory t = TrajectoryFromDict(trajectory);
         const Model parsed_model = ParseModel(model);
         const Mode parsed_mode = ParseMode(mode);
         const EstimatorConfig cfg = ConfigFor(t, config_json, apply_sigmas);

@@ -2,7 +2,7 @@
 // over recordings, trajectory files and simulated pushes; the tables as lists of dicts.
 #include "common.h"
 
-#include <pushgraph/io/evaluation.h>
+#include <pushgraph/evaluation/evaluation.h>
 
 #include <thread>
 
@@ -15,8 +15,8 @@ void RegisterEvaluation(py::module_& m) {
       [](const std::vector<std::string>& inputs, const std::string& protocols, int simulate, const py::object& sim_object,
          const py::object& sim_finger, double sim_mass, double sim_mu, double sim_mu_contact, std::uint64_t seed, int jobs,
          const std::string& mesh_dir, const std::string& estimator_json) {
-        io::EvaluationOptions options;
-        options.protocols = io::ParseProtocols(protocols);
+        evaluation::EvaluationOptions options;
+        options.protocols = evaluation::ParseProtocols(protocols);
         options.seed = seed;
         options.mesh_dir = mesh_dir;
         if (!estimator_json.empty()) options.estimator = graph::ParseEstimatorConfig(estimator_json, "estimator_config");
@@ -25,27 +25,27 @@ void RegisterEvaluation(py::module_& m) {
         if (simulate > 0) {
           if (sim_object.is_none() || sim_finger.is_none()) throw py::value_error("simulate > 0 needs sim_object and sim_finger shapes");
           options.simulation.object.shape = sim_object.cast<geometry::Shape>();
-          options.simulation.object.finger = sim_finger.cast<geometry::Shape>();
+          options.simulation.finger.shape = sim_finger.cast<geometry::Shape>();
           if (!(sim_mass > 0.0) || !(sim_mu > 0.0) || !(sim_mu_contact >= 0.0)) {
             throw py::value_error("sim_mass and sim_mu must be > 0, sim_mu_contact >= 0");
           }
           options.simulation.object.mass = sim_mass;
           options.simulation.object.mu_surface = sim_mu;
-          options.simulation.object.mu_contact = sim_mu_contact;
+          options.simulation.finger.mu_contact = sim_mu_contact;
           options.simulation.name = "sim";
         }
-        std::vector<io::EvaluationRow> rows;
+        std::vector<evaluation::EvaluationRow> rows;
         std::vector<std::string> notes;
         {
           py::gil_scoped_release release;
-          const std::vector<std::string> files = inputs.empty() ? std::vector<std::string>{} : io::ExpandInputs(inputs);
-          std::vector<io::EvaluationItem> items = io::PlanEvaluation(files, options);
+          const std::vector<std::string> files = inputs.empty() ? std::vector<std::string>{} : evaluation::ExpandInputs(inputs);
+          std::vector<evaluation::EvaluationItem> items = evaluation::PlanEvaluation(files, options);
           if (items.empty()) throw graph::GraphError("evaluate: nothing to evaluate: give inputs or simulate > 0");
-          notes = io::RegisterGroups(items, options);
-          rows = io::RunEvaluation(items, options, jobs);
+          notes = evaluation::RegisterGroups(items, options);
+          rows = evaluation::RunEvaluation(items, options, jobs);
         }
         py::list tables;
-        for (const io::Table& t : io::MakeTables(rows, options.SettingsJson())) {
+        for (const evaluation::Table& t : evaluation::MakeTables(rows, options.SettingsJson())) {
           py::list table_rows;
           for (const auto& r : t.rows) {
             py::dict row;
@@ -61,7 +61,7 @@ void RegisterEvaluation(py::module_& m) {
           tables.append(table);
         }
         py::list trajectories;
-        for (const io::EvaluationRow& r : rows) {
+        for (const evaluation::EvaluationRow& r : rows) {
           py::dict d;
           d["name"] = r.name;
           d["group"] = r.group;

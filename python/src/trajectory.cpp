@@ -5,13 +5,13 @@
 
 #include <pushgraph/io/mit_push.h>
 #include <pushgraph/io/trajectory_json.h>
-#include <pushgraph/limit_surface/noise.h>
-#include <pushgraph/limit_surface/simulator.h>
+#include <pushgraph/push/noise.h>
+#include <pushgraph/push/simulator.h>
 
 namespace pushgraph::python {
 namespace {
 
-using namespace limit_surface;
+using namespace push;
 
 template <class Sample, class Get>
 py::dict StreamDict(const std::vector<Sample>& samples, const char* value_name, int columns, Get get) {
@@ -128,7 +128,7 @@ py::dict TrajectoryToDict(const Trajectory& t) {
   object["shape"] = t.object.shape;
   object["mass"] = t.object.mass;
   object["mu_surface"] = t.object.mu_surface;
-  object["pressure"] = t.object.pressure;
+  object["pressure"] = "uniform";  // the only pressure trajectories carry
   finger["shape"] = t.finger.shape;
   finger["mu_contact"] = t.finger.mu_contact;
   d["object"] = object;
@@ -172,7 +172,8 @@ Trajectory TrajectoryFromDict(const py::handle& object) {
   }
   t.object.mass = Number(o, "mass", "trajectory['object']", 0.0);
   t.object.mu_surface = Number(o, "mu_surface", "trajectory['object']", 0.0);
-  if (o.contains("pressure")) t.object.pressure = py::str(o["pressure"]);
+  if (o.contains("pressure") && py::str(o["pressure"]).cast<std::string>() != "uniform")
+    throw py::value_error("trajectory['object']['pressure']: only 'uniform' is supported");
   t.finger.mu_contact = Number(f, "mu_contact", "trajectory['finger']", 0.0);
   if (!d.contains("measured")) throw py::value_error("trajectory: missing 'measured'");
   t.measured = StreamsFrom(d["measured"], "trajectory['measured']");
@@ -252,11 +253,8 @@ Raises IoError naming the file and the field.)doc");
          double force_rate, std::uint64_t seed, const py::object& waypoints, double duration, const py::object& sigmas,
          const py::object& occlusions) {
         PushPlan plan;
-        plan.object = object;
-        plan.finger = finger;
-        plan.mass = mass;
-        plan.mu_surface = mu_surface;
-        plan.mu_contact = mu_contact;
+        plan.object = {object, mass, mu_surface};
+        plan.finger = {finger, mu_contact};
         plan.object_pose = ToPose(object_pose, "object_pose");
         if (surface == "exact") plan.surface = SurfaceModel::kExact;
         else if (surface == "ellipsoid") plan.surface = SurfaceModel::kEllipsoid;

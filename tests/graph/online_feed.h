@@ -4,7 +4,7 @@
 //
 //   for (const Arrival& a : ArrivalOrder(traj, /*object_delay=*/0.06)) Deliver(a, traj, online);
 #include <pushgraph/graph/incremental.h>
-#include <pushgraph/limit_surface/trajectory.h>
+#include <pushgraph/push/trajectory.h>
 
 #include <algorithm>
 #include <vector>
@@ -21,7 +21,7 @@ struct Arrival {
 
 /// Every measured sample of `t` in arrival order (stable: streams in the order above at equal
 /// times); object poses arrive `object_delay` s after their time stamp, the others at it.
-inline std::vector<Arrival> ArrivalOrder(const limit_surface::Trajectory& t, double object_delay = 0.0) {
+inline std::vector<Arrival> ArrivalOrder(const push::Trajectory& t, double object_delay = 0.0) {
   std::vector<Arrival> out;
   const auto& m = t.measured;
   for (std::size_t i = 0; i < m.object_pose.size(); ++i) out.push_back({m.object_pose[i].t, m.object_pose[i].t + object_delay, 0, i});
@@ -33,7 +33,7 @@ inline std::vector<Arrival> ArrivalOrder(const limit_surface::Trajectory& t, dou
 }
 
 /// Hands one sample to the estimator; returns what Add* returned (false: dropped as late).
-inline bool Deliver(const Arrival& a, const limit_surface::Trajectory& t, OnlineEstimator& online) {
+inline bool Deliver(const Arrival& a, const push::Trajectory& t, OnlineEstimator& online) {
   const auto& m = t.measured;
   switch (a.stream) {
     case 0: return online.AddObjectPose(a.t, m.object_pose[a.index].pose);
@@ -45,8 +45,8 @@ inline bool Deliver(const Arrival& a, const limit_surface::Trajectory& t, Online
 
 /// What an OnlineEstimator is built from for a recording: object and finger, no samples, and
 /// the ground truth (only for Finish()'s metrics).
-inline limit_surface::Trajectory SetupOf(const limit_surface::Trajectory& t) {
-  limit_surface::Trajectory setup;
+inline push::Trajectory SetupOf(const push::Trajectory& t) {
+  push::Trajectory setup;
   setup.object = t.object;
   setup.finger = t.finger;
   setup.ground_truth = t.ground_truth;
@@ -54,7 +54,7 @@ inline limit_surface::Trajectory SetupOf(const limit_surface::Trajectory& t) {
 }
 
 /// The streams a recording has, for OnlineStreams.
-inline OnlineStreams StreamsOf(const limit_surface::Trajectory& t) {
+inline OnlineStreams StreamsOf(const push::Trajectory& t) {
   OnlineStreams s;
   s.contact_point = !t.measured.contact_point.empty();
   s.force = !t.measured.force.empty();

@@ -7,12 +7,12 @@
 // stream sample.
 //
 //   PushSpec spec;  spec.contact_offset = 0.02;   // off-centre: the object rotates
-//   limit_surface::Trajectory t = GeneratePush(spec);
+//   push::Trajectory t = GeneratePush(spec);
 #include <pushgraph/geometry/pose.h>
 #include <pushgraph/geometry/shape.h>
 #include <pushgraph/limit_surface/limit_surface.h>
 #include <pushgraph/limit_surface/support.h>
-#include <pushgraph/limit_surface/trajectory.h>
+#include <pushgraph/push/trajectory.h>
 
 #include <cmath>
 #include <random>
@@ -93,8 +93,8 @@ class PushModel {
   double c_, f_max_;
 };
 
-inline limit_surface::Trajectory GeneratePush(const PushSpec& s) {
-  limit_surface::Trajectory traj;
+inline push::Trajectory GeneratePush(const PushSpec& s) {
+  push::Trajectory traj;
   traj.object.shape = geometry::Shape::Box(s.side, s.side);
   traj.object.mass = s.mass;
   traj.object.mu_surface = s.mu;
@@ -114,7 +114,7 @@ inline limit_surface::Trajectory GeneratePush(const PushSpec& s) {
     for (int i = 0; i <= static_cast<int>(std::floor(s.duration * rate + 1e-9)); ++i) t.push_back(i / rate);
     return t;
   };
-  limit_surface::Streams gt;
+  push::Streams gt;
   const auto to = clock(s.object_rate), tf = clock(s.finger_rate), tc = clock(s.contact_rate), tfo = clock(s.force_rate);
   const auto xo = model.Sample(to), xf = model.Sample(tf), xc = model.Sample(tc), xfo = model.Sample(tfo);
   for (std::size_t i = 0; i < to.size(); ++i) {

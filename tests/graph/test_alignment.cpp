@@ -3,7 +3,7 @@
 // shape file turned, shifted and in millimetres; a wrong probe radius; a frozen force sensor.
 #include <pushgraph/geometry/point_query.h>
 #include <pushgraph/graph/estimator.h>
-#include <pushgraph/limit_surface/simulator.h>
+#include <pushgraph/push/simulator.h>
 
 #include <gtest/gtest.h>
 
@@ -24,22 +24,22 @@ const std::string kData = std::string(PUSHGRAPH_SOURCE_DIR) + "/data/shapes/";
 
 // A push of the notched block with the paper's Gaussian noise (5 mm, 0.05 rad, 0.5 N) on every
 // stream, the sigmas recorded in the trajectory.
-limit_surface::Trajectory NotchedPush(double angle, double offset, unsigned seed, const Shape& finger = Shape::Disk(0.005)) {
-  limit_surface::PushPlan plan;
-  plan.object = geometry::LoadShapeJson(kData + "notched_block.json");
-  plan.finger = finger;
-  plan.mass = 0.5;
-  plan.mu_surface = 0.3;
-  plan.mu_contact = 0.4;
-  plan.waypoints = limit_surface::StraightPushPath(plan, angle, offset, 0.005, 0.06);
-  plan.noise = limit_surface::DefaultNoise(limit_surface::NoiseKind::kGaussian);
-  for (limit_surface::StreamNoise* s : {&plan.noise.object_pose, &plan.noise.finger_pose, &plan.noise.contact_point}) {
+push::Trajectory NotchedPush(double angle, double offset, unsigned seed, const Shape& finger = Shape::Disk(0.005)) {
+  push::PushPlan plan;
+  plan.object.shape = geometry::LoadShapeJson(kData + "notched_block.json");
+  plan.finger.shape = finger;
+  plan.object.mass = 0.5;
+  plan.object.mu_surface = 0.3;
+  plan.finger.mu_contact = 0.4;
+  plan.waypoints = push::StraightPushPath(plan, angle, offset, 0.005, 0.06);
+  plan.noise = push::DefaultNoise(push::NoiseKind::kGaussian);
+  for (push::StreamNoise* s : {&plan.noise.object_pose, &plan.noise.finger_pose, &plan.noise.contact_point}) {
     s->position.sigma = 0.005;
   }
   plan.noise.object_pose.angle.sigma = 0.05;
   plan.noise.force.position.sigma = 0.5;
   plan.seed = seed;
-  return limit_surface::Simulate(plan).trajectory;
+  return push::Simulate(plan).trajectory;
 }
 
 double OutlineDistance(const Shape& a, const Shape& b) {
@@ -92,7 +92,7 @@ TEST(Alignment, MisframedShapesAreAlignedAndEstimatedAsWellAsTheTrueOne) {
   std::vector<double> outlines, ratios, off_ratios;
   int cases = 0, flagged = 0, aligned_count = 0;
   for (unsigned seed = 2; seed <= 4; ++seed) {
-    const limit_surface::Trajectory truth = NotchedPush(1.1 * seed, 0.006 * ((seed % 3) - 1.0), seed);
+    const push::Trajectory truth = NotchedPush(1.1 * seed, 0.006 * ((seed % 3) - 1.0), seed);
     EstimatorConfig cfg = ApplyMeasurementSigmas({}, *truth.measurement_sigmas);
     const EstimationResult reference = Estimate(truth, Model::kQs, Mode::kBatch, cfg);
     ASSERT_TRUE(reference.shape_alignment && reference.shape_alignment->checked);
@@ -103,7 +103,7 @@ TEST(Alignment, MisframedShapesAreAlignedAndEstimatedAsWellAsTheTrueOne) {
     }
     const double rms = reference.metrics.at("object_position_rms");
     for (const Misframe& m : misframes) {
-      limit_surface::Trajectory t = truth;
+      push::Trajectory t = truth;
       t.object.shape = FileShape(truth.object.shape, m);
       const EstimationResult aligned = Estimate(t, Model::kQs, Mode::kBatch, cfg);
       EstimatorConfig off = cfg;
@@ -151,9 +151,9 @@ TEST(Alignment, MisframedShapesAreAlignedAndEstimatedAsWellAsTheTrueOne) {
 }
 
 TEST(Alignment, IncrementalModeUsesTheAlignedShape) {
-  const limit_surface::Trajectory truth = NotchedPush(1.0, 0.0, 5);
+  const push::Trajectory truth = NotchedPush(1.0, 0.0, 5);
   EstimatorConfig cfg = ApplyMeasurementSigmas({}, *truth.measurement_sigmas);
-  limit_surface::Trajectory t = truth;
+  push::Trajectory t = truth;
   t.object.shape = FileShape(truth.object.shape, {"", {0.015, 0.01, 2.0}, 1.0});
   const EstimationResult reference = Estimate(truth, Model::kQs, Mode::kIncremental, cfg);
   const EstimationResult aligned = Estimate(t, Model::kQs, Mode::kIncremental, cfg);
@@ -165,17 +165,17 @@ TEST(Alignment, IncrementalModeUsesTheAlignedShape) {
 }
 
 TEST(Alignment, DiskRotationIsUnobservableAndReportedSo) {
-  limit_surface::PushPlan plan;
-  plan.object = Shape::RegularPolygon(64, 0.05);  // the simulator's support region is polygonal
-  plan.finger = Shape::Disk(0.005);
-  plan.mass = 0.8;
-  plan.mu_surface = 0.3;
-  plan.mu_contact = 0.3;
-  plan.waypoints = limit_surface::StraightPushPath(plan, 0.3, 0.01, 0.005, 0.06);
-  plan.noise = limit_surface::DefaultNoise(limit_surface::NoiseKind::kGaussian);
-  const limit_surface::Trajectory truth = limit_surface::Simulate(plan).trajectory;
-  limit_surface::Trajectory t = truth;
-  t.object.shape = geometry::TransformShape(plan.object, Pose2{0.02, -0.01, 0.3});  // the file's origin is not the centre
+  push::PushPlan plan;
+  plan.object.shape = Shape::RegularPolygon(64, 0.05);  // the simulator's support region is polygonal
+  plan.finger.shape = Shape::Disk(0.005);
+  plan.object.mass = 0.8;
+  plan.object.mu_surface = 0.3;
+  plan.finger.mu_contact = 0.3;
+  plan.waypoints = push::StraightPushPath(plan, 0.3, 0.01, 0.005, 0.06);
+  plan.noise = push::DefaultNoise(push::NoiseKind::kGaussian);
+  const push::Trajectory truth = push::Simulate(plan).trajectory;
+  push::Trajectory t = truth;
+  t.object.shape = geometry::TransformShape(plan.object.shape, Pose2{0.02, -0.01, 0.3});  // the file's origin is not the centre
   const EstimationResult r = Estimate(t, Model::kQs, Mode::kBatch, ApplyMeasurementSigmas({}, *t.measurement_sigmas));
   ASSERT_TRUE(r.shape_alignment && r.shape_alignment->aligned);
   EXPECT_FALSE(r.shape_alignment->rotation_observable);
@@ -186,7 +186,7 @@ TEST(Alignment, DiskRotationIsUnobservableAndReportedSo) {
 }
 
 TEST(Diagnostics, AHealthyEstimateHasChiSquaresNearTheirExpectation) {
-  const limit_surface::Trajectory t = NotchedPush(0.9, 0.0, 7);
+  const push::Trajectory t = NotchedPush(0.9, 0.0, 7);
   const EstimationResult r = Estimate(t, Model::kQs, Mode::kBatch, ApplyMeasurementSigmas({}, *t.measurement_sigmas));
   ASSERT_TRUE(r.diagnostics);
   const Diagnostics& d = *r.diagnostics;
@@ -205,9 +205,9 @@ TEST(Diagnostics, AHealthyEstimateHasChiSquaresNearTheirExpectation) {
 }
 
 TEST(Diagnostics, AWrongProbeRadiusIsNamed) {
-  const limit_surface::Trajectory truth = NotchedPush(2.0, 0.005, 8);
+  const push::Trajectory truth = NotchedPush(2.0, 0.005, 8);
   for (double radius : {0.0025, 0.009}) {
-    limit_surface::Trajectory t = truth;
+    push::Trajectory t = truth;
     t.finger.shape = Shape::Disk(radius);
     const EstimationResult r = Estimate(t, Model::kQs, Mode::kBatch, ApplyMeasurementSigmas({}, *t.measurement_sigmas));
     for (const std::string& w : r.warnings) std::printf("[diagnostics] radius %.1f mm: %s\n", radius * 1e3, w.c_str());
@@ -218,7 +218,7 @@ TEST(Diagnostics, AWrongProbeRadiusIsNamed) {
 }
 
 TEST(Diagnostics, AFrozenForceSensorIsNamed) {
-  limit_surface::Trajectory t = NotchedPush(0.5, -0.005, 9);
+  push::Trajectory t = NotchedPush(0.5, -0.005, 9);
   // The force sensor sticks at two values (as the MIT rect1 files do) after the first 50 samples.
   for (std::size_t i = 50; i < t.measured.force.size(); ++i) {
     t.measured.force[i].force = i < t.measured.force.size() / 2 ? Vec2(0.8, 0.1) : Vec2(0.2, -0.3);

@@ -8,7 +8,7 @@
 #include <pushgraph/graph/incremental.h>
 #include <pushgraph/graph/marginals.h>
 #include <pushgraph/io/mit_push.h>
-#include <pushgraph/limit_surface/simulator.h>
+#include <pushgraph/push/simulator.h>
 
 #include "graph/push_generator.h"
 
@@ -217,7 +217,7 @@ TEST(ChainSolver, NamesTheFactorThatIsNotFiniteAtTheStart) {
 }
 
 // Both solvers to tight tolerances on the same trajectory: the same minimum.
-void ExpectSameMinimum(const limit_surface::Trajectory& traj, Model model, const char* what, double state_tolerance = 1e-6) {
+void ExpectSameMinimum(const push::Trajectory& traj, Model model, const char* what, double state_tolerance = 1e-6) {
   EstimatorConfig cfg;
   if (traj.measurement_sigmas) cfg = ApplyMeasurementSigmas(cfg, *traj.measurement_sigmas);
   cfg.function_tolerance = 1e-12;
@@ -254,19 +254,19 @@ TEST(ChainSolver, SameMinimumAsCeresOnSimulatedPushes) {
   testing::PushSpec spec;
   spec.contact_offset = 0.02;
   spec.duration = 1.5;
-  const limit_surface::Trajectory square = testing::GeneratePush(spec);
+  const push::Trajectory square = testing::GeneratePush(spec);
   ExpectSameMinimum(square, Model::kQs, "square, QS");
   ExpectSameMinimum(square, Model::kCp, "square, CP");
-  limit_surface::PushPlan plan;
-  plan.object = geometry::LoadShapeJson(std::string(PUSHGRAPH_SOURCE_DIR) + "/data/shapes/notched_block.json");
-  plan.finger = geometry::Shape::Disk(0.005);
-  plan.mass = 0.5;
-  plan.mu_surface = 0.3;
-  plan.mu_contact = 0.4;
-  plan.waypoints = limit_surface::StraightPushPath(plan, 0.7, 0.01, 0.005, 0.05);
-  plan.noise = limit_surface::DefaultNoise(limit_surface::NoiseKind::kGaussian);
+  push::PushPlan plan;
+  plan.object.shape = geometry::LoadShapeJson(std::string(PUSHGRAPH_SOURCE_DIR) + "/data/shapes/notched_block.json");
+  plan.finger.shape = geometry::Shape::Disk(0.005);
+  plan.object.mass = 0.5;
+  plan.object.mu_surface = 0.3;
+  plan.finger.mu_contact = 0.4;
+  plan.waypoints = push::StraightPushPath(plan, 0.7, 0.01, 0.005, 0.05);
+  plan.noise = push::DefaultNoise(push::NoiseKind::kGaussian);
   plan.seed = 3;
-  ExpectSameMinimum(limit_surface::Simulate(plan).trajectory, Model::kQs, "notched block, QS");
+  ExpectSameMinimum(push::Simulate(plan).trajectory, Model::kQs, "notched block, QS");
 }
 
 TEST(ChainSolver, SameMinimumAsCeresOnARealRecording) {
@@ -276,14 +276,14 @@ TEST(ChainSolver, SameMinimumAsCeresOnARealRecording) {
   io::MitReadOptions options;
   options.trim_to_contact = true;
   const io::MitRecording rec = io::ReadMitPush(file, options);
-  limit_surface::ObjectDescription object;
+  push::ObjectDescription object;
   object.shape = geometry::Shape::Box(0.09, 0.09);
   object.mass = 0.8374;
   object.mu_surface = 0.35;
-  limit_surface::FingerDescription finger;
+  push::FingerDescription finger;
   finger.shape = geometry::Shape::Disk(0.00235);
   finger.mu_contact = 0.2;
-  limit_surface::Trajectory t = io::MitToTrajectory(rec, object, finger);
+  push::Trajectory t = io::MitToTrajectory(rec, object, finger);
   std::mt19937_64 rng(5);
   std::normal_distribution<double> n(0.0, 1.0);
   for (auto& s : t.measured.object_pose) s.pose = {s.pose.x + 0.005 * n(rng), s.pose.y + 0.005 * n(rng), s.pose.theta + 0.05 * n(rng)};
@@ -295,7 +295,7 @@ TEST(ChainSolver, IncrementalAtEveryStepMatchesBatch) {
   testing::PushSpec spec;
   spec.contact_offset = 0.02;
   spec.duration = 0.8;
-  const limit_surface::Trajectory traj = testing::GeneratePush(spec);
+  const push::Trajectory traj = testing::GeneratePush(spec);
   EstimatorConfig cfg;
   cfg.diagnostics = false;
   cfg.solver = EstimatorConfig::Solver::kChain;

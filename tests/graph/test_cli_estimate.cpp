@@ -1,6 +1,6 @@
 // `pushgraph estimate`: RESULT.json layout (the format) for every model and both modes,
 // MIT recordings as input with added noise, and one-line errors for bad input.
-#include <pushgraph/io/result_json.h>
+#include <pushgraph/evaluation/result_json.h>
 #include <pushgraph/io/trajectory_json.h>
 
 #include "graph/push_generator.h"
@@ -113,7 +113,7 @@ TEST_F(EstimateCli, BadInputGetsOneLineErrors) {
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find("/nonexistent/push.json"), std::string::npos) << r.err;
   // No object measurements at all.
-  limit_surface::Trajectory t = io::LoadTrajectoryJson(in);
+  push::Trajectory t = io::LoadTrajectoryJson(in);
   t.measured.object_pose.clear();
   const std::string empty = dir() + "/estimate_no_object.json";
   io::SaveTrajectoryJson(t, empty);
@@ -130,8 +130,8 @@ TEST_F(EstimateCli, BadInputGetsOneLineErrors) {
 // The data's measurement sigmas first, the configuration file's keys on top: a config that
 // claims a 20x smaller object noise than the file's makes the covariances overconfident.
 TEST_F(EstimateCli, ConfigOverridesTheDataMeasurementSigmas) {
-  limit_surface::Trajectory t = io::LoadTrajectoryJson(WritePush());
-  limit_surface::MeasurementSigmas sigmas;
+  push::Trajectory t = io::LoadTrajectoryJson(WritePush());
+  push::MeasurementSigmas sigmas;
   sigmas.object_trans = 0.005;
   sigmas.object_rot = 0.05;
   sigmas.finger_trans = 0.005;
@@ -157,7 +157,7 @@ TEST_F(EstimateCli, ConfigOverridesTheDataMeasurementSigmas) {
 // Forces whose size nothing fixes (no force stream, no limit-surface load) are not reported:
 // RESULT.json has no force and a warning says why, also on stderr.
 TEST_F(EstimateCli, ForcesWithoutAScaleAreLeftOutWithAWarning) {
-  limit_surface::Trajectory t = io::LoadTrajectoryJson(WritePush());
+  push::Trajectory t = io::LoadTrajectoryJson(WritePush());
   t.measured.force.clear();
   const std::string in = dir() + "/estimate_no_force.json";
   io::SaveTrajectoryJson(t, in);
@@ -187,9 +187,9 @@ TEST_F(EstimateCli, RefusesInputsItWouldMisread) {
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("is a directory"), std::string::npos) << r.err;
   // Noise on streams that already carry it, with no ground truth to score against.
-  limit_surface::Trajectory t = io::LoadTrajectoryJson(in);
+  push::Trajectory t = io::LoadTrajectoryJson(in);
   t.ground_truth.reset();
-  t.measurement_sigmas = limit_surface::MeasurementSigmas{0.005, 0.05, 0.005, 0.05, 0.005, 0.5};
+  t.measurement_sigmas = push::MeasurementSigmas{0.005, 0.05, 0.005, 0.05, 0.005, 0.5};
   const std::string noisy = dir() + "/estimate_noisy_no_truth.json";
   io::SaveTrajectoryJson(t, noisy);
   r = Tool("estimate " + noisy + " --add-noise gaussian -o " + out);
@@ -202,7 +202,7 @@ TEST_F(EstimateCli, RefusesInputsItWouldMisread) {
   r = Tool("estimate " + in + " --mu -0.1 -o " + out);
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find("--mu"), std::string::npos) << r.err;
-  for (const std::string flag : {"--mass", "--mu", "--mu-contact"}) {  // CLI11's range checks pass NaN
+  for (const std::string flag : {"--mass", "--mu"}) {  // CLI11's range checks pass NaN
     r = Tool("estimate " + in + " " + flag + " nan -o " + out);
     EXPECT_NE(r.status, 0) << flag;
     EXPECT_NE(r.err.find("must be a finite number"), std::string::npos) << flag << ": " << r.err;

@@ -69,11 +69,11 @@ TEST(Estimator, ConfigParsingNamesBadKeys) {
   EXPECT_EQ(d.limit_surface_load, EstimatorConfig::LimitSurfaceLoad::kOn);
   // A config file overrides a base (the trajectory's measurement sigmas) by name only.
   EstimatorConfig base;
-  base.force_sigma = 0.123;
-  base.object_pose_sigma_trans = 0.007;
+  base.measurement.force = 0.123;
+  base.measurement.object_trans = 0.007;
   const EstimatorConfig over = ParseEstimatorConfig(R"({"force_sigma": 0.5})", "cfg.json", base);
-  EXPECT_EQ(over.force_sigma, 0.5);
-  EXPECT_EQ(over.object_pose_sigma_trans, 0.007);
+  EXPECT_EQ(over.measurement.force, 0.5);
+  EXPECT_EQ(over.measurement.object_trans, 0.007);
 }
 
 // Joint estimation of c: started 40% too high, the estimate moves towards the value of the
@@ -81,7 +81,7 @@ TEST(Estimator, ConfigParsingNamesBadKeys) {
 TEST(Estimator, JointEstimationOfCMovesTowardsTheTruth) {
   PushSpec spec = OffsetPush(7);
   spec.contact_offset = 0.03;  // off-centre: rotation makes c observable
-  const limit_surface::Trajectory t = GeneratePush(spec);
+  const push::Trajectory t = GeneratePush(spec);
   EstimatorConfig cfg;
   const double c_true = QuasiStaticGeometryFor(t, cfg).c;
   cfg.c_scale = 1.4;
@@ -103,7 +103,7 @@ TEST(Estimator, JointEstimationOfCMovesTowardsTheTruth) {
 }
 
 // The GraphError message of a QS batch estimate ("no error" when it succeeds).
-std::string BatchQsError(const limit_surface::Trajectory& t, const EstimatorConfig& cfg) {
+std::string BatchQsError(const push::Trajectory& t, const EstimatorConfig& cfg) {
   try {
     Estimate(t, Model::kQs, Mode::kBatch, cfg);
   } catch (const GraphError& e) {
@@ -116,7 +116,7 @@ std::string BatchQsError(const limit_surface::Trajectory& t, const EstimatorConf
 // the ellipsoidal limit surface exactly). Started 40% high, the estimate must come back.
 TEST(Estimator, JointEstimationOfMuMovesTowardsTheTruth) {
   PushSpec spec = OffsetPush(11);
-  limit_surface::Trajectory t = GeneratePush(spec);
+  push::Trajectory t = GeneratePush(spec);
   const double mu_true = spec.mu;
   t.object.mu_surface = 1.4 * mu_true;
   EstimatorConfig cfg;
@@ -144,7 +144,7 @@ TEST(Estimator, JointEstimationOfMuMovesTowardsTheTruth) {
   {
     PushSpec turn = OffsetPush(7);
     turn.contact_offset = 0.03;  // off-centre: rotation makes c observable
-    limit_surface::Trajectory both = GeneratePush(turn);
+    push::Trajectory both = GeneratePush(turn);
     both.object.mu_surface = 1.4 * turn.mu;
     EstimatorConfig cm;
     const double c_true = QuasiStaticGeometryFor(both, cm).c;
@@ -162,7 +162,7 @@ TEST(Estimator, JointEstimationOfMuMovesTowardsTheTruth) {
   }
   // Without a force stream mu is not observable (forces and mu scale together): refused.
   {
-    limit_surface::Trajectory no_force = t;
+    push::Trajectory no_force = t;
     no_force.measured.force.clear();
     EstimatorConfig nf;
     nf.estimate_mu = true;
@@ -170,7 +170,7 @@ TEST(Estimator, JointEstimationOfMuMovesTowardsTheTruth) {
     EXPECT_NE(why.find("force stream"), std::string::npos) << why;
   }
   // Without the object's friction there is nothing to start from: a clear error.
-  limit_surface::Trajectory no_mu = t;
+  push::Trajectory no_mu = t;
   no_mu.object.mu_surface = 0.0;
   cfg.estimate_mu = true;
   const std::string why = BatchQsError(no_mu, cfg);
@@ -178,7 +178,7 @@ TEST(Estimator, JointEstimationOfMuMovesTowardsTheTruth) {
 }
 
 TEST(Estimator, MeasurementSigmasSetTheMeasurementFactors) {
-  limit_surface::MeasurementSigmas s;
+  push::MeasurementSigmas s;
   s.object_trans = 0.002;
   s.object_rot = 0.02;
   s.finger_trans = 0.0005;
@@ -186,12 +186,12 @@ TEST(Estimator, MeasurementSigmasSetTheMeasurementFactors) {
   s.contact = 0.001;
   s.force = 0.05;
   const EstimatorConfig c = ApplyMeasurementSigmas(EstimatorConfig{}, s);
-  EXPECT_EQ(c.object_pose_sigma_trans, 0.002);
-  EXPECT_EQ(c.object_pose_sigma_rot, 0.02);
-  EXPECT_EQ(c.finger_pose_sigma_trans, 0.0005);
-  EXPECT_EQ(c.finger_pose_sigma_rot, 1e-3);
-  EXPECT_EQ(c.contact_sigma, 0.001);
-  EXPECT_EQ(c.force_sigma, 0.05);
+  EXPECT_EQ(c.measurement.object_trans, 0.002);
+  EXPECT_EQ(c.measurement.object_rot, 0.02);
+  EXPECT_EQ(c.measurement.finger_trans, 0.0005);
+  EXPECT_EQ(c.measurement.finger_rot, 1e-3);
+  EXPECT_EQ(c.measurement.contact, 0.001);
+  EXPECT_EQ(c.measurement.force, 0.05);
   EXPECT_NO_THROW(ValidateConfig(c));
   s.force = NAN;
   EXPECT_THROW(ApplyMeasurementSigmas(EstimatorConfig{}, s), GraphError);
@@ -200,7 +200,7 @@ TEST(Estimator, MeasurementSigmasSetTheMeasurementFactors) {
 // A corrupted force byte (1e5 N in a 0.8 kg push) is a sensor fault: left out with a warning
 // naming it, so the estimate is the one without it (with it, LM chases the spike).
 TEST(Estimator, ForceSpikesAreLeftOutAsSensorFaults) {
-  limit_surface::Trajectory traj = GeneratePush(OffsetPush(4));
+  push::Trajectory traj = GeneratePush(OffsetPush(4));
   EstimatorConfig cfg = ApplyMeasurementSigmas(EstimatorConfig{}, *traj.measurement_sigmas);
   cfg.covariance = false;
   cfg.diagnostics = false;
@@ -218,8 +218,8 @@ TEST(Estimator, ForceSpikesAreLeftOutAsSensorFaults) {
 }
 
 TEST(Estimator, BadTrajectoriesGetClearErrors) {
-  limit_surface::Trajectory t = GeneratePush(OffsetPush(1, 0.3));
-  auto message = [](const limit_surface::Trajectory& tr) {
+  push::Trajectory t = GeneratePush(OffsetPush(1, 0.3));
+  auto message = [](const push::Trajectory& tr) {
     try {
       Estimate(tr, Model::kQs, Mode::kBatch);
     } catch (const GraphError& e) {
@@ -265,7 +265,7 @@ TEST(Estimator, BadTrajectoriesGetClearErrors) {
 }
 
 TEST(Estimator, StepsFollowTheInputClocks) {
-  const limit_surface::Trajectory t = GeneratePush(OffsetPush(2, 0.4));
+  const push::Trajectory t = GeneratePush(OffsetPush(2, 0.4));
   EstimatorConfig cfg;
   cfg.covariance = false;
   const EstimationResult r = Estimate(t, Model::kCp, Mode::kBatch, cfg);
@@ -281,7 +281,7 @@ TEST(Estimator, StepsFollowTheInputClocks) {
 // Recovery with the paper's noise (0.5 cm, 0.5 N): every model beats the raw measurements on
 // every quantity it estimates; the force and contact estimates too.
 TEST(Estimator, EveryModelBeatsTheRawMeasurements) {
-  const limit_surface::Trajectory t = GeneratePush(OffsetPush(3));
+  const push::Trajectory t = GeneratePush(OffsetPush(3));
   for (Model m : {Model::kCp, Model::kSdf, Model::kQs, Model::kYu}) {
     const EstimationResult r = Estimate(t, m, Mode::kBatch);
     const auto& x = r.metrics;
@@ -313,7 +313,7 @@ TEST(Estimator, QsBeatsSdfBeatsCpOnObjectPoseAndCovariancesAreConsistent) {
   for (int seed = 0; seed < seeds; ++seed) {
     PushSpec spec = OffsetPush(100 + seed);
     spec.contact_offset = (seed % 2 == 0 ? 1 : -1) * (0.01 + 0.01 * seed);
-    const limit_surface::Trajectory t = GeneratePush(spec);
+    const push::Trajectory t = GeneratePush(spec);
     for (Model m : {Model::kCp, Model::kSdf, Model::kQs, Model::kYu}) {
       const EstimationResult r = Estimate(t, m, Mode::kBatch);
       pos[m] += r.metrics.at("object_position_rms") / seeds;
@@ -343,10 +343,10 @@ TEST(Estimator, ForcesAndContactsRecoveredUnderBimodalNoise) {
   spec.bimodal_contact_force = true;
   spec.sigma_contact = 0.004;
   spec.sigma_force = 0.4;
-  const limit_surface::Trajectory t = GeneratePush(spec);
+  const push::Trajectory t = GeneratePush(spec);
   EstimatorConfig cfg;
-  cfg.contact_sigma = 0.006;
-  cfg.force_sigma = 0.6;
+  cfg.measurement.contact = 0.006;
+  cfg.measurement.force = 0.6;
   cfg.covariance = false;
   const EstimationResult r = Estimate(t, Model::kQs, Mode::kBatch, cfg);
   std::printf("[bimodal] contact %.2f mm (raw %.2f), force %.3f N (raw %.3f)\n", 1e3 * r.metrics.at("contact_rms"),
@@ -361,7 +361,7 @@ TEST(Estimator, OcclusionQsKeepsAPhysicalPath) {
   PushSpec spec = OffsetPush(11, 2.0);
   spec.occlusion_begin = 0.5;
   spec.occlusion_end = 1.5;
-  const limit_surface::Trajectory t = GeneratePush(spec);
+  const push::Trajectory t = GeneratePush(spec);
   geometry::ShapePairQuerier pair(t.object.shape, t.finger.shape);
   const auto& gt = t.ground_truth->object_pose;
   std::map<Model, double> occluded_rms;
@@ -396,7 +396,7 @@ TEST(Estimator, OcclusionQsKeepsAPhysicalPath) {
 // With no force stream and no limit-surface load nothing fixes the forces' size: both modes
 // leave them out and say why, rather than reporting 0 N with a confident covariance.
 TEST(Estimator, ForcesWithoutAScaleAreNotReported) {
-  limit_surface::Trajectory t = GeneratePush(OffsetPush(3, 0.4));
+  push::Trajectory t = GeneratePush(OffsetPush(3, 0.4));
   t.measured.force.clear();
   EstimatorConfig off;
   off.limit_surface_load = EstimatorConfig::LimitSurfaceLoad::kOff;
@@ -418,7 +418,7 @@ TEST(Estimator, ForcesWithoutAScaleAreNotReported) {
 // Incremental fixed-lag smoothing: the window stays bounded as the trajectory grows, and the
 // final estimate is close to the batch one.
 TEST(Incremental, BoundedWindowAndCloseToBatch) {
-  const limit_surface::Trajectory t = GeneratePush(OffsetPush(21, 3.0));
+  const push::Trajectory t = GeneratePush(OffsetPush(21, 3.0));
   for (Model m : {Model::kQs, Model::kSdf}) {
     const EstimationResult batch = Estimate(t, m, Mode::kBatch);
     IncrementalEstimator inc(t, m);

@@ -283,7 +283,7 @@ TEST(SparseMarginals, RefusesSingularProblemsAndEarlyQueries) {
 }
 
 // The push generator's 2 cm off-centre push.
-limit_surface::Trajectory OffsetPush(unsigned seed, double duration) {
+push::Trajectory OffsetPush(unsigned seed, double duration) {
   testing::PushSpec spec;
   spec.contact_offset = 0.02;
   spec.duration = duration;
@@ -294,7 +294,7 @@ limit_surface::Trajectory OffsetPush(unsigned seed, double duration) {
 // Stiff geometric factors make the estimator's J^T J ill-conditioned: the default method falls
 // back to the QR of ceres::Covariance and reports the same covariances as asking for it.
 TEST(SparseMarginals, EstimatorFallsBackToTheQrWhenIllConditioned) {
-  const limit_surface::Trajectory traj = OffsetPush(4, 0.4);
+  const push::Trajectory traj = OffsetPush(4, 0.4);
   EstimatorConfig stiff;
   stiff.touching_sigma = stiff.contact_object_sigma = stiff.contact_finger_sigma = stiff.intersection_sigma = 1e-10;
   EstimatorConfig reference = stiff;
@@ -309,7 +309,7 @@ TEST(SparseMarginals, EstimatorFallsBackToTheQrWhenIllConditioned) {
 }
 
 TEST(SparseMarginals, EstimatorCovariancesEqualCeresCovariance) {
-  const limit_surface::Trajectory traj = OffsetPush(3, 0.8);
+  const push::Trajectory traj = OffsetPush(3, 0.8);
   for (Mode mode : {Mode::kBatch, Mode::kIncremental}) {
     EstimatorConfig fast, reference;
     fast.estimate_c = reference.estimate_c = mode == Mode::kBatch;

@@ -35,7 +35,7 @@ PushSpec OffsetPush(unsigned seed, double duration) {
 
 // Every sample of `t` in time order; samples sharing a time stamp are delivered together,
 // then `after_stamp` runs (a robot loop polling UpdateDue).
-void Feed(const limit_surface::Trajectory& t, OnlineEstimator& online, const std::function<void()>& after_stamp) {
+void Feed(const push::Trajectory& t, OnlineEstimator& online, const std::function<void()>& after_stamp) {
   const std::vector<Arrival> arrivals = ArrivalOrder(t);
   for (std::size_t k = 0; k < arrivals.size(); ++k) {
     Deliver(arrivals[k], t, online);
@@ -54,7 +54,7 @@ double WorstTranslationGap(const EstimationResult& a, const EstimationResult& b)
 
 // Fed the same samples at the same update times, the online smoother is the replay.
 TEST(Online, SameEstimateAsTheReplayOfTheRecording) {
-  const limit_surface::Trajectory t = GeneratePush(OffsetPush(21, 2.0));
+  const push::Trajectory t = GeneratePush(OffsetPush(21, 2.0));
   for (Model model : {Model::kQs, Model::kCp}) {
     IncrementalEstimator replay(t, model);
     while (!replay.Done()) replay.Update();
@@ -96,7 +96,7 @@ TEST(Online, KeepsUpdatingThroughAnOcclusion) {
   PushSpec spec = OffsetPush(5, 2.0);
   spec.occlusion_begin = 0.6;
   spec.occlusion_end = 1.4;
-  const limit_surface::Trajectory t = GeneratePush(spec);
+  const push::Trajectory t = GeneratePush(spec);
   IncrementalEstimator replay(t, Model::kQs);
   while (!replay.Done()) replay.Update();
   const EstimationResult expected = replay.Finish();
@@ -128,7 +128,7 @@ TEST(Online, WaitsForASlowerSensor) {
   for (double object_rate : {25.0, 250.0}) {
     PushSpec spec = OffsetPush(9, 1.5);
     spec.object_rate = object_rate;
-    const limit_surface::Trajectory t = GeneratePush(spec);
+    const push::Trajectory t = GeneratePush(spec);
     IncrementalEstimator replay(t, Model::kQs);
     while (!replay.Done()) replay.Update();
     const EstimationResult expected = replay.Finish();
@@ -158,7 +158,7 @@ TEST(Online, WaitsForASlowerSensor) {
 // Without a force stream and with the limit-surface load off nothing fixes the forces' size:
 // online, neither the newest state nor the final result reports them.
 TEST(Online, LeavesOutForcesWithoutAScale) {
-  limit_surface::Trajectory t = GeneratePush(OffsetPush(4, 0.6));
+  push::Trajectory t = GeneratePush(OffsetPush(4, 0.6));
   t.measured.force.clear();
   EstimatorConfig off;
   off.limit_surface_load = EstimatorConfig::LimitSurfaceLoad::kOff;
@@ -176,11 +176,11 @@ TEST(Online, LeavesOutForcesWithoutAScale) {
 // A corrupted force sample (1e5 N) arriving online is a sensor fault as in batch: AddForce
 // returns false, it is counted, and Finish() warns about it; the estimate is the one without it.
 TEST(Online, ForceSpikesAreLeftOutAsSensorFaults) {
-  const limit_surface::Trajectory t = GeneratePush(OffsetPush(22, 1.0));
-  limit_surface::Trajectory spiked = t;
+  const push::Trajectory t = GeneratePush(OffsetPush(22, 1.0));
+  push::Trajectory spiked = t;
   const std::size_t k = spiked.measured.force.size() / 2;
   spiked.measured.force[k].force = Vec2(1e5, 0.0);
-  auto run = [](const limit_surface::Trajectory& traj, int* faults) {
+  auto run = [](const push::Trajectory& traj, int* faults) {
     OnlineEstimator online(SetupOf(traj), Model::kQs, {}, StreamsOf(traj));
     Feed(traj, online, [&] {
       if (online.UpdateDue()) online.Update();
@@ -201,8 +201,8 @@ TEST(Online, ForceSpikesAreLeftOutAsSensorFaults) {
 }
 
 TEST(Online, RefusesBadAndLateSamples) {
-  const limit_surface::Trajectory t = GeneratePush(OffsetPush(3, 0.3));
-  const limit_surface::Trajectory setup = SetupOf(t);
+  const push::Trajectory t = GeneratePush(OffsetPush(3, 0.3));
+  const push::Trajectory setup = SetupOf(t);
   const geometry::Pose2 pose = t.measured.object_pose.front().pose;
   const geometry::Pose2 finger = t.measured.finger_pose.front().pose;
 

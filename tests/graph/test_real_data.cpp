@@ -12,18 +12,18 @@
 namespace pushgraph::graph {
 namespace {
 
-limit_surface::Trajectory NoisyMit(const std::string& file, const geometry::Shape& shape, double mass, unsigned seed) {
+push::Trajectory NoisyMit(const std::string& file, const geometry::Shape& shape, double mass, unsigned seed) {
   io::MitReadOptions options;
   options.trim_to_contact = true;
   const io::MitRecording rec = io::ReadMitPush(file, options);
-  limit_surface::ObjectDescription object;
+  push::ObjectDescription object;
   object.shape = shape;
   object.mass = mass;
   object.mu_surface = 0.35;  // the apparent mu of these files (README)
-  limit_surface::FingerDescription finger;
+  push::FingerDescription finger;
   finger.shape = geometry::Shape::Disk(0.00235);
   finger.mu_contact = 0.2;
-  limit_surface::Trajectory t = io::MitToTrajectory(rec, object, finger);
+  push::Trajectory t = io::MitToTrajectory(rec, object, finger);
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> n(0.0, 1.0);
   for (auto& s : t.measured.object_pose) s.pose = {s.pose.x + 0.005 * n(rng), s.pose.y + 0.005 * n(rng), s.pose.theta + 0.05 * n(rng)};
@@ -43,7 +43,7 @@ TEST(RealData, MitEllip1AndRect1PushesAreRecovered) {
     double mass;
   };
   for (const Case& c : {Case{ellip, geometry::Shape::Disk(0.0525), 0.8937}, Case{rect, geometry::Shape::Box(0.09, 0.09), 0.8374}}) {
-    const limit_surface::Trajectory t = NoisyMit(c.file, c.shape, c.mass, 3);
+    const push::Trajectory t = NoisyMit(c.file, c.shape, c.mass, 3);
     for (Model m : {Model::kSdf, Model::kQs}) {
       EstimatorConfig cfg;
       cfg.covariance = false;

@@ -4,7 +4,7 @@
 #include <pushgraph/graph/registration.h>
 #include <pushgraph/io/footprint.h>
 #include <pushgraph/io/mit_push.h>
-#include <pushgraph/limit_surface/simulator.h>
+#include <pushgraph/push/simulator.h>
 
 #include <gtest/gtest.h>
 
@@ -33,23 +33,23 @@ std::vector<std::string> Recordings(const std::string& object) {
   return files;
 }
 
-limit_surface::Trajectory Recording(const std::string& file, const Shape& shape, double noise, unsigned seed) {
+push::Trajectory Recording(const std::string& file, const Shape& shape, double noise, unsigned seed) {
   io::MitReadOptions options;
   options.trim_to_contact = true;
   const io::MitRecording rec = io::ReadMitPush(file, options);
-  limit_surface::ObjectDescription object;
+  push::ObjectDescription object;
   object.shape = shape;
   object.mass = 1.0;
   object.mu_surface = 0.35;
-  limit_surface::FingerDescription finger;
+  push::FingerDescription finger;
   finger.shape = Shape::Disk(0.0047);  // tip.obj: a 4.7 mm radius cylinder
-  limit_surface::Trajectory t = io::MitToTrajectory(rec, object, finger);
+  push::Trajectory t = io::MitToTrajectory(rec, object, finger);
   if (noise > 0.0) {
     std::mt19937_64 rng(seed);
     std::normal_distribution<double> n(0.0, 1.0);
     for (auto& s : t.measured.object_pose) s.pose = {s.pose.x + noise * n(rng), s.pose.y + noise * n(rng), s.pose.theta + 10 * noise * n(rng)};
     for (auto& s : t.measured.finger_pose) s.pose = {s.pose.x + noise * n(rng), s.pose.y + noise * n(rng), s.pose.theta};
-    limit_surface::MeasurementSigmas sigmas;
+    push::MeasurementSigmas sigmas;
     sigmas.object_trans = sigmas.finger_trans = noise;
     sigmas.object_rot = 10 * noise;
     t.measurement_sigmas = sigmas;
@@ -131,7 +131,7 @@ TEST(Registration, JudgesTheSharedMeshesOnEveryRealRecording) {
         std::vector<double> errors;
         int fitting = 0;
         for (std::size_t k = 0; k < files.size(); ++k) {
-          const limit_surface::Trajectory t = Recording(files[k], file, noise, 7 + k);
+          const push::Trajectory t = Recording(files[k], file, noise, 7 + k);
           const RegistrationResult r = RegisterShape(t);
           errors.push_back(OutlineDistance(r.Apply(file), truth));
           // Fits: the gaps are in tolerance and no other placement is clearly better (a
@@ -163,9 +163,9 @@ namespace {
 TEST(Registration, PooledOverAnObjectsRecordings) {
   ForEachCase([](const std::string& object, const Shape& truth, const std::vector<std::string>& files, const Misframe& m,
                  const Shape& file, double noise) {
-        std::vector<limit_surface::Trajectory> trajs;
+        std::vector<push::Trajectory> trajs;
         for (std::size_t k = 0; k < files.size(); ++k) trajs.push_back(Recording(files[k], file, noise, 7 + k));
-        std::vector<const limit_surface::Trajectory*> ptrs;
+        std::vector<const push::Trajectory*> ptrs;
         for (const auto& t : trajs) ptrs.push_back(&t);
         const RegistrationResult r = RegisterShape(ptrs);
         const double d = OutlineDistance(r.Apply(file), truth);
@@ -211,28 +211,28 @@ TEST(Registration, DatasetMeshesAsShippedAreRegisteredOnSimulatedPushes) {
   cases.push_back({"hex (synthetic file)", Shape::RegularPolygon(6, 0.0605),
                    geometry::TransformShape(Shape::RegularPolygon(6, 0.0605), Pose2{0, 0, M_PI / 6})});
   for (const Case& c : cases) {
-    std::vector<limit_surface::Trajectory> pushes;
+    std::vector<push::Trajectory> pushes;
     const int count = c.name == "l_bracket mirrored" ? 8 : 4;
     for (int k = 0; k < count; ++k) {
-      limit_surface::PushPlan plan;
-      plan.object = c.truth;
-      plan.finger = Shape::Disk(0.0047);
-      plan.mass = 1.0;
-      plan.mu_surface = 0.35;
-      plan.mu_contact = 0.25;
-      plan.waypoints = limit_surface::StraightPushPath(plan, 0.3 + k * 2 * M_PI / count, 0.01 * ((k % 4) - 1.5), 0.005, 0.05);
-      plan.noise = limit_surface::DefaultNoise(limit_surface::NoiseKind::kGaussian);
+      push::PushPlan plan;
+      plan.object.shape = c.truth;
+      plan.finger.shape = Shape::Disk(0.0047);
+      plan.object.mass = 1.0;
+      plan.object.mu_surface = 0.35;
+      plan.finger.mu_contact = 0.25;
+      plan.waypoints = push::StraightPushPath(plan, 0.3 + k * 2 * M_PI / count, 0.01 * ((k % 4) - 1.5), 0.005, 0.05);
+      plan.noise = push::DefaultNoise(push::NoiseKind::kGaussian);
       // Motion-capture noise: `pushgraph evaluate` registers each object on its clean recordings.
-      for (limit_surface::StreamNoise* s : {&plan.noise.object_pose, &plan.noise.finger_pose, &plan.noise.contact_point}) {
+      for (push::StreamNoise* s : {&plan.noise.object_pose, &plan.noise.finger_pose, &plan.noise.contact_point}) {
         s->position.sigma = 0.0005;
       }
       plan.noise.object_pose.angle.sigma = 0.005;
       plan.seed = 11 + k;
-      limit_surface::Trajectory t = limit_surface::Simulate(plan).trajectory;
+      push::Trajectory t = push::Simulate(plan).trajectory;
       t.object.shape = c.file;
       pushes.push_back(std::move(t));
     }
-    std::vector<const limit_surface::Trajectory*> ptrs;
+    std::vector<const push::Trajectory*> ptrs;
     for (const auto& t : pushes) ptrs.push_back(&t);
     const RegistrationResult r = RegisterShape(ptrs);
     const double error = OutlineDistance(r.Apply(c.file), c.truth);

@@ -151,5 +151,5 @@ def test_simulate_along_waypoints_with_chosen_noise_and_an_occlusion(notched_blo
         pg.simulate(notched_block, finger, sigmas={"camera": 0.1})
     with pytest.raises(ValueError, match="noise is 'none'"):
         pg.simulate(notched_block, finger, noise="none", sigmas={"force": 0.1})
-    with pytest.raises(pg.LimitSurfaceError):
+    with pytest.raises(pg.PushError):
         pg.simulate(notched_block, finger, waypoints=[[0.0, 0.0]])

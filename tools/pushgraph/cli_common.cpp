@@ -212,4 +212,12 @@ CLI::Validator FrictionValue(bool zero_allowed) {
   return FiniteNumber(0.0, zero_allowed, zero_allowed ? "in [0, 10]" : "in (0, 10]", limit_surface::kMaxFriction);
 }
 
+geometry::Shape LoadShapeArgument(const std::string& path, const std::string& what) {
+  try {
+    return geometry::LoadShapeJson(path);
+  } catch (const std::exception& e) {
+    throw CliError(what + " " + path + ": " + e.what());
+  }
+}
+
 }  // namespace pushgraph::cli

@@ -3,6 +3,7 @@
 // cmd_*.cpp and registers itself on the app; errors are thrown as CliError (or any
 // std::exception) and reported by main() as one line on stderr with exit status 1.
 #include <pushgraph/geometry/pose.h>
+#include <pushgraph/geometry/shape.h>
 #include <pushgraph/graph/config.h>
 
 #include <CLI/CLI.hpp>
@@ -51,6 +52,9 @@ CLI::Validator FrictionValue(bool zero_allowed);
 /// configuration's value stands).
 void AddAlignShapeOption(CLI::App* sub, std::string* value);
 graph::EstimatorConfig::AlignShape ParseAlignShape(const std::string& value);
+/// A shape file named by a flag or argument (`what`, e.g. "--object"): geometry::LoadShapeJson,
+/// its errors prefixed with the flag.
+geometry::Shape LoadShapeArgument(const std::string& path, const std::string& what);
 /// Formats a double with 17 significant digits (round-trips exactly).
 std::string FormatDouble(double value);
 

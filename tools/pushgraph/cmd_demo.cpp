@@ -17,8 +17,9 @@
 #include <pushgraph/geometry/shape_pair.h>
 #ifdef PUSHGRAPH_WITH_GRAPH
 #include <pushgraph/graph/estimator.h>
-#include <pushgraph/io/plot_svg.h>
-#include <pushgraph/limit_surface/simulator.h>
+#include <pushgraph/evaluation/plots.h>
+#include <pushgraph/evaluation/window_error.h>
+#include <pushgraph/push/simulator.h>
 #endif
 
 #include <algorithm>
@@ -141,41 +142,6 @@ void RunGeometryDemo(const std::string& data_dir, const std::string& svg_path) {
 }
 
 #ifdef PUSHGRAPH_WITH_GRAPH
-namespace ls = limit_surface;
-
-// Mean object position error (m) over [t0, t1]: of an estimate at its states, and of the raw
-// stream as a user without an estimator would see it (the last measurement held while occluded).
-double MeanErrorIn(const std::vector<graph::StateEstimate>& states, const ls::Trajectory& traj, double t0, double t1) {
-  const auto& truth = traj.ground_truth->object_pose;
-  double sum = 0.0;
-  int count = 0;
-  for (const graph::StateEstimate& s : states) {
-    if (s.t < t0 || s.t > t1) continue;
-    auto it = std::lower_bound(truth.begin(), truth.end(), s.t, [](const ls::PoseSample& a, double t) { return a.t < t; });
-    if (it == truth.end() || it == truth.begin()) continue;
-    const ls::PoseSample& a = *(it - 1);  // ground truth interpolated linearly at the state's time
-    const double w = it->t > a.t ? (s.t - a.t) / (it->t - a.t) : 1.0;
-    const Vec2 truth_position = a.pose.translation() + w * (it->pose.translation() - a.pose.translation());
-    sum += (s.object_pose.translation() - truth_position).norm();
-    ++count;
-  }
-  return count > 0 ? sum / count : std::nan("");
-}
-
-double MeanHeldRawErrorIn(const ls::Trajectory& traj, double t0, double t1) {
-  const auto& measured = traj.measured.object_pose;
-  double sum = 0.0;
-  int count = 0;
-  for (const ls::PoseSample& truth : traj.ground_truth->object_pose) {
-    if (truth.t < t0 || truth.t > t1) continue;
-    auto it = std::upper_bound(measured.begin(), measured.end(), truth.t,
-                               [](double t, const ls::PoseSample& a) { return t < a.t; });
-    if (it == measured.begin()) continue;
-    sum += ((it - 1)->pose.translation() - truth.pose.translation()).norm();
-    ++count;
-  }
-  return count > 0 ? sum / count : std::nan("");
-}
 
 struct DemoOptions {
   std::string data_dir = DefaultDataDir();
@@ -186,24 +152,21 @@ struct DemoOptions {
 
 void RunEstimationDemo(const DemoOptions& o) {
   const auto t_start = std::chrono::steady_clock::now();
-  ls::PushPlan plan;
-  plan.object = geometry::LoadShapeJson(o.data_dir + "/shapes/notched_block.json");
-  plan.finger = geometry::LoadShapeJson(o.data_dir + "/shapes/disk_finger_5mm.json");
+  push::PushPlan plan;
+  plan.object = {geometry::LoadShapeJson(o.data_dir + "/shapes/notched_block.json"), /*mass=*/0.5, /*mu_surface=*/0.3};
+  plan.finger = {geometry::LoadShapeJson(o.data_dir + "/shapes/disk_finger_5mm.json"), /*mu_contact=*/0.4};
   MakeParentFolder(o.svg_path);
-  io::WriteSvgFile(o.svg_path, "");  // an unwritable picture path fails now, not after the solves
-  plan.mass = 0.5;
-  plan.mu_surface = 0.3;
-  plan.mu_contact = 0.4;
+  evaluation::WriteSvgFile(o.svg_path, "");  // an unwritable picture path fails now, not after the solves
   // Pushed upwards 2 cm left of the centroid: the block slides and turns.
-  plan.waypoints = ls::StraightPushPath(plan, M_PI / 2, /*offset=*/0.02, /*standoff=*/0.005, /*push=*/0.05);
+  plan.waypoints = push::StraightPushPath(plan, M_PI / 2, /*offset=*/0.02, /*standoff=*/0.005, /*push=*/0.05);
   plan.speed = 0.05;
   plan.seed = o.seed;
   // The paper's bimodal noise (Sec. V-B); the tracker loses the object mid-push.
-  plan.noise = ls::DefaultNoise(ls::NoiseKind::kBimodal);
+  plan.noise = push::DefaultNoise(push::NoiseKind::kBimodal);
   const double occlusion_t0 = 0.55, occlusion_t1 = 0.95;
-  plan.noise.occlusions.push_back({occlusion_t0, occlusion_t1, ls::OcclusionMode::kStop});
-  const ls::SimulationResult sim = ls::Simulate(plan);
-  const ls::Trajectory& traj = sim.trajectory;
+  plan.noise.occlusions.push_back({occlusion_t0, occlusion_t1, push::OcclusionMode::kStop});
+  const push::SimulationResult sim = push::Simulate(plan);
+  const push::Trajectory& traj = sim.trajectory;
 
   graph::EstimatorConfig config;
   if (traj.measurement_sigmas) config = graph::ApplyMeasurementSigmas(config, *traj.measurement_sigmas);
@@ -219,7 +182,7 @@ void RunEstimationDemo(const DemoOptions& o) {
   }
 
   std::printf("pushgraph demo: a 5 mm disk finger pushes the notched block with two holes (data/shapes/)\n");
-  const ls::NoiseModel& noise = plan.noise;
+  const push::NoiseModel& noise = plan.noise;
   std::printf("%zu steps over %.2f s; bimodal noise (object %.1f mm / %.2f deg, contact %.1f mm, force %.2f N);\n",
               rows.front().result.states.size(), sim.states.empty() ? 0.0 : sim.states.back().t,
               noise.object_pose.position.sigma * 1e3, noise.object_pose.angle.sigma * 180.0 / M_PI,
@@ -239,27 +202,27 @@ void RunEstimationDemo(const DemoOptions& o) {
   std::printf("%-5s %s %s %s %s %16.2f %8s\n", "raw", cell(metrics, "measured_object_position_rms", 1e3, 12).c_str(),
               cell(metrics, "measured_object_rotation_rms", 180.0 / M_PI, 14).c_str(),
               cell(metrics, "measured_contact_rms", 1e3, 12).c_str(), cell(metrics, "measured_force_rms", 1.0, 10).c_str(),
-              1e3 * MeanHeldRawErrorIn(traj, occlusion_t0, occlusion_t1), "-");
+              1e3 * evaluation::MeanHeldRawObjectPositionError(traj, occlusion_t0, occlusion_t1), "-");
   for (const Row& row : rows) {
     const auto& m = row.result.metrics;
     std::printf("%-5s %s %s %s %s %16.2f %8.2f\n", row.name.c_str(), cell(m, "object_position_rms", 1e3, 12).c_str(),
                 cell(m, "object_rotation_rms", 180.0 / M_PI, 14).c_str(), cell(m, "contact_rms", 1e3, 12).c_str(),
                 cell(m, "force_rms", 1.0, 10).c_str(),
-                1e3 * MeanErrorIn(row.result.states, traj, occlusion_t0, occlusion_t1), row.result.solver.time_s);
+                1e3 * evaluation::MeanObjectPositionError(traj, row.result, occlusion_t0, occlusion_t1), row.result.solver.time_s);
   }
   std::printf("\n(occluded: mean object position error inside the occlusion; raw holds the last measurement)\n");
 
   const graph::EstimationResult& qs = rows.back().result;
-  io::TrajectoryPlotOptions plot;
+  evaluation::TrajectoryPlotOptions plot;
   plot.title = "QS batch estimate of a push with occlusion (" + std::to_string(qs.states.size()) + " steps)";
   plot.error_panel = false;  // the panel below compares all models
   std::vector<std::pair<std::string, const graph::EstimationResult*>> compared;
   for (const Row& row : rows) compared.emplace_back(row.name, &row.result);
-  const std::string svg = io::StackSvgVertically(
-      {io::TrajectorySvg(traj, qs, plot),
-       io::TimeSeriesSvg(io::ObjectPositionErrorSeries(traj, compared), "object position error over time",
+  const std::string svg = evaluation::StackSvgVertically(
+      {evaluation::TrajectorySvg(traj, qs, plot),
+       evaluation::TimeSeriesSvg(evaluation::ObjectPositionErrorSeries(traj, compared), "object position error over time",
                          "error [mm]", {{occlusion_t0, occlusion_t1}})});
-  io::WriteSvgFile(o.svg_path, svg);
+  evaluation::WriteSvgFile(o.svg_path, svg);
   std::printf("picture: %s (%.1f s in all)\n", o.svg_path.c_str(),
               std::chrono::duration<double>(std::chrono::steady_clock::now() - t_start).count());
 }

@@ -6,10 +6,9 @@
 #include "cli_common.h"
 
 #include <pushgraph/graph/estimator.h>
-#include <pushgraph/io/evaluation.h>
-#include <pushgraph/io/mit_push.h>
-#include <pushgraph/io/plot_svg.h>
-#include <pushgraph/io/result_json.h>
+#include <pushgraph/evaluation/evaluation.h>
+#include <pushgraph/evaluation/plots.h>
+#include <pushgraph/evaluation/result_json.h>
 #include <pushgraph/io/trajectory_json.h>
 
 #include <cmath>
@@ -27,56 +26,25 @@ struct EstimateOptions {
   std::string output;
   std::string config;
   std::string object, finger;
-  double mass = 0.0, mu = -1.0, mu_contact = 0.25;
+  double mass = 0.0, mu = -1.0;
   std::string add_noise;
   std::uint64_t seed = 1;
   std::string svg;
   std::string align_shape;  // empty: the configuration's (default auto)
 };
 
-geometry::Shape LoadShape(const std::string& path, const std::string& what) {
-  try {
-    return geometry::LoadShapeJson(path);
-  } catch (const std::exception& e) {
-    throw CliError(what + " " + path + ": " + e.what());
-  }
-}
-
-limit_surface::Trajectory LoadInput(const EstimateOptions& o, std::string* source) {
-  const io::InputKind kind = io::DetectInputKind(o.input);
-  if (kind == io::InputKind::kTrajectory) {
-    *source = "trajectory";
-    std::vector<std::string> notes;
-    limit_surface::Trajectory t = io::LoadTrajectoryJson(o.input, &notes);
-    for (const std::string& note : notes) std::cerr << "estimate: " << o.input << ": " << note << "\n";
-    // Optional overrides of the file's object and finger.
-    if (!o.object.empty()) t.object.shape = LoadShape(o.object, "--object");
-    if (!o.finger.empty()) t.finger.shape = LoadShape(o.finger, "--finger");
-    if (o.mass > 0.0) t.object.mass = o.mass;
-    if (o.mu >= 0.0) t.object.mu_surface = o.mu;
-    return t;
-  }
-  *source = "mit";
-  if (o.object.empty() || o.finger.empty() || !(o.mass > 0.0) || !(o.mu >= 0.0)) {
-    throw CliError(o.input + " is an MIT recording: give the object and probe with --object SHAPE.json --finger SHAPE.json "
-                   "--mass KG --mu MU (e.g. shapes from `pushgraph footprint`, masses from the dataset README)");
-  }
-  if (!std::isfinite(o.mass) || !std::isfinite(o.mu) || !(o.mu_contact >= 0.0))
-    throw CliError("--mass, --mu and --mu-contact must be finite (mass > 0, mu >= 0)");
-  io::MitReadOptions read;
-  read.trim_to_contact = true;
-  const io::MitRecording rec = io::ReadMitPush(o.input, read);
-  for (const std::string& note : rec.notes) std::cerr << "estimate: " << note << "\n";
-  if (!rec.contact_found) {
-    // Nothing was pushed: the contact, force and quasi-static factors would be fitted to a
-    // push that never happened (a finger far from a resting object).
-    throw CliError(o.input + ": no contact phase found (no force above the contact threshold and no object motion): "
-                   "nothing was pushed, nothing to estimate");
-  }
-  limit_surface::ObjectDescription object{LoadShape(o.object, "--object"), o.mass, o.mu, "uniform"};
-  limit_surface::FingerDescription finger{LoadShape(o.finger, "--finger"), o.mu_contact};
-  // Time stamps stay the recording's own (unix seconds): ReadMitPush keeps them.
-  return io::MitToTrajectory(rec, object, finger);
+push::Trajectory LoadInput(const EstimateOptions& o, std::string* source) {
+  evaluation::InputOverrides given;
+  if (!o.object.empty()) given.object_shape = LoadShapeArgument(o.object, "--object");
+  if (!o.finger.empty()) given.finger_shape = LoadShapeArgument(o.finger, "--finger");
+  if (o.mass > 0.0) given.mass = o.mass;
+  if (o.mu >= 0.0) given.mu_surface = o.mu;
+  std::vector<std::string> notes;
+  evaluation::InputKind kind;
+  push::Trajectory t = evaluation::LoadEstimationInput(o.input, given, &notes, &kind);
+  for (const std::string& note : notes) std::cerr << "estimate: " << o.input << ": " << note << "\n";
+  *source = kind == evaluation::InputKind::kTrajectory ? "trajectory" : "mit";
+  return t;
 }
 
 void RunEstimate(const EstimateOptions& o) {
@@ -87,15 +55,15 @@ void RunEstimate(const EstimateOptions& o) {
   // A bad configuration file is reported before any input is read.
   if (!o.config.empty()) graph::LoadEstimatorConfig(o.config);
   std::string source;
-  limit_surface::Trajectory traj = LoadInput(o, &source);
+  push::Trajectory traj = LoadInput(o, &source);
   if (!o.add_noise.empty()) {
     // The paper's Sec. IV noise on the clean streams (the recording, or the file's ground truth);
     // the clean streams stay as ground truth, so metrics are computed.
-    const limit_surface::NoiseKind kind =
-        o.add_noise == "bimodal" ? limit_surface::NoiseKind::kBimodal : limit_surface::NoiseKind::kGaussian;
+    const push::NoiseKind kind =
+        o.add_noise == "bimodal" ? push::NoiseKind::kBimodal : push::NoiseKind::kGaussian;
     try {
-      traj = io::AddNoise(traj, io::MakePaperNoise(kind), o.seed);
-    } catch (const io::IoError& e) {
+      traj = evaluation::AddNoise(traj, evaluation::MakePaperNoise(kind), o.seed);
+    } catch (const evaluation::EvaluationError& e) {
       throw CliError(o.input + ": --add-noise: " + e.what());
     }
   }
@@ -119,11 +87,11 @@ void RunEstimate(const EstimateOptions& o) {
     throw CliError(o.input + ": " + e.what());
   }
   for (const std::string& w : result.warnings) std::cerr << "estimate: warning: " << w << "\n";
-  io::SaveResultJson(result, o.output);
+  evaluation::SaveResultJson(result, o.output);
   if (!o.svg.empty()) {
-    io::TrajectoryPlotOptions plot;
+    evaluation::TrajectoryPlotOptions plot;
     plot.title = graph::ModelName(model) + " " + graph::ModeName(mode);
-    io::WriteTrajectorySvg(o.svg, traj, result, plot);
+    evaluation::WriteTrajectorySvg(o.svg, traj, result, plot);
   }
   nlohmann::json summary = {{"input", source},
                             {"model", o.model},
@@ -176,9 +144,6 @@ void RegisterEstimate(CLI::App& app) {
   sub->add_option("--mass", opts->mass, "Object mass in kg (required for MIT recordings)")->check(MassValue());
   sub->add_option("--mu", opts->mu, "Object-table friction coefficient (required for MIT recordings)")
       ->check(FrictionValue(true));
-  sub->add_option("--mu-contact", opts->mu_contact, "Finger-object friction coefficient (MIT recordings)")
-      ->check(FrictionValue(true))
-      ->capture_default_str();
   sub->add_option("--add-noise", opts->add_noise,
                   "Add the paper's noise (5 mm, 0.05 rad, 0.5 N per axis) to the clean streams, which stay as ground truth")
       ->check(CLI::IsMember({"gaussian", "bimodal"}));

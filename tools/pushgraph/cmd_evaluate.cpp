@@ -2,12 +2,13 @@
 // pushgraph evaluate merge DIR... --out DIR
 // The paper's evaluation protocols (Tables I, II, Fig. 5, occlusion, consistency, runtime) over
 // MIT recordings, trajectory files and simulated pushes, in parallel, sharded for job arrays
-// (docs/evaluation.md). The logic is io/evaluation.h; this file parses options, shows progress
+// (docs/evaluation.md). The logic is evaluation/evaluation.h; this file parses options, shows progress
 // and writes files.
 #include "cli_common.h"
 
 #include <pushgraph/geometry/json_check.h>
-#include <pushgraph/io/evaluation.h>
+#include <pushgraph/evaluation/config.h>
+#include <pushgraph/evaluation/evaluation.h>
 #include <pushgraph/io/footprint.h>
 #include <pushgraph/io/trajectory_json.h>
 
@@ -39,7 +40,7 @@ struct EvaluateOptions {
   std::string protocols = "all";
   int plots = 1;  // pictures of the first N pushes of every object
   std::string object, finger;
-  double mass = 0.0, mu = -1.0, mu_contact = 0.25;
+  double mass = 0.0, mu = -1.0;
   std::string mesh_dir;
   std::string config;
   std::string estimator_config;
@@ -57,83 +58,11 @@ struct EvaluateOptions {
   std::string align_shape;  // empty: the estimator configuration's (default auto)
 };
 
-geometry::Shape LoadShape(const std::string& path, const std::string& what) {
-  try {
-    return geometry::LoadShapeJson(path);
-  } catch (const std::exception& e) {
-    throw CliError(what + " " + path + ": " + e.what());
-  }
-}
-
-// A shape in the evaluation config: "shape.json", or {"mesh": "x.obj", "up": "z", "scale": 1}.
-geometry::Shape ConfigShape(const nlohmann::json& j, const fs::path& base, const std::string& where) {
-  auto resolve = [&](const std::string& p) { return fs::path(p).is_absolute() ? p : (base / p).string(); };
-  if (j.is_string()) return LoadShape(resolve(j.get<std::string>()), where);
-  if (j.is_object() && j.contains("mesh")) {
-    io::FootprintOptions o;
-    for (const auto& [k, v] : j.items()) {
-      if (k != "mesh" && k != "up" && k != "scale") throw CliError(where + ": unknown key '" + k + "' (mesh, up, scale)");
-    }
-    if (j.contains("up")) o.up = io::ParseUpAxis(j["up"].get<std::string>());
-    if (j.contains("scale")) o.scale = j["scale"].get<double>();
-    return io::MeshFootprint(resolve(j["mesh"].get<std::string>()), o);
-  }
-  throw CliError(where + ": expected a shape file name or {\"mesh\": FILE.obj, \"up\": \"z\", \"scale\": 1}");
-}
-
-// {"mesh_dir": DIR, "estimator": {...EstimatorConfig keys...},
-//  "objects": {"ellip1": {"shape": ..., "finger": ..., "mass": kg, "mu_surface": mu, "mu_contact": mu}}}
-void LoadEvaluationConfig(const std::string& path, io::EvaluationOptions* options) {
-  std::ifstream in(path);
-  if (!in) throw CliError("--config " + path + ": cannot open file");
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::exception& e) {
-    throw CliError("--config " + path + ": malformed JSON: " + e.what());
-  }
-  if (const std::string dup = geometry::FindDuplicateJsonKey(text); !dup.empty()) throw CliError("--config " + path + ": " + dup);
-  if (!j.is_object()) throw CliError("--config " + path + ": expected a JSON object");
-  const fs::path base = fs::path(path).parent_path();
-  try {
-    for (const auto& [key, value] : j.items()) {
-      if (key == "mesh_dir") {
-        const std::string d = value.get<std::string>();
-        options->mesh_dir = fs::path(d).is_absolute() ? d : (base / d).string();
-      } else if (key == "estimator") {
-        options->estimator = graph::ParseEstimatorConfig(value.dump(), path + " (estimator)");
-      } else if (key == "objects") {
-        for (const auto& [name, o] : value.items()) {
-          const std::string where = path + ": objects." + name;
-          io::ObjectModel m;
-          for (const auto& [k, v] : o.items()) {
-            if (k == "shape") m.shape = ConfigShape(v, base, where + ".shape");
-            else if (k == "finger") m.finger = ConfigShape(v, base, where + ".finger");
-            else if (k == "mass") m.mass = v.get<double>();
-            else if (k == "mu_surface") m.mu_surface = v.get<double>();
-            else if (k == "mu_contact") m.mu_contact = v.get<double>();
-            else throw CliError(where + ": unknown key '" + k + "' (shape, finger, mass, mu_surface, mu_contact)");
-          }
-          if (m.shape.empty() || m.finger.empty()) throw CliError(where + ": needs both 'shape' and 'finger'");
-          if (!(m.mass > 0.0) || !std::isfinite(m.mass)) throw CliError(where + ".mass must be a number > 0");
-          if (!(m.mu_surface >= 0.0) || !(m.mu_contact >= 0.0)) throw CliError(where + ": friction must be >= 0");
-          options->objects[name] = m;
-        }
-      } else {
-        throw CliError(path + ": unknown key '" + key + "' (mesh_dir, estimator, objects)");
-      }
-    }
-  } catch (const nlohmann::json::exception& e) {
-    throw CliError(path + ": " + e.what());
-  }
-}
-
 // Progress on stderr: one updating line on a terminal, else a plain line every ~10% or 30 s.
 class Progress {
  public:
   explicit Progress(bool quiet) : quiet_(quiet), tty_(::isatty(2) == 1), start_(Clock::now()), last_(start_) {}
-  void Update(int done, int total, int failed, const io::EvaluationRow& row) {
+  void Update(int done, int total, int failed, const evaluation::EvaluationRow& row) {
     if (!row.error.empty()) {
       if (tty_) std::cerr << "\r\033[K";
       std::cerr << "evaluate: error: " << row.error << "\n";
@@ -159,28 +88,23 @@ class Progress {
   Clock::time_point start_, last_;
 };
 
-void PrintTables(const std::string& out_dir, const std::vector<io::EvaluationRow>& rows, const std::string& settings) {
-  const std::vector<io::Table> tables = io::MakeTables(rows, settings);
-  std::cout << io::WriteTables(out_dir, tables, rows);
+void PrintTables(const std::string& out_dir, const std::vector<evaluation::EvaluationRow>& rows, const std::string& settings) {
+  const std::vector<evaluation::Table> tables = evaluation::MakeTables(rows, settings);
+  std::cout << evaluation::WriteTables(out_dir, tables, rows);
   std::cerr << "evaluate: tables written to " << out_dir << " (results.md, TABLE.md, TABLE.csv, rows.jsonl)\n";
 }
 
 void RunMerge(const std::vector<std::string>& dirs, const std::string& out) {
   if (out.empty()) throw CliError("evaluate merge: --out DIR is required");
-  io::RowsHeader header;
-  const std::vector<io::EvaluationRow> rows = io::MergeRows(dirs, &header);
-  fs::create_directories(out);
-  io::RowsHeader merged = header;
-  merged.shard = 0;
-  merged.shards = 1;
-  io::WriteRows((fs::path(out) / "rows.jsonl").string(), merged, rows);
+  evaluation::RowsHeader header;
+  const std::vector<evaluation::EvaluationRow> rows = evaluation::MergeRowsInto(dirs, out, &header);
   PrintTables(out, rows, header.settings_json);
 }
 
 void RunEvaluate(const EvaluateOptions& o) {
   if (!o.merge.empty()) return RunMerge(o.merge, o.out);
-  io::EvaluationOptions options;
-  options.protocols = io::ParseProtocols(o.protocols);
+  evaluation::EvaluationOptions options;
+  options.protocols = evaluation::ParseProtocols(o.protocols);
   options.seed = o.seed;
   if (!std::isfinite(o.mit_rate) || o.mit_rate < 0.0) throw CliError("--mit-rate must be >= 0 (0 keeps every sample)");
   options.mit_rate = o.mit_rate;
@@ -188,31 +112,25 @@ void RunEvaluate(const EvaluateOptions& o) {
   options.occlusion_fraction = o.occlusion_fraction;
   options.occlusion_mode = graph::ParseMode(o.occlusion_mode);
   options.mesh_dir = o.mesh_dir;
-  if (!o.config.empty()) LoadEvaluationConfig(o.config, &options);
+  if (!o.config.empty()) evaluation::LoadEvaluationConfig(o.config, &options);
   if (!o.estimator_config.empty()) options.estimator = graph::LoadEstimatorConfig(o.estimator_config);
   if (!o.align_shape.empty()) options.estimator.align_shape = ParseAlignShape(o.align_shape);
   const bool any_override = !o.object.empty() || !o.finger.empty() || o.mass > 0.0 || o.mu >= 0.0;
   if (any_override) {
     if (o.object.empty() || o.finger.empty() || !(o.mass > 0.0) || !(o.mu >= 0.0))
       throw CliError("--object, --finger, --mass and --mu go together (they describe every MIT recording)");
-    io::ObjectModel m;
-    m.shape = LoadShape(o.object, "--object");
-    m.finger = LoadShape(o.finger, "--finger");
-    m.mass = o.mass;
-    m.mu_surface = o.mu;
-    m.mu_contact = o.mu_contact;
+    evaluation::ObjectModel m;
+    m.object = {LoadShapeArgument(o.object, "--object"), o.mass, o.mu};
+    m.finger.shape = LoadShapeArgument(o.finger, "--finger");
     options.object_override = m;
   }
   if (o.simulate < 0) throw CliError("--simulate must be >= 0");
   options.simulation.count = o.simulate;
   if (o.simulate > 0) {
-    options.simulation.object.shape = LoadShape(o.sim_object, "--sim-object");
-    options.simulation.object.finger = LoadShape(o.sim_finger, "--sim-finger");
     if (!(o.sim_mass > 0.0) || !(o.sim_mu > 0.0) || !(o.sim_mu_contact >= 0.0))
       throw CliError("--sim-mass and --sim-mu must be > 0, --sim-mu-contact >= 0");
-    options.simulation.object.mass = o.sim_mass;
-    options.simulation.object.mu_surface = o.sim_mu;
-    options.simulation.object.mu_contact = o.sim_mu_contact;
+    options.simulation.object = {LoadShapeArgument(o.sim_object, "--sim-object"), o.sim_mass, o.sim_mu};
+    options.simulation.finger = {LoadShapeArgument(o.sim_finger, "--sim-finger"), o.sim_mu_contact};
     options.simulation.name = "sim:" + fs::path(o.sim_object).stem().string();
   }
   if (o.out.empty()) throw CliError("--out DIR is required");
@@ -220,70 +138,29 @@ void RunEvaluate(const EvaluateOptions& o) {
   options.plots_per_group = o.plots;
   if (o.plots > 0) options.plot_dir = (fs::path(o.out) / "plots").string();
 
-  const std::vector<std::string> files = o.inputs.empty() ? std::vector<std::string>{} : io::ExpandInputs(o.inputs);
-  std::vector<io::EvaluationItem> all = io::PlanEvaluation(files, options);
+  const std::vector<std::string> files = o.inputs.empty() ? std::vector<std::string>{} : evaluation::ExpandInputs(o.inputs);
+  std::vector<evaluation::EvaluationItem> all = evaluation::PlanEvaluation(files, options);
   if (all.empty()) throw CliError("nothing to evaluate: give recordings/trajectories or --simulate N");
   // Each object's shape against all of its recordings together, before sharding (every shard
   // then uses the same transforms).
-  for (const std::string& line : io::RegisterGroups(all, options)) std::cerr << "evaluate: " << line << "\n";
+  for (const std::string& line : evaluation::RegisterGroups(all, options)) std::cerr << "evaluate: " << line << "\n";
   int shard = 0, shards = 1;
-  if (!o.shard.empty()) std::tie(shard, shards) = io::ParseShard(o.shard);
-  const std::vector<io::EvaluationItem> items = io::ShardItems(all, shard, shards);
+  if (!o.shard.empty()) std::tie(shard, shards) = evaluation::ParseShard(o.shard);
+  const std::vector<evaluation::EvaluationItem> items = evaluation::ShardItems(all, shard, shards);
   const std::string settings = options.SettingsJson();
 
-  std::error_code ec;
-  fs::create_directories(o.out, ec);
-  if (ec) throw CliError("--out " + o.out + ": cannot create folder (" + ec.message() + ")");
-  const io::RowsHeader header{shard, shards, static_cast<int>(all.size()), settings};
-  const std::string rows_path =
-      (fs::path(o.out) / (shards > 1 ? "rows-" + std::to_string(shard) + "-of-" + std::to_string(shards) + ".jsonl"
-                                     : std::string("rows.jsonl"))).string();
-  // Every finished trajectory's row is appended to this file at once (flushed to disk): a
-  // killed run loses nothing, and --resume skips what it holds.
-  const std::string partial_path = rows_path + ".partial";
-  std::vector<io::EvaluationRow> done_rows;
-  std::vector<io::EvaluationItem> pending = items;
-  if (o.resume) {
-    for (const std::string& path : {partial_path, rows_path}) {
-      if (!fs::exists(path)) continue;
-      io::RowsHeader previous;
-      std::vector<io::EvaluationRow> previous_rows = io::ReadRows(path, &previous, /*cut_last_line_ok=*/path == partial_path);
-      if (previous.settings_json != settings || previous.shard != shard || previous.shards != shards) {
-        throw CliError("--resume: " + path + " was written by a run with other settings, inputs or shards; "
-                       "run without --resume (or with another --out) to start over");
-      }
-      for (io::EvaluationRow& r : previous_rows) {
-        if (r.error.empty()) done_rows.push_back(std::move(r));  // failed ones run again
-      }
-      break;
-    }
-    std::set<int> done;
-    for (const io::EvaluationRow& r : done_rows) done.insert(r.index);
-    pending.clear();
-    for (const io::EvaluationItem& item : items) {
-      if (!done.count(item.index)) pending.push_back(item);
-    }
-    std::cerr << "evaluate: --resume: " << done_rows.size() << " trajectories already done in " << o.out << "\n";
-  }
-
-  std::cerr << "evaluate: " << pending.size() << " of " << all.size() << " trajectories";
+  std::cerr << "evaluate: " << items.size() << " of " << all.size() << " trajectories";
   if (shards > 1) std::cerr << " (shard " << shard << "/" << shards << ")";
   std::cerr << ", protocols " << o.protocols << "\n";
   Progress progress(o.quiet);
-  io::WriteRows(partial_path, header, done_rows);
-  const std::vector<io::EvaluationRow> new_rows =
-      io::RunEvaluation(pending, options, o.jobs, [&](int done, int total, int failed, const io::EvaluationRow& row) {
-        progress.Update(done, total, failed, row);
-        io::AppendRow(partial_path, row);
-      });
-  std::vector<io::EvaluationRow> rows = done_rows;
-  rows.insert(rows.end(), new_rows.begin(), new_rows.end());
-  std::sort(rows.begin(), rows.end(), [](const io::EvaluationRow& a, const io::EvaluationRow& b) { return a.index < b.index; });
-  int failed = 0;
-  for (const io::EvaluationRow& r : rows) failed += r.error.empty() ? 0 : 1;
-
-  io::WriteRows(rows_path, header, rows);
-  fs::remove(partial_path, ec);
+  const evaluation::RowsHeader header{shard, shards, static_cast<int>(all.size()), settings};
+  const evaluation::FolderRun run = evaluation::RunIntoFolder(
+      o.out, items, header, options, o.jobs, o.resume,
+      [&](int done, int total, int failed, const evaluation::EvaluationRow& row) { progress.Update(done, total, failed, row); });
+  if (o.resume) std::cerr << "evaluate: --resume: " << run.resumed << " trajectories already done in " << o.out << "\n";
+  const std::vector<evaluation::EvaluationRow>& rows = run.rows;
+  const int failed = run.failed;
+  const std::string& rows_path = run.rows_path;
   if (shards > 1) {
     std::cerr << "evaluate: shard rows written to " << rows_path << "; combine with `pushgraph evaluate merge DIR...`\n";
   } else {
@@ -321,9 +198,6 @@ void RegisterEvaluate(CLI::App& app) {
   cmd->add_option("--finger", o->finger, "Probe shape JSON for every MIT recording");
   cmd->add_option("--mass", o->mass, "Object mass (kg) for every MIT recording")->check(MassValue());
   cmd->add_option("--mu", o->mu, "Object-table friction for every MIT recording")->check(FrictionValue(false));
-  cmd->add_option("--mu-contact", o->mu_contact, "Finger-object friction with --object")
-      ->check(FrictionValue(true))
-      ->capture_default_str();
   cmd->add_option("--mesh-dir", o->mesh_dir,
                   "Folder with the dataset's NAME.obj and tip.obj (default: an obj/ folder beside or above each recording)");
   cmd->add_option("--config", o->config, "Evaluation config JSON: objects, mesh_dir, estimator (docs/evaluation.md)");

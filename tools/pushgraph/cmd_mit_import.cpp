@@ -36,8 +36,8 @@ void RegisterMitImport(CLI::App& app) {
     io::MitReadOptions options;
     options.trim_to_contact = a->trim;
     const io::MitRecording rec = io::ReadMitPush(a->recording, options);
-    limit_surface::ObjectDescription object{geometry::LoadShapeJson(a->object), a->mass, a->mu_surface, "uniform"};
-    limit_surface::FingerDescription finger{geometry::LoadShapeJson(a->finger), a->mu_contact};
+    push::ObjectDescription object{LoadShapeArgument(a->object, "--object"), a->mass, a->mu_surface};
+    push::FingerDescription finger{LoadShapeArgument(a->finger, "--finger"), a->mu_contact};
     io::SaveTrajectoryJson(io::MitToTrajectory(rec, object, finger), a->output);
     for (const std::string& note : rec.notes) std::cerr << "mit-import: " << note << "\n";
     std::cerr << "mit-import: " << rec.streams.object_pose.size() << " object, " << rec.streams.finger_pose.size()

@@ -5,7 +5,7 @@
 #include "cli_common.h"
 
 #include <pushgraph/io/trajectory_json.h>
-#include <pushgraph/limit_surface/simulator.h>
+#include <pushgraph/push/simulator.h>
 
 #include <cmath>
 #include <iostream>
@@ -15,7 +15,6 @@
 namespace pushgraph::cli {
 namespace {
 
-namespace ls = limit_surface;
 
 struct SimulateOptions {
   std::string output;
@@ -53,14 +52,6 @@ void NonNegative(double value, const std::string& name) {
   if (!std::isfinite(value) || value < 0.0) throw CliError(name + " must be a finite number >= 0 (got " + FormatDouble(value) + ")");
 }
 
-geometry::Shape LoadShape(const std::string& path, const std::string& what) {
-  try {
-    return geometry::LoadShapeJson(path);
-  } catch (const std::exception& e) {
-    throw CliError(what + " " + path + ": " + e.what());
-  }
-}
-
 std::vector<geometry::Vec2> ParseWaypoints(const std::string& text) {
   std::vector<geometry::Vec2> points;
   std::stringstream stream(text);
@@ -81,7 +72,7 @@ std::pair<double, double> ParseWindow(const std::string& text, const std::string
 
 void Run(const SimulateOptions& o) {
   CheckOutputsAreNew({{"--object", o.object_path}, {"--finger", o.finger_path}}, {{"-o", o.output}});
-  ls::PushPlan plan;
+  push::PushPlan plan;
   Positive(o.mass, "--mass");
   Positive(o.mu_surface, "--mu-surface");
   NonNegative(o.mu_contact, "--mu-contact");
@@ -100,12 +91,9 @@ void Run(const SimulateOptions& o) {
     throw CliError("--outliers must be a probability in [0, 1] (got " + FormatDouble(o.outliers) + ")");
   NonNegative(o.occlusion_scale, "--occlusion-scale");
 
-  plan.object = LoadShape(o.object_path, "--object");
-  plan.finger = LoadShape(o.finger_path, "--finger");
-  plan.mass = o.mass;
-  plan.mu_surface = o.mu_surface;
-  plan.mu_contact = o.mu_contact;
-  plan.surface = o.surface == "ellipsoid" ? ls::SurfaceModel::kEllipsoid : ls::SurfaceModel::kExact;
+  plan.object = {LoadShapeArgument(o.object_path, "--object"), o.mass, o.mu_surface};
+  plan.finger = {LoadShapeArgument(o.finger_path, "--finger"), o.mu_contact};
+  plan.surface = o.surface == "ellipsoid" ? push::SurfaceModel::kEllipsoid : push::SurfaceModel::kExact;
   plan.object_pose = ParsePose(o.object_pose, "--object-pose");
   plan.speed = o.speed;
   plan.duration = o.duration;
@@ -113,18 +101,18 @@ void Run(const SimulateOptions& o) {
   plan.internal_step = o.internal_step;
   plan.seed = o.seed;
 
-  const ls::NoiseKind kind = o.noise == "none"       ? ls::NoiseKind::kNone
-                             : o.noise == "bimodal" ? ls::NoiseKind::kBimodal
-                                                    : ls::NoiseKind::kGaussian;
-  plan.noise = ls::DefaultNoise(kind);
-  if (kind == ls::NoiseKind::kNone) {
+  const push::NoiseKind kind = o.noise == "none"       ? push::NoiseKind::kNone
+                             : o.noise == "bimodal" ? push::NoiseKind::kBimodal
+                                                    : push::NoiseKind::kGaussian;
+  plan.noise = push::DefaultNoise(kind);
+  if (kind == push::NoiseKind::kNone) {
     for (const auto& [flag, value] : {std::pair{"--sigma-object", &o.sigma_object}, {"--sigma-finger", &o.sigma_finger},
                                       {"--sigma-contact", &o.sigma_contact}, {"--sigma-force", &o.sigma_force}})
       if (!value->empty())
         throw CliError(std::string(flag) + " " + *value + " is given with --noise none, which adds no noise: drop it or "
                        "choose --noise gaussian or bimodal");
   }
-  auto set_sigma = [&](const std::string& text, ls::StreamNoise& stream, bool with_angle, const std::string& what) {
+  auto set_sigma = [&](const std::string& text, push::StreamNoise& stream, bool with_angle, const std::string& what) {
     if (text.empty()) return;
     const std::vector<double> v = ParseNumbers(text, with_angle ? 2 : 1, what);
     for (double x : v) NonNegative(x, what);
@@ -137,8 +125,8 @@ void Run(const SimulateOptions& o) {
   set_sigma(o.sigma_force, plan.noise.force, false, "--sigma-force (N)");
   for (const std::string& text : o.occlusions) {
     const auto [t0, t1] = ParseWindow(text, "--occlusion");
-    plan.noise.occlusions.push_back({t0, t1, o.occlusion_mode == "degrade" ? ls::OcclusionMode::kDegrade
-                                                                            : ls::OcclusionMode::kStop,
+    plan.noise.occlusions.push_back({t0, t1, o.occlusion_mode == "degrade" ? push::OcclusionMode::kDegrade
+                                                                            : push::OcclusionMode::kStop,
                                      o.occlusion_scale});
   }
   for (const std::string& text : o.frozen) {
@@ -158,19 +146,19 @@ void Run(const SimulateOptions& o) {
     plan.noise.force.outlier_magnitude = 1.0;
   }
 
-  plan.waypoints = o.waypoints.empty() ? ls::StraightPushPath(plan, o.push_angle, o.offset, o.standoff, o.distance)
+  plan.waypoints = o.waypoints.empty() ? push::StraightPushPath(plan, o.push_angle, o.offset, o.standoff, o.distance)
                                        : ParseWaypoints(o.waypoints);
-  const ls::SimulationResult result = ls::Simulate(plan);
-  ls::Trajectory trajectory = result.trajectory;
+  const push::SimulationResult result = push::Simulate(plan);
+  push::Trajectory trajectory = result.trajectory;
   if (o.no_ground_truth) trajectory.ground_truth.reset();
   io::SaveTrajectoryJson(trajectory, o.output);
 
-  const ls::SimulationStats& s = result.stats;
+  const push::SimulationStats& s = result.stats;
   // The simulator's own last state (the object stream may be disabled, --rate-object 0).
   const geometry::Pose2 end = result.states.empty() ? plan.object_pose : result.states.back().object_pose;
   nlohmann::json out;
   out["output"] = o.output;
-  out["surface"] = ls::ToString(plan.surface);
+  out["surface"] = push::ToString(plan.surface);
   out["duration"] = result.states.empty() ? 0.0 : result.states.back().t;
   out["steps"] = s.steps;
   out["sticking_steps"] = s.sticking_steps;

@@ -1,10 +1,9 @@
 #pragma once
 // Basic types shared by the geometry module. Plain Eigen types in the public API; CGAL stays
 // inside the library's .cpp files.
-#include <Eigen/Core>
+#include <pushgraph/geometry/errors.h>
 
-#include <stdexcept>
-#include <string>
+#include <Eigen/Core>
 
 namespace pushgraph::geometry {
 
@@ -23,20 +22,6 @@ inline constexpr double kMaxQueryCoordinate = 1e12;
 struct Box2 {
   Vec2 min{0.0, 0.0};
   Vec2 max{0.0, 0.0};
-};
-
-/// Thrown for invalid geometric input (degenerate or self-intersecting polygons, NaN, ...).
-/// what() says what is wrong and where; the indices are also available (-1 when not applicable).
-class GeometryError : public std::invalid_argument {
- public:
-  explicit GeometryError(const std::string& message, int polygon = -1, int ring = -1, int vertex = -1)
-      : std::invalid_argument(message), polygon_(polygon), ring_(ring), vertex_(vertex) {}
-  int polygon() const { return polygon_; }  ///< polygon index
-  int ring() const { return ring_; }        ///< -1 outer boundary, k >= 0 hole k ... or -1 unknown
-  int vertex() const { return vertex_; }    ///< vertex index within the ring
-
- private:
-  int polygon_, ring_, vertex_;
 };
 
 }  // namespace pushgraph::geometry

@@ -10,7 +10,7 @@
 //   graph::EstimatorConfig cfg = graph::LoadEstimatorConfig("config.json");
 //
 // Unknown keys, wrong types, non-positive sigmas and NaN are errors (GraphError naming the key).
-#include <pushgraph/limit_surface/trajectory.h>
+#include <pushgraph/push/trajectory.h>
 
 #include <string>
 
@@ -24,13 +24,11 @@ struct LossConfig {
 };
 
 struct EstimatorConfig {
-  // M: measurement sigmas (the paper's Sec. IV noise is 0.5 cm and 0.5 N).
-  double object_pose_sigma_trans = 0.005;  ///< m
-  double object_pose_sigma_rot = 0.05;     ///< rad
-  double finger_pose_sigma_trans = 0.005;  ///< m
-  double finger_pose_sigma_rot = 0.05;     ///< rad
-  double contact_sigma = 0.005;            ///< m
-  double force_sigma = 0.5;                ///< N
+  /// M: measurement sigmas, the push module's MeasurementSigmas (JSON keys
+  /// object_pose_sigma_trans, object_pose_sigma_rot, finger_pose_sigma_trans,
+  /// finger_pose_sigma_rot, contact_sigma, force_sigma). Defaults: the paper's Sec. IV noise,
+  /// 0.5 cm and 0.5 N, with 0.05 rad for orientations.
+  push::MeasurementSigmas measurement{0.005, 0.05, 0.005, 0.05, 0.005, 0.5};
   // C and S: geometric consistency (stiff).
   double contact_object_sigma = 5e-4;  ///< m, contact point on the object boundary
   double contact_finger_sigma = 5e-4;  ///< m, contact point on the finger (witness or boundary)
@@ -151,13 +149,13 @@ EstimatorConfig ParseEstimatorConfig(const std::string& json_text,
 EstimatorConfig LoadEstimatorConfig(const std::string& path, const EstimatorConfig& base = {});
 
 /// `config` with its measurement sigmas (M factors) set to the known noise of the data
-/// (limit_surface::Trajectory::measurement_sigmas), so covariances are consistent. Zero
+/// (push::Trajectory::measurement_sigmas), so covariances are consistent. Zero
 /// (noise-free) sigmas are floored at 1e-4 m, 1e-3 rad and 1e-3 N: an exact measurement would
 /// make the problem infinitely stiff.
 ///
 ///   cfg = graph::ApplyMeasurementSigmas(cfg, *traj.measurement_sigmas);
 EstimatorConfig ApplyMeasurementSigmas(EstimatorConfig config,
-                                       const limit_surface::MeasurementSigmas& sigmas);
+                                       const push::MeasurementSigmas& sigmas);
 /// Checks every field (positive sigmas, finite values, window >= update_every >= 1).
 void ValidateConfig(const EstimatorConfig& config);
 

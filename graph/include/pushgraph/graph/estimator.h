@@ -3,7 +3,7 @@
 // baseline) contact force per step, with marginal covariances, from noisy, multi-rate and
 // partly missing measurements (Lambert et al. 2019, Sec. III, Fig. 2).
 //
-//   limit_surface::Trajectory traj = io::LoadTrajectoryJson("push.json");
+//   push::Trajectory traj = io::LoadTrajectoryJson("push.json");
 //   graph::EstimatorConfig cfg;                        // or graph::LoadEstimatorConfig(path)
 //   if (traj.measurement_sigmas)                       // the data's known noise (simulator, --add-noise)
 //     cfg = graph::ApplyMeasurementSigmas(cfg, *traj.measurement_sigmas);
@@ -24,7 +24,7 @@
 #include <pushgraph/graph/diagnostics.h>
 #include <pushgraph/graph/factors.h>
 #include <pushgraph/graph/registration.h>
-#include <pushgraph/limit_surface/trajectory.h>
+#include <pushgraph/push/trajectory.h>
 
 #include <Eigen/Core>
 
@@ -124,17 +124,17 @@ struct EstimationResult {
 /// force stream). QS and the baseline report forces only when something fixes their size: a
 /// force stream, or (QS) the limit-surface load from the object's mass and mu_surface; otherwise
 /// D fixes only their direction, the states carry no force and `warnings` says why.
-EstimationResult Estimate(const limit_surface::Trajectory& trajectory, Model model, Mode mode,
+EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode mode,
                           const EstimatorConfig& config = {});
 
 /// The metrics of EstimationResult for given states.
-std::map<std::string, double> ComputeMetrics(const limit_surface::Trajectory& trajectory,
+std::map<std::string, double> ComputeMetrics(const push::Trajectory& trajectory,
                                              const std::vector<StateEstimate>& states);
 
 /// The limit-surface ratio c used by D for this trajectory and config (config.c if set, else
 /// the uniform-pressure limit surface of the object's shape; times config.c_scale), and the
 /// centre of pressure in the object frame.
-QuasiStaticGeometry QuasiStaticGeometryFor(const limit_surface::Trajectory& trajectory,
+QuasiStaticGeometry QuasiStaticGeometryFor(const push::Trajectory& trajectory,
                                            const EstimatorConfig& config);
 
 }  // namespace pushgraph::graph

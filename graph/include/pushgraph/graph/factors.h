@@ -21,6 +21,7 @@
 #include <pushgraph/geometry/pose.h>
 #include <pushgraph/geometry/shape.h>
 #include <pushgraph/geometry/shape_pair.h>
+#include <pushgraph/graph/errors.h>
 
 #include <ceres/sized_cost_function.h>
 
@@ -34,13 +35,6 @@ namespace pushgraph::graph {
 
 using geometry::Pose2;
 using geometry::Vec2;
-
-/// Thrown for invalid estimation input (bad sigmas, unknown model, unusable trajectory, ...);
-/// what() names the offending field or sample.
-class GraphError : public std::invalid_argument {
- public:
-  using std::invalid_argument::invalid_argument;
-};
 
 /// M for an SE(2) pose: r = W Log(Between(measured, estimate)), W = diag(1/s_t, 1/s_t, 1/s_r).
 class PoseMeasurementFactor : public ceres::SizedCostFunction<3, 3> {

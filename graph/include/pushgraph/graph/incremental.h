@@ -20,7 +20,7 @@
 //
 // - OnlineEstimator takes measurements one at a time as a robot's sensors deliver them:
 //
-//     limit_surface::Trajectory setup;  // object and finger shapes, mass, frictions; no samples
+//     push::Trajectory setup;  // object and finger shapes, mass, frictions; no samples
 //     graph::OnlineEstimator online(setup, graph::Model::kQs, cfg, {/*contact_point=*/false, /*force=*/true});
 //     online.AddObjectPose(t, pose);    // from the sensor callbacks, each stream in time order
 //     online.AddFingerPose(t, pose);
@@ -69,7 +69,7 @@ struct OnlineStreams {
 
 class IncrementalEstimator {
  public:
-  IncrementalEstimator(const limit_surface::Trajectory& trajectory, Model model,
+  IncrementalEstimator(const push::Trajectory& trajectory, Model model,
                        const EstimatorConfig& config = {});
   ~IncrementalEstimator();
   IncrementalEstimator(const IncrementalEstimator&) = delete;
@@ -105,7 +105,7 @@ class OnlineEstimator {
   /// `setup` gives the object, the finger and, when the trajectory has them, mass and
   /// frictions; its measured streams must be empty. Its ground truth, if any, is only used
   /// for Finish()'s metrics (simulation and testing).
-  OnlineEstimator(const limit_surface::Trajectory& setup, Model model, const EstimatorConfig& config = {},
+  OnlineEstimator(const push::Trajectory& setup, Model model, const EstimatorConfig& config = {},
                   const OnlineStreams& streams = {});
   ~OnlineEstimator();
   OnlineEstimator(const OnlineEstimator&) = delete;

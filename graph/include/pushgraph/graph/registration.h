@@ -37,7 +37,7 @@
 #include <pushgraph/graph/config.h>
 #include <pushgraph/geometry/pose.h>
 #include <pushgraph/geometry/shape.h>
-#include <pushgraph/limit_surface/trajectory.h>
+#include <pushgraph/push/trajectory.h>
 
 #include <Eigen/Core>
 
@@ -128,7 +128,7 @@ struct ShapeFitCheck {
 
 /// The cheap check alone (smoothing and one exact query per contact sample): what
 /// EstimatorConfig::align_shape "auto" runs on every estimate before deciding to search.
-ShapeFitCheck CheckShapeFit(const limit_surface::Trajectory& trajectory, const RegistrationOptions& options = {});
+ShapeFitCheck CheckShapeFit(const push::Trajectory& trajectory, const RegistrationOptions& options = {});
 
 struct RegistrationResult {
   ShapeTransform transform;  ///< the best transform (the identity when nothing was found)
@@ -181,12 +181,12 @@ struct RegistrationResult {
 /// streams (object and finger poses; contact from the contact or force stream, else every
 /// finger sample). Throws GraphError when there are fewer than 8 usable contact samples or no
 /// object or finger stream.
-RegistrationResult RegisterShape(const limit_surface::Trajectory& trajectory, const RegistrationOptions& options = {});
+RegistrationResult RegisterShape(const push::Trajectory& trajectory, const RegistrationOptions& options = {});
 
 /// The same from several recordings of one object with one tracker (pooled contacts: pushes on
 /// different sides fix what one push leaves free). Every trajectory must carry the same object
 /// and finger shapes; throws GraphError otherwise.
-RegistrationResult RegisterShape(const std::vector<const limit_surface::Trajectory*>& recordings,
+RegistrationResult RegisterShape(const std::vector<const push::Trajectory*>& recordings,
                                  const RegistrationOptions& options = {});
 
 /// The finger's reference point in the object frame at every finger sample in contact (object
@@ -200,7 +200,7 @@ struct ContactPath {
   /// the raw noise (the measurement sigmas, else the streams' own second differences).
   double noise = 0.0;
 };
-ContactPath MeasuredContactPath(const limit_surface::Trajectory& trajectory, const RegistrationOptions& options);
+ContactPath MeasuredContactPath(const push::Trajectory& trajectory, const RegistrationOptions& options);
 
 /// Of the transforms that place a shape with k-fold symmetric outline identically (turns by
 /// multiples of 360/k degrees about its centroid), the one whose angle is closest to 0.

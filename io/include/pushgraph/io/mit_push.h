@@ -24,7 +24,7 @@
 //   io::MitRecording rec = io::ReadMitPush("motion_surface=abs_shape=rect1_....h5", options);
 //   if (rec.force_frozen) std::cerr << rec.force_fault << "\n";
 #include <pushgraph/geometry/shape.h>
-#include <pushgraph/limit_surface/trajectory.h>
+#include <pushgraph/push/trajectory.h>
 
 #include <string>
 #include <vector>
@@ -44,7 +44,7 @@ struct MitReadOptions {
 
 struct MitRecording {
   std::string file;
-  limit_surface::Streams streams;     ///< object_pose, finger_pose, force (probe on object)
+  push::Streams streams;     ///< object_pose, finger_pose, force (probe on object)
   bool force_frozen = false;
   std::string force_fault;            ///< why the force stream was dropped
   double contact_start = 0.0, contact_end = 0.0;  ///< contact phase (recording's own clock)
@@ -61,7 +61,7 @@ MitRecording ReadMitPush(const std::string& path, const MitReadOptions& options 
 
 /// The recording as a trajectory: the measured streams, and the same clean streams as ground
 /// truth (the dataset's motion capture is the paper's ground truth).
-limit_surface::Trajectory MitToTrajectory(const MitRecording& recording, const limit_surface::ObjectDescription& object,
-                                          const limit_surface::FingerDescription& finger);
+push::Trajectory MitToTrajectory(const MitRecording& recording, const push::ObjectDescription& object,
+                                          const push::FingerDescription& finger);
 
 }  // namespace pushgraph::io

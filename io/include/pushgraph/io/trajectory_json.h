@@ -14,9 +14,10 @@
 // friction, invalid shapes. Samples out of time order are sorted (stable); duplicate time
 // stamps within a stream are an error.
 //
-//   limit_surface::Trajectory t = io::LoadTrajectoryJson("push.json");
+//   push::Trajectory t = io::LoadTrajectoryJson("push.json");
 //   io::SaveTrajectoryJson(t, "copy.json");
-#include <pushgraph/limit_surface/trajectory.h>
+#include <pushgraph/io/errors.h>
+#include <pushgraph/push/trajectory.h>
 
 #include <stdexcept>
 #include <string>
@@ -24,21 +25,15 @@
 
 namespace pushgraph::io {
 
-/// Thrown for unreadable or invalid input files; what() names the file and the location.
-class IoError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
 inline constexpr const char* kTrajectoryFormat = "pushgraph-trajectory-1";
 
 /// Rows of a stream are sorted by time (stable); when `notes` is given, each stream that needed
 /// it gets a line there ("streams.force: sorted 2 rows that came after a later time stamp (first:
 /// row [5])") for the caller to show: a large reordering often means a clock glitch.
-limit_surface::Trajectory LoadTrajectoryJson(const std::string& path, std::vector<std::string>* notes = nullptr);
-limit_surface::Trajectory ParseTrajectoryJson(const std::string& text, const std::string& source_name = "<string>",
+push::Trajectory LoadTrajectoryJson(const std::string& path, std::vector<std::string>* notes = nullptr);
+push::Trajectory ParseTrajectoryJson(const std::string& text, const std::string& source_name = "<string>",
                                               std::vector<std::string>* notes = nullptr);
-std::string TrajectoryToJson(const limit_surface::Trajectory& trajectory, int indent = 1);
-void SaveTrajectoryJson(const limit_surface::Trajectory& trajectory, const std::string& path);
+std::string TrajectoryToJson(const push::Trajectory& trajectory, int indent = 1);
+void SaveTrajectoryJson(const push::Trajectory& trajectory, const std::string& path);
 
 }  // namespace pushgraph::io

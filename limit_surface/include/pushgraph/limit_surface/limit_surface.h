@@ -42,6 +42,15 @@ struct Summary {
 
 Summary Summarize(const Support& support);
 
+/// What the pushing models need from a region alone: its centre of pressure and
+/// c = tau_max / f_max. Neither depends on mass or friction (mu m g scales f_max and tau_max
+/// alike), so none is asked for. Throws LimitSurfaceError like MakeSupport for a bad region.
+struct RegionGeometry {
+  Vec2 centre_of_pressure = Vec2::Zero();
+  double c = 0.0;  ///< m
+};
+RegionGeometry RegionGeometryOf(const geometry::Shape& region, const Pressure& pressure = {});
+
 /// mu * integral of |r - centre of pressure| P dA: the torque sustaining pure rotation.
 double MaxFrictionTorque(const Support& support);
 

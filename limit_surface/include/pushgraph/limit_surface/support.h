@@ -16,6 +16,7 @@
 // rounded segments and rounded polygons are rejected (LimitSurfaceError says so).
 #include <pushgraph/geometry/shape.h>
 #include <pushgraph/geometry/types.h>
+#include <pushgraph/limit_surface/errors.h>
 
 #include <functional>
 #include <stdexcept>
@@ -34,13 +35,6 @@ inline constexpr double kStandardGravity = 9.80665;
 inline constexpr double kMaxMass = 1e6;
 inline constexpr double kMaxFriction = 10.0;
 inline constexpr double kMaxGravity = 1e3;
-
-/// Thrown for invalid input (negative mass, NaN, empty region, negative pressure, ...);
-/// what() names the offending field.
-class LimitSurfaceError : public std::invalid_argument {
- public:
-  using std::invalid_argument::invalid_argument;
-};
 
 /// P(r) = offset + slope . r, r in the shape frame (a tilted plane). Must be >= 0 on the region.
 struct LinearPressure {

@@ -1,0 +1,113 @@
+#pragma once
+// The evaluation's inputs: what a file holds (a pushgraph trajectory or an MIT recording), the
+// MIT objects and their meshes, the paper's noise added to clean streams, simulated pushes, and
+// the one loader used by `pushgraph estimate` and the evaluation.
+//
+//   evaluation::InputOverrides given;                    // e.g. from --object/--finger/--mass/--mu
+//   given.object_shape = geometry::LoadShapeJson("rect1.json");
+//   given.finger_shape = geometry::Shape::Disk(0.00235);
+//   given.mass = 0.8374;  given.mu_surface = 0.35;
+//   std::vector<std::string> notes;
+//   push::Trajectory t = evaluation::LoadEstimationInput("push.h5", given, &notes);
+//   push::Trajectory noisy = evaluation::AddNoise(t, evaluation::MakePaperNoise(push::NoiseKind::kGaussian), 7);
+//
+// Errors: EvaluationError naming the file (io::IoError from the readers passes through).
+#include <pushgraph/evaluation/errors.h>
+#include <pushgraph/geometry/shape.h>
+#include <pushgraph/push/noise.h>
+#include <pushgraph/push/trajectory.h>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace pushgraph::evaluation {
+
+/// Noise added to the clean streams (per axis, standard deviations). The paper's Sec. IV values
+/// are 0.5 cm and 0.5 N; its 0.5 rad for orientations (29 degrees) is implausible for a vision
+/// tracker and would make orientation unobservable from the poses, so 0.05 rad is used.
+struct PaperNoise {
+  double position = 0.005;  ///< m: object, finger and contact point
+  double rotation = 0.05;   ///< rad: object orientation (the finger's angle is not measured)
+  double force = 0.5;       ///< N
+};
+
+/// Noise model for `kind` (kGaussian or kBimodal) with the given sigmas on every stream.
+push::NoiseModel MakePaperNoise(push::NoiseKind kind, const PaperNoise& sigmas = {});
+
+/// The trajectory with ground truth = its clean streams (its ground truth when it has one, else
+/// its measured streams) and measured = clean + noise (push::ApplyNoise with `seed`);
+/// measurement_sigmas set to the noise's sigmas. Throws EvaluationError for a trajectory without ground
+/// truth whose measurement_sigmas say its streams are already noisy (noise added twice, metrics
+/// scored against noisy streams).
+push::Trajectory AddNoise(const push::Trajectory& trajectory, const push::NoiseModel& noise,
+                                   std::uint64_t seed);
+
+/// What a file holds, decided by its content: HDF5 signature or MIT arrays
+/// (tip_pose/object_pose/ft_wrench) -> kMitRecording; {"format": "pushgraph-trajectory-1"} ->
+/// kTrajectory. Throws EvaluationError naming the file when it is neither (or cannot be read).
+enum class InputKind { kMitRecording, kTrajectory };
+InputKind DetectInputKind(const std::string& path);
+
+/// An object and the finger that pushes it (an MIT object and its probe, or any other): the
+/// push module's descriptions, as every trajectory carries them.
+struct ObjectModel {
+  push::ObjectDescription object;
+  push::FingerDescription finger{geometry::Shape(), 0.25};
+};
+
+/// Masses of the dataset's eleven objects from its own shape table: rect1 0.8374, rect2 1.045,
+/// rect3 1.2508, ellip1 0.8937, ellip2 1.1104, ellip3 1.3338, tri1 0.8028, tri2 0.9826, tri3
+/// 1.1326, hex 0.9827, butter 1.1974 kg. nullopt for other names.
+std::optional<double> MitObjectMass(const std::string& object_name);
+
+/// The MIT object named `object_name` with its footprint from `mesh_dir`/NAME.obj (up z), the
+/// probe a disk of the radius of `mesh_dir`/tip.obj (a cylinder along y: 4.7 mm), the dataset mass, mu_surface 0.35 (the apparent
+/// friction of the ellip1 recordings, dataset README) and mu_contact 0.25. Throws EvaluationError when
+/// the name or a mesh is unknown.
+ObjectModel MitObjectModel(const std::string& object_name, const std::string& mesh_dir);
+
+/// What replaces a file's object and finger (the command line's --object, --finger, --mass,
+/// --mu). An MIT recording carries neither shape nor mass: it needs all four.
+struct InputOverrides {
+  std::optional<geometry::Shape> object_shape, finger_shape;
+  std::optional<double> mass, mu_surface;
+};
+
+/// A trajectory file or an MIT recording (DetectInputKind) as the estimator's input: a trajectory
+/// with the overrides applied; a recording trimmed to its contact phase (refused when nothing was
+/// pushed), time stamps its own, object and finger from the overrides (mu_contact 0.25). The
+/// readers' notes (rows sorted, samples dropped) go to `notes`; `kind` receives the input's kind.
+push::Trajectory LoadEstimationInput(const std::string& path, const InputOverrides& overrides,
+                                     std::vector<std::string>* notes = nullptr, InputKind* kind = nullptr);
+
+/// An MIT recording trimmed to its contact phase (refused when nothing was pushed), each stream
+/// decimated to at most one sample per 1/rate s (0: every sample), with `model`'s object and
+/// finger. Notes as above.
+push::Trajectory ReadMitTrajectory(const std::string& path, const ObjectModel& model, double rate,
+                                   std::vector<std::string>* notes = nullptr);
+
+/// Simulated pushes: the finger pushes `shape` straight over `push_distance` at `speed`; push
+/// direction uniform in [0, 2 pi) and sideways offset uniform in +-offset_fraction of the shape's
+/// smaller half-extent, drawn from a generator seeded with (seed, index). Rates: the paper's
+/// Sec. V (object 25 Hz, finger/contact/force 250 Hz).
+struct SimulationSpec {
+  int count = 0;
+  std::string name = "sim";  ///< group name in the tables
+  push::ObjectDescription object;
+  push::FingerDescription finger{geometry::Shape(), 0.25};
+  double push_distance = 0.05;  ///< m
+  double speed = 0.05;          ///< m/s
+  double offset_fraction = 0.5;
+  double standoff = 0.005;  ///< m
+};
+
+/// The clean (noise-free) simulated push number `index`.
+push::Trajectory SimulatedPush(const SimulationSpec& spec, int index, std::uint64_t seed);
+
+/// Files from paths, folders (recursively: *.h5, *.hdf5, *.json) and glob patterns, sorted and
+/// without duplicates. Throws EvaluationError for a path or pattern that matches no file.
+std::vector<std::string> ExpandInputs(const std::vector<std::string>& patterns);
+
+}  // namespace pushgraph::evaluation

@@ -1,0 +1,318 @@
+// The evaluation's inputs (inputs.h): file kinds, MIT objects and recordings, the paper's
+// noise, simulated pushes, input lists.
+#include "internal.h"
+
+#include <pushgraph/evaluation/inputs.h>
+#include <pushgraph/io/footprint.h>
+#include <pushgraph/io/mit_push.h>
+#include <pushgraph/io/trajectory_json.h>
+#include <pushgraph/push/simulator.h>
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <random>
+#include <regex>
+#include <set>
+
+#include <glob.h>
+
+namespace pushgraph::evaluation {
+namespace {
+
+namespace fs = std::filesystem;
+using io::UpAxis;
+using internal::SplitMix;
+
+// Mesh footprints by path and axis: every recording of an object shares one (the Boolean union
+// of a mesh's faces takes up to seconds).
+std::mutex g_footprint_mutex;
+std::map<std::string, geometry::Shape> g_footprints;  // mesh path + axis -> footprint
+
+geometry::Shape CachedFootprint(const std::string& path, UpAxis up) {
+  const std::string key = path + (up == UpAxis::kY ? "#y" : "#z");
+  {
+    std::lock_guard<std::mutex> lock(g_footprint_mutex);
+    auto it = g_footprints.find(key);
+    if (it != g_footprints.end()) return it->second;
+  }
+  io::FootprintOptions o;
+  o.up = up;
+  geometry::Shape s = io::MeshFootprint(path, o);
+  std::lock_guard<std::mutex> lock(g_footprint_mutex);
+  return g_footprints.emplace(key, std::move(s)).first->second;
+}
+
+// An `obj` folder holding NAME.obj beside or above the recording (the dataset's layout:
+// abs/ellip1/recording.h5 and obj/ellip1.obj).
+std::string FindMeshDir(const std::string& recording, const std::string& name) {
+  fs::path dir = fs::absolute(fs::path(recording)).parent_path();
+  for (int up = 0; up < 4 && !dir.empty(); ++up) {
+    if (fs::exists(dir / "obj" / (name + ".obj"))) return (dir / "obj").string();
+    if (dir == dir.parent_path()) break;
+    dir = dir.parent_path();
+  }
+  return "";
+}
+
+template <class Sample>
+void Decimate(std::vector<Sample>* v, double t0, double rate) {
+  std::vector<Sample> out;
+  long long last_bin = std::numeric_limits<long long>::min();
+  for (const Sample& s : *v) {
+    const long long bin = static_cast<long long>(std::floor((s.t - t0) * rate));
+    if (bin != last_bin) out.push_back(s);
+    last_bin = bin;
+  }
+  *v = std::move(out);
+}
+
+}  // namespace
+
+namespace internal {
+
+// MIT object name from "..._shape=ellip1_..." or the folder name.
+std::string MitGroup(const std::string& path) {
+  static const std::regex re("shape=([A-Za-z0-9]+)");
+  const std::string base = fs::path(path).filename().string();
+  std::smatch m;
+  if (std::regex_search(base, m, re)) return m[1];
+  const std::string parent = fs::path(path).parent_path().filename().string();
+  return parent.empty() ? "." : parent;
+}
+
+// An `obj` folder holding NAME.obj beside or above the recording (the dataset's layout:
+
+push::Trajectory LoadCleanTrajectory(const EvaluationItem& item, const EvaluationOptions& o) {
+  if (item.source == EvaluationItem::Source::kSimulated) return SimulatedPush(o.simulation, item.sim_index, o.seed);
+  if (DetectInputKind(item.path) == InputKind::kTrajectory) {
+    push::Trajectory t = io::LoadTrajectoryJson(item.path);
+    if (t.ground_truth) t.measured = *t.ground_truth;  // the clean streams get the protocol's noise
+    t.ground_truth = t.measured;
+    return t;
+  }
+  ObjectModel model;
+  if (o.object_override) {
+    model = *o.object_override;
+  } else if (auto it = o.objects.find(item.group); it != o.objects.end()) {
+    model = it->second;
+  } else {
+    std::string dir = o.mesh_dir.empty() ? FindMeshDir(item.path, item.group) : o.mesh_dir;
+    if (dir.empty()) {
+      throw EvaluationError(item.path + ": no mesh for object '" + item.group +
+                    "' (no obj/" + item.group + ".obj beside or above it); give --mesh-dir, --object/--finger/--mass/--mu or an evaluation config");
+    }
+    model = MitObjectModel(item.group, dir);
+  }
+  return ReadMitTrajectory(item.path, model, o.mit_rate);
+}
+
+}  // namespace internal
+
+push::Trajectory ReadMitTrajectory(const std::string& path, const ObjectModel& model, double rate,
+                                   std::vector<std::string>* notes) {
+  io::MitReadOptions read;
+  read.trim_to_contact = true;
+  io::MitRecording rec = io::ReadMitPush(path, read);
+  if (notes) notes->insert(notes->end(), rec.notes.begin(), rec.notes.end());
+  if (!rec.contact_found) {
+    // Nothing was pushed: the contact, force and quasi-static factors would be fitted to a
+    // push that never happened (a finger far from a resting object).
+    throw EvaluationError(path + ": no contact phase found (no force above the contact threshold and no object "
+                          "motion): nothing was pushed, nothing to estimate");
+  }
+  if (rate > 0.0) {
+    double t0 = std::numeric_limits<double>::infinity();
+    for (const auto& s : rec.streams.object_pose) t0 = std::min(t0, s.t);
+    for (const auto& s : rec.streams.finger_pose) t0 = std::min(t0, s.t);
+    for (const auto& s : rec.streams.force) t0 = std::min(t0, s.t);
+    Decimate(&rec.streams.object_pose, t0, rate);
+    Decimate(&rec.streams.finger_pose, t0, rate);
+    Decimate(&rec.streams.force, t0, rate);
+  }
+  // Time stamps stay the recording's own (unix seconds): ReadMitPush keeps them.
+  return io::MitToTrajectory(rec, model.object, model.finger);
+}
+
+push::Trajectory LoadEstimationInput(const std::string& path, const InputOverrides& given,
+                                     std::vector<std::string>* notes, InputKind* kind_out) {
+  const InputKind kind = DetectInputKind(path);
+  if (kind_out) *kind_out = kind;
+  if (kind == InputKind::kTrajectory) {
+    push::Trajectory t = io::LoadTrajectoryJson(path, notes);
+    if (given.object_shape) t.object.shape = *given.object_shape;
+    if (given.finger_shape) t.finger.shape = *given.finger_shape;
+    if (given.mass) t.object.mass = *given.mass;
+    if (given.mu_surface) t.object.mu_surface = *given.mu_surface;
+    return t;
+  }
+  if (!given.object_shape || !given.finger_shape || !given.mass || !given.mu_surface) {
+    throw EvaluationError(path + " is an MIT recording: give the object and probe with --object SHAPE.json --finger "
+                          "SHAPE.json --mass KG --mu MU (e.g. shapes from `pushgraph footprint`, masses from the "
+                          "dataset README)");
+  }
+  ObjectModel model;
+  model.object.shape = *given.object_shape;
+  model.object.mass = *given.mass;
+  model.object.mu_surface = *given.mu_surface;
+  model.finger.shape = *given.finger_shape;
+  return ReadMitTrajectory(path, model, /*rate=*/0.0, notes);
+}
+
+push::NoiseModel MakePaperNoise(push::NoiseKind kind, const PaperNoise& s) {
+  push::NoiseModel m;
+  m.object_pose.position = {kind, s.position};
+  m.object_pose.angle = {kind, s.rotation};
+  m.finger_pose.position = {kind, s.position};
+  m.contact_point.position = {kind, s.position};
+  m.force.position = {kind, s.force};
+  push::ValidateNoise(m);
+  return m;
+}
+
+push::Trajectory AddNoise(const push::Trajectory& trajectory, const push::NoiseModel& noise, std::uint64_t seed) {
+  if (!trajectory.ground_truth && trajectory.measurement_sigmas) {
+    const push::MeasurementSigmas& m = *trajectory.measurement_sigmas;
+    if (m.object_trans > 0 || m.object_rot > 0 || m.finger_trans > 0 || m.finger_rot > 0 || m.contact > 0 || m.force > 0) {
+      throw EvaluationError("adding noise needs clean streams, but these streams already carry noise (measurement_sigmas) "
+                    "and there is no ground_truth: the noise would be added twice and the metrics scored against "
+                    "noisy streams");
+    }
+  }
+  push::Trajectory t = trajectory;
+  const push::Streams clean = trajectory.ground_truth ? *trajectory.ground_truth : trajectory.measured;
+  t.ground_truth = clean;
+  t.measured = push::ApplyNoise(clean, noise, seed);
+  t.measurement_sigmas = push::SigmasOf(noise);
+  return t;
+}
+
+InputKind DetectInputKind(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw EvaluationError(path + ": is a directory, not an input file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw EvaluationError(path + ": cannot open file");
+  char magic[8] = {};
+  in.read(magic, 8);
+  if (in.gcount() == 8 && std::string(magic, 8) == std::string("\x89HDF\r\n\x1a\n", 8)) return InputKind::kMitRecording;
+  in.clear();
+  in.seekg(0);
+  nlohmann::json doc;
+  try {
+    doc = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw EvaluationError(path + ": neither an HDF5 file nor valid JSON (" + e.what() + ")");
+  } catch (const std::exception& e) {
+    throw EvaluationError(path + ": cannot read the file (" + e.what() + ")");
+  }
+  if (doc.is_object() && doc.contains("format")) {
+    if (doc["format"] == io::kTrajectoryFormat) return InputKind::kTrajectory;
+    throw EvaluationError(path + ": unknown format " + doc["format"].dump() + " (expected \"" + io::kTrajectoryFormat + "\")");
+  }
+  if (doc.is_object() && doc.contains("tip_pose") && doc.contains("object_pose") && doc.contains("ft_wrench")) {
+    if (fs::path(path).extension() != ".json") {
+      throw EvaluationError(path + ": an MIT JSON recording must have the .json extension (the reader decides by it)");
+    }
+    return InputKind::kMitRecording;
+  }
+  throw EvaluationError(path + ": neither a pushgraph trajectory (\"format\": \"" + io::kTrajectoryFormat +
+                "\") nor an MIT recording (HDF5, or JSON with tip_pose, object_pose, ft_wrench)");
+}
+
+std::optional<double> MitObjectMass(const std::string& name) {
+  static const std::map<std::string, double> kMass = {
+      {"rect1", 0.8374},  {"rect2", 1.045},  {"rect3", 1.2508}, {"ellip1", 0.8937}, {"ellip2", 1.1104}, {"ellip3", 1.3338},
+      {"tri1", 0.8028},   {"tri2", 0.9826},  {"tri3", 1.1326},  {"hex", 0.9827},    {"butter", 1.1974}};
+  auto it = kMass.find(name);
+  if (it == kMass.end()) return std::nullopt;
+  return it->second;
+}
+
+ObjectModel MitObjectModel(const std::string& name, const std::string& mesh_dir) {
+  const std::optional<double> mass = MitObjectMass(name);
+  if (!mass) {
+    throw EvaluationError("unknown MIT object '" + name +
+                  "' (known: rect1-3, ellip1-3, tri1-3, hex, butter); give its shape and mass");
+  }
+  ObjectModel m;
+  m.object.shape = CachedFootprint((fs::path(mesh_dir) / (name + ".obj")).string(), UpAxis::kZ);
+  // The probe is a cylinder: a disk of the mesh's radius (its footprint's vertices lie on the
+  // circle). A disk, not the polygon: the intersection factor's obstacle (a Minkowski sum) then
+  // does not depend on the relative rotation and is built once instead of at every new angle.
+  const geometry::Box2 tip = CachedFootprint((fs::path(mesh_dir) / "tip.obj").string(), UpAxis::kY).bounds();
+  m.finger.shape = geometry::Shape::Disk(0.25 * ((tip.max.x() - tip.min.x()) + (tip.max.y() - tip.min.y())));
+  m.finger.mu_contact = 0.25;
+  m.object.mass = *mass;
+  m.object.mu_surface = 0.35;
+  return m;
+}
+
+push::Trajectory SimulatedPush(const SimulationSpec& spec, int index, std::uint64_t seed) {
+  push::PushPlan plan;
+  plan.object = spec.object;
+  plan.finger = spec.finger;
+  plan.speed = spec.speed;
+  const geometry::Box2 b = plan.object.shape.bounds();
+  const double half = 0.5 * std::min(b.max.x() - b.min.x(), b.max.y() - b.min.y());
+  std::mt19937_64 rng(SplitMix(SplitMix(seed) ^ static_cast<std::uint64_t>(index)));
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::string last_error;
+  for (int attempt = 0; attempt < 20; ++attempt) {
+    const double angle = 2.0 * M_PI * unit(rng);
+    const double offset = spec.offset_fraction * half * (2.0 * unit(rng) - 1.0);
+    try {
+      plan.waypoints = push::StraightPushPath(plan, angle, offset, spec.standoff, spec.push_distance);
+    } catch (const std::exception& e) {
+      last_error = e.what();
+      continue;
+    }
+    push::Trajectory t = push::Simulate(plan).trajectory;
+    t.measured = *t.ground_truth;
+    t.measurement_sigmas.reset();
+    return t;
+  }
+  throw EvaluationError("simulated push " + std::to_string(index) + ": no push line hits the object (" + last_error + ")");
+}
+
+std::vector<std::string> ExpandInputs(const std::vector<std::string>& patterns) {
+  std::set<std::string> files;
+  auto add_dir = [&](const fs::path& dir) {
+    for (const auto& e : fs::recursive_directory_iterator(dir, fs::directory_options::follow_directory_symlink)) {
+      if (!e.is_regular_file()) continue;
+      const std::string ext = e.path().extension().string();
+      if (ext == ".h5" || ext == ".hdf5" || ext == ".json") files.insert(e.path().lexically_normal().string());
+    }
+  };
+  for (const std::string& p : patterns) {
+    if (fs::is_directory(p)) {
+      add_dir(p);
+    } else if (fs::is_regular_file(p)) {
+      files.insert(fs::path(p).lexically_normal().string());
+    } else if (p.find_first_of("*?[") != std::string::npos) {
+      glob_t g{};
+      const int rc = ::glob(p.c_str(), 0, nullptr, &g);
+      if (rc != 0) {
+        ::globfree(&g);
+        throw EvaluationError("input pattern '" + p + "' matches no file");
+      }
+      for (std::size_t i = 0; i < g.gl_pathc; ++i) {
+        const fs::path m(g.gl_pathv[i]);
+        if (fs::is_directory(m)) add_dir(m);
+        else if (fs::is_regular_file(m)) files.insert(m.lexically_normal().string());
+      }
+      ::globfree(&g);
+    } else {
+      throw EvaluationError("input '" + p + "': no such file or directory");
+    }
+  }
+  return {files.begin(), files.end()};
+}
+
+
+}  // namespace pushgraph::evaluation

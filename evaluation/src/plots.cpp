@@ -1,0 +1,772 @@
+// SVG plots of pushes and estimates (plot_svg.h). Plain string building: no drawing library, the
+// output is small hand-readable SVG 1.1 that browsers and rsvg-convert render alike.
+#include <pushgraph/geometry/file_output.h>
+#include <pushgraph/evaluation/plots.h>
+#include <pushgraph/io/trajectory_json.h>
+#include <pushgraph/push/scoring.h>
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+namespace pushgraph::evaluation {
+namespace {
+
+using geometry::Pose2;
+using geometry::Vec2;
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr const char* kFont = "font-family='DejaVu Sans, Helvetica, Arial, sans-serif'";
+
+// Palette after the paper's Fig. 6: measured pink, estimated blue, ground truth black.
+constexpr const char* kMeasuredColor = "#d6449a";
+constexpr const char* kEstimatedColor = "#1f5fa8";
+constexpr const char* kTruthColor = "#222222";
+constexpr const char* kFingerColor = "#7f7f7f";
+constexpr const char* kContactColor = "#e07b00";
+constexpr const char* kForceColor = "#c0282d";
+// Series colours of the time-series plot (raw first: pink like the measured dots).
+constexpr const char* kSeriesColors[] = {"#d6449a", "#2ca02c", "#9467bd", "#1f5fa8", "#e07b00", "#17becf", "#8c564b"};
+
+std::string Num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.2f", v);
+  return buf;
+}
+
+std::string Escape(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '\'': out += "&apos;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+// A "nice" number (1, 2 or 5 times a power of ten) near `x` (Heckbert, Graphics Gems I, 1990).
+double NiceNumber(double x, bool round) {
+  if (!(x > 0.0) || !std::isfinite(x)) return 1.0;
+  const double exponent = std::floor(std::log10(x));
+  const double fraction = x / std::pow(10.0, exponent);
+  double nice;
+  if (round) nice = fraction < 1.5 ? 1 : fraction < 3 ? 2 : fraction < 7 ? 5 : 10;
+  else nice = fraction <= 1 ? 1 : fraction <= 2 ? 2 : fraction <= 5 ? 5 : 10;
+  return nice * std::pow(10.0, exponent);
+}
+
+// The largest 1-2-5 value not above x.
+double NiceFloor(double x) {
+  if (!(x > 0.0) || !std::isfinite(x)) return 1.0;
+  const double exponent = std::floor(std::log10(x));
+  const double fraction = x / std::pow(10.0, exponent);
+  const double nice = fraction >= 5 ? 5 : fraction >= 2 ? 2 : 1;
+  return nice * std::pow(10.0, exponent);
+}
+
+std::vector<double> Ticks(double lo, double hi, int target_count) {
+  const double step = NiceNumber((hi - lo) / std::max(1, target_count), true);
+  std::vector<double> ticks;
+  for (double v = std::ceil(lo / step - 1e-9) * step; v <= hi + 1e-9 * step; v += step)
+    ticks.push_back(std::abs(v) < 1e-12 * step ? 0.0 : v);
+  return ticks;
+}
+
+std::string TickLabel(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+struct Bounds {
+  double xmin = std::numeric_limits<double>::infinity(), xmax = -xmin, ymin = xmin, ymax = -xmin;
+  void Add(const Vec2& p) {
+    if (!std::isfinite(p.x()) || !std::isfinite(p.y())) return;
+    xmin = std::min(xmin, p.x());
+    xmax = std::max(xmax, p.x());
+    ymin = std::min(ymin, p.y());
+    ymax = std::max(ymax, p.y());
+  }
+  bool empty() const { return !(xmax >= xmin); }
+};
+
+double Cross(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+// The boundary of a rounded ring (every point within r of it), sampled: offset edges joined by
+// circular arcs (at most 10 degrees per segment) at convex corners and by the offset lines'
+// intersection at reflex corners (exact while edges are longer than the rounding, as in every
+// shipped shape). Rings keep the shape's convention: interior on the left, so the offset side is
+// the right-hand normal for outer boundaries and holes alike.
+std::vector<Vec2> RoundedRing(const geometry::Ring& ring, double r) {
+  const std::size_t n = ring.size();
+  if (r <= 0.0) return ring;
+  std::vector<Vec2> out;
+  auto arc = [&](const Vec2& centre, double a0, double sweep) {
+    const int segments = std::max(1, static_cast<int>(std::ceil(std::abs(sweep) / (M_PI / 18.0))));
+    for (int k = 0; k <= segments; ++k) {
+      const double a = a0 + sweep * k / segments;
+      out.push_back(centre + r * Vec2(std::cos(a), std::sin(a)));
+    }
+  };
+  if (n == 1) {
+    arc(ring[0], 0.0, 2.0 * M_PI);
+    out.pop_back();
+    return out;
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec2& prev = ring[(i + n - 1) % n];
+    const Vec2& v = ring[i];
+    const Vec2& next = ring[(i + 1) % n];
+    const Vec2 d0 = (v - prev).normalized(), d1 = (next - v).normalized();
+    const Vec2 n0(d0.y(), -d0.x()), n1(d1.y(), -d1.x());
+    const double turn = std::atan2(Cross(d0, d1), d0.dot(d1));  // > 0: convex corner (interior on the left)
+    if (n == 2 || turn > 0.0) {
+      arc(v, std::atan2(n0.y(), n0.x()), n == 2 ? M_PI : turn);
+    } else if (1.0 + n0.dot(n1) > 0.1) {
+      out.push_back(v + r * (n0 + n1) / (1.0 + n0.dot(n1)));
+    } else {  // a needle-sharp reflex corner: keep both offset points rather than a far miter
+      out.push_back(v + r * n0);
+      out.push_back(v + r * n1);
+    }
+  }
+  return out;
+}
+
+// Boundary rings (world frame) of a shape at a pose: outer boundaries and holes, rounding sampled.
+std::vector<std::vector<Vec2>> WorldRings(const geometry::Shape& shape, const Pose2& pose) {
+  std::vector<std::vector<Vec2>> rings;
+  if (shape.empty()) return rings;
+  const Eigen::Matrix2d R = pose.rotation();
+  const Vec2 t = pose.translation();
+  auto add = [&](const geometry::Ring& ring) {
+    std::vector<Vec2> world = RoundedRing(ring, shape.radius());
+    for (Vec2& p : world) p = R * p + t;
+    rings.push_back(std::move(world));
+  };
+  for (const geometry::Polygon& polygon : shape.polygons()) {
+    add(polygon.outer);
+    for (const geometry::Ring& hole : polygon.holes) add(hole);
+  }
+  return rings;
+}
+
+// World (metres) to picture (pixels): equal aspect, y up.
+struct WorldView {
+  double scale = 1.0;  // px per metre
+  double x0 = 0.0, y0 = 0.0;  // pixel position of the world point (xmin, ymax)
+  double xmin = 0.0, ymax = 0.0;
+  double X(double x) const { return x0 + (x - xmin) * scale; }
+  double Y(double y) const { return y0 + (ymax - y) * scale; }
+  std::string P(const Vec2& p) const { return Num(X(p.x())) + "," + Num(Y(p.y())); }
+};
+
+std::string RingsPath(const std::vector<std::vector<Vec2>>& rings, const WorldView& view) {
+  std::string d;
+  for (const auto& ring : rings) {
+    if (ring.size() < 2) continue;
+    for (std::size_t i = 0; i < ring.size(); ++i) d += (i == 0 ? "M" : "L") + view.P(ring[i]) + " ";
+    if (ring.size() > 2) d += "Z ";
+  }
+  return d;
+}
+
+// Polyline path through the points, broken (new "M") wherever consecutive times are further apart
+// than `max_gap` (a tracking loss is shown as a gap, not as a straight line across it).
+std::string PolylinePath(const std::vector<double>& t, const std::vector<Vec2>& points, double max_gap,
+                         const WorldView& view) {
+  std::string d;
+  bool pen_down = false;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!std::isfinite(points[i].x()) || !std::isfinite(points[i].y())) {
+      pen_down = false;
+      continue;
+    }
+    if (i > 0 && t[i] - t[i - 1] > max_gap) pen_down = false;
+    d += (pen_down ? "L" : "M") + view.P(points[i]) + " ";
+    pen_down = true;
+  }
+  return d;
+}
+
+double MedianStep(const std::vector<double>& t) {
+  std::vector<double> steps;
+  for (std::size_t i = 1; i < t.size(); ++i)
+    if (t[i] > t[i - 1]) steps.push_back(t[i] - t[i - 1]);
+  if (steps.empty()) return std::numeric_limits<double>::infinity();
+  std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
+  return steps[steps.size() / 2];
+}
+
+Pose2 InterpolatePose(const std::vector<push::PoseSample>& samples, double t) {
+  return push::PoseAtClamped(samples.begin(), samples.end(), t);
+}
+
+// The sample of a stream nearest in time to t, if one lies within `tolerance`.
+template <class Sample>
+const Sample* Nearest(const std::vector<Sample>& samples, double t, double tolerance) {
+  auto it = std::lower_bound(samples.begin(), samples.end(), t,
+                             [](const Sample& s, double time) { return s.t < time; });
+  const Sample* best = nullptr;
+  double best_dt = tolerance;
+  for (auto c : {it, it == samples.begin() ? it : it - 1}) {
+    if (c == samples.end()) continue;
+    const double dt = std::abs(c->t - t);
+    if (dt <= best_dt) best_dt = dt, best = &*c;
+  }
+  return best;
+}
+
+// Two-sigma ellipse of a 2x2 position covariance: semi-axes 2 sqrt(eigenvalue) along the
+// eigenvectors (the 86.5% contour of a 2-D Gaussian). Empty when the covariance is unusable.
+std::string Ellipse(const Eigen::Matrix2d& cov, const Vec2& centre, const WorldView& view, const std::string& cls,
+                    const std::string& style) {
+  if (!cov.allFinite()) return "";
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(0.5 * (cov + cov.transpose()));
+  if (eig.info() != Eigen::Success) return "";
+  const Eigen::Vector2d lambda = eig.eigenvalues().cwiseMax(0.0);
+  const Eigen::Vector2d major = eig.eigenvectors().col(1);
+  const double rx = std::max(2.0 * std::sqrt(lambda(1)) * view.scale, 0.3);
+  const double ry = std::max(2.0 * std::sqrt(lambda(0)) * view.scale, 0.3);
+  // Picture y points down: a world angle a is -a on screen.
+  const double angle_deg = -std::atan2(major.y(), major.x()) * 180.0 / M_PI;
+  const double cx = view.X(centre.x()), cy = view.Y(centre.y());
+  return "<ellipse class='" + cls + "' cx='" + Num(cx) + "' cy='" + Num(cy) + "' rx='" + Num(rx) + "' ry='" +
+         Num(ry) + "' transform='rotate(" + Num(angle_deg) + " " + Num(cx) + " " + Num(cy) + ")' " + style + "/>\n";
+}
+
+// An arrow from `from` to `to` (pixels) as one path: shaft and filled head.
+std::string Arrow(double x0, double y0, double x1, double y1, const std::string& cls, const std::string& color,
+                  double width, const std::string& extra = "") {
+  const double dx = x1 - x0, dy = y1 - y0, length = std::hypot(dx, dy);
+  if (!(length > 0.5)) return "";
+  const double ux = dx / length, uy = dy / length;
+  const double head = std::min(9.0, 0.45 * length), half = 0.4 * head;
+  const double bx = x1 - head * ux, by = y1 - head * uy;
+  std::string d = "M" + Num(x0) + "," + Num(y0) + " L" + Num(bx) + "," + Num(by) + " M" + Num(x1) + "," + Num(y1) +
+                  " L" + Num(bx - half * uy) + "," + Num(by + half * ux) + " L" + Num(bx + half * uy) + "," +
+                  Num(by - half * ux) + " Z";
+  return "<path class='" + cls + "' d='" + d + "' stroke='" + color + "' fill='" + color + "' stroke-width='" +
+         Num(width) + "' " + extra + "/>\n";
+}
+
+std::string Text(double x, double y, const std::string& text, int size = 13, const std::string& anchor = "start",
+                 const std::string& extra = "") {
+  return "<text x='" + Num(x) + "' y='" + Num(y) + "' font-size='" + std::to_string(size) + "' text-anchor='" +
+         anchor + "' " + kFont + " " + extra + ">" + Escape(text) + "</text>\n";
+}
+
+std::string SvgOpen(double width, double height) {
+  return "<?xml version='1.0' encoding='UTF-8'?>\n<svg xmlns='http://www.w3.org/2000/svg' version='1.1' width='" +
+         Num(width) + "' height='" + Num(height) + "' viewBox='0 0 " + Num(width) + " " + Num(height) +
+         "'>\n<rect x='0' y='0' width='" + Num(width) + "' height='" + Num(height) + "' fill='white'/>\n";
+}
+
+// Time windows in which a stream has no samples although its neighbours are close: gaps longer
+// than 3 median sample periods (the object tracker losing the object).
+std::vector<std::pair<double, double>> StreamGaps(const std::vector<double>& t) {
+  std::vector<std::pair<double, double>> gaps;
+  const double step = MedianStep(t);
+  if (!std::isfinite(step)) return gaps;
+  for (std::size_t i = 1; i < t.size(); ++i)
+    if (t[i] - t[i - 1] > 3.0 * step) gaps.emplace_back(t[i - 1], t[i]);
+  return gaps;
+}
+
+// The time-series panel drawn into the box (x, y, width, height) of a larger picture.
+std::string TimeSeriesPanel(const std::vector<TimeSeries>& series, const std::string& title,
+                            const std::string& y_label, const std::vector<std::pair<double, double>>& shaded,
+                            double x, double y, double width, double height) {
+  std::string svg;
+  const double legend_width = 170.0;
+  const double left = x + 62.0, right = x + width - legend_width, top = y + 30.0, bottom = y + height - 42.0;
+  double tmin = std::numeric_limits<double>::infinity(), tmax = -tmin, vmax = 0.0;
+  for (const TimeSeries& s : series) {
+    for (std::size_t i = 0; i < s.t.size() && i < s.value.size(); ++i) {
+      if (!std::isfinite(s.t[i]) || !std::isfinite(s.value[i])) continue;
+      tmin = std::min(tmin, s.t[i]);
+      tmax = std::max(tmax, s.t[i]);
+      vmax = std::max(vmax, s.value[i]);
+    }
+  }
+  for (const auto& [t0, t1] : shaded) {
+    if (std::isfinite(t0)) tmin = std::min(tmin, t0);
+    if (std::isfinite(t1)) tmax = std::max(tmax, t1);
+  }
+  if (!(tmax >= tmin)) tmin = 0.0, tmax = 1.0;
+  if (tmax == tmin) tmax = tmin + 1.0;
+  // Unix time stamps (MIT recordings): at 1.46e9 s every tick would read the same; plot the time
+  // since the first sample and say so in the title.
+  if (std::abs(tmin) > 1e3 && std::abs(tmin) > 1e4 * (tmax - tmin)) {
+    std::vector<TimeSeries> shifted = series;
+    for (TimeSeries& s : shifted) {
+      for (double& t : s.t) t -= tmin;
+    }
+    std::vector<std::pair<double, double>> windows = shaded;
+    for (auto& w : windows) w = {w.first - tmin, w.second - tmin};
+    char origin[64];
+    std::snprintf(origin, sizeof origin, " (time from t0 = %.3f s)", tmin);
+    return TimeSeriesPanel(shifted, title + origin, y_label, windows, x, y, width, height);
+  }
+  double vmin = 0.0;
+  for (const TimeSeries& s : series)
+    for (double v : s.value)
+      if (std::isfinite(v)) vmin = std::min(vmin, v);
+  if (!(vmax > vmin)) vmax = vmin + 1.0;
+  // The top of the axis is the first tick above the data plus 5% headroom.
+  const double ystep = NiceNumber((1.05 * vmax - vmin) / 5.0, true);
+  vmax = std::ceil(1.05 * vmax / ystep - 1e-9) * ystep;
+  vmin = std::floor(vmin / ystep + 1e-9) * ystep;
+  std::vector<double> yticks;
+  for (double v = vmin; v <= vmax + 1e-9 * ystep; v += ystep) yticks.push_back(std::abs(v) < 1e-12 * ystep ? 0.0 : v);
+  const std::vector<double> xticks = Ticks(tmin, tmax, 8);
+  auto X = [&](double t) { return left + (t - tmin) / (tmax - tmin) * (right - left); };
+  auto Y = [&](double v) { return bottom - (v - vmin) / (vmax - vmin) * (bottom - top); };
+
+  svg += Text(x + width / 2.0 - legend_width / 2.0, y + 19.0, title, 15, "middle", "font-weight='bold'");
+  for (const auto& [t0, t1] : shaded) {
+    const double a = X(std::max(t0, tmin)), b = X(std::min(t1, tmax));
+    if (b > a)
+      svg += "<rect class='shaded' x='" + Num(a) + "' y='" + Num(top) + "' width='" + Num(b - a) + "' height='" +
+             Num(bottom - top) + "' fill='#cccccc' fill-opacity='0.45'/>\n";
+  }
+  for (double v : yticks) {
+    svg += "<line x1='" + Num(left) + "' y1='" + Num(Y(v)) + "' x2='" + Num(right) + "' y2='" + Num(Y(v)) +
+           "' stroke='#e4e4e4'/>\n";
+    svg += Text(left - 6.0, Y(v) + 4.0, TickLabel(v), 11, "end");
+  }
+  for (double t : xticks) {
+    svg += "<line x1='" + Num(X(t)) + "' y1='" + Num(bottom) + "' x2='" + Num(X(t)) + "' y2='" + Num(bottom + 4.0) +
+           "' stroke='black'/>\n";
+    svg += Text(X(t), bottom + 17.0, TickLabel(t), 11, "middle");
+  }
+  svg += "<rect x='" + Num(left) + "' y='" + Num(top) + "' width='" + Num(right - left) + "' height='" +
+         Num(bottom - top) + "' fill='none' stroke='black'/>\n";
+  svg += Text((left + right) / 2.0, bottom + 34.0, "time [s]", 12, "middle");
+  svg += Text(x + 16.0, (top + bottom) / 2.0, y_label, 12, "middle",
+              "transform='rotate(-90 " + Num(x + 16.0) + " " + Num((top + bottom) / 2.0) + ")'");
+
+  double legend_y = top + 8.0;
+  for (std::size_t k = 0; k < series.size(); ++k) {
+    const TimeSeries& s = series[k];
+    const std::string color = kSeriesColors[k % (sizeof kSeriesColors / sizeof *kSeriesColors)];
+    const double max_gap = 3.0 * MedianStep(s.t);
+    std::string d;
+    bool pen_down = false;
+    for (std::size_t i = 0; i < s.t.size() && i < s.value.size(); ++i) {
+      if (!std::isfinite(s.t[i]) || !std::isfinite(s.value[i])) {
+        pen_down = false;
+        continue;
+      }
+      if (i > 0 && s.t[i] - s.t[i - 1] > max_gap) pen_down = false;
+      d += (pen_down ? "L" : "M") + Num(X(s.t[i])) + "," + Num(Y(s.value[i])) + " ";
+      pen_down = true;
+    }
+    const bool raw = k == 0 && (s.label == "raw" || s.label == "measured");
+    // Every other estimate dashed, so that coinciding curves stay visible.
+    const std::string dash = k >= 2 && k % 2 == 0 ? " stroke-dasharray='7 4'" : "";
+    svg += "<path class='series' d='" + d + "' fill='none' stroke='" + color + "' stroke-width='" +
+           (raw ? "1.2" : "1.8") + "' stroke-linejoin='round'" + (raw ? " stroke-opacity='0.8'" : "") + dash + "/>\n";
+    svg += "<line x1='" + Num(right + 14.0) + "' y1='" + Num(legend_y) + "' x2='" + Num(right + 40.0) + "' y2='" +
+           Num(legend_y) + "' stroke='" + color + "' stroke-width='2.5'" + dash + "/>\n";
+    svg += Text(right + 46.0, legend_y + 4.0, s.label, 12);
+    legend_y += 19.0;
+  }
+  if (!shaded.empty()) {
+    svg += "<rect x='" + Num(right + 14.0) + "' y='" + Num(legend_y - 6.0) +
+           "' width='26' height='12' fill='#cccccc' fill-opacity='0.6'/>\n";
+    svg += Text(right + 46.0, legend_y + 4.0, "occlusion", 12);
+  }
+  return svg;
+}
+
+std::string ModelLabel(const graph::EstimationResult& result) {
+  std::string name = graph::ModelName(result.model);
+  std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return std::toupper(c); });
+  return name;
+}
+
+// One entry of the trajectory plot's legend: a drawn sample (in a 28 x 14 box) and its text.
+struct LegendEntry {
+  std::string sample;  // SVG drawn relative to (0, 0) = left, middle of the sample box
+  std::string text;
+};
+
+}  // namespace
+
+std::string TrajectorySvg(const push::Trajectory& trajectory, const graph::EstimationResult& result,
+                          const TrajectoryPlotOptions& options) {
+  if (result.states.empty()) throw EvaluationError("trajectory plot: the estimation result has no states");
+  const std::vector<graph::StateEstimate>& states = result.states;
+  const std::size_t n = states.size();
+  const push::Streams& measured = trajectory.measured;
+  const push::Streams* truth = trajectory.ground_truth ? &*trajectory.ground_truth : nullptr;
+  const bool truth_poses = truth && !truth->object_pose.empty();
+
+  // Marked steps: about 12 along the push; the last state is always marked.
+  const int every = options.every > 0 ? options.every : std::max(1, static_cast<int>(std::lround(n / 12.0)));
+  std::vector<std::size_t> marked;
+  for (std::size_t i = 0; i < n; i += every) marked.push_back(i);
+  if (marked.back() != n - 1 && n - 1 - marked.back() > static_cast<std::size_t>(every) / 2) marked.push_back(n - 1);
+
+  // Extent of everything drawn, in metres.
+  Bounds bounds;
+  std::vector<std::vector<std::vector<Vec2>>> estimated_footprints, truth_footprints, finger_shapes;
+  for (std::size_t i : marked) {
+    estimated_footprints.push_back(WorldRings(trajectory.object.shape, states[i].object_pose));
+    finger_shapes.push_back(WorldRings(trajectory.finger.shape, states[i].finger_pose));
+    if (truth_poses) truth_footprints.push_back(WorldRings(trajectory.object.shape, InterpolatePose(truth->object_pose, states[i].t)));
+  }
+  for (const auto* set : {&estimated_footprints, &truth_footprints, &finger_shapes})
+    for (const auto& rings : *set)
+      for (const auto& ring : rings)
+        for (const Vec2& p : ring) bounds.Add(p);
+  for (const graph::StateEstimate& s : states) {
+    bounds.Add(s.object_pose.translation());
+    bounds.Add(s.finger_pose.translation());
+    if (s.contact) bounds.Add(*s.contact);
+  }
+  for (const auto& s : measured.object_pose) bounds.Add(s.pose.translation());
+  for (const auto& s : measured.finger_pose) bounds.Add(s.pose.translation());
+  if (truth)
+    for (const auto& s : truth->object_pose) bounds.Add(s.pose.translation());
+  if (bounds.empty()) bounds.Add(Vec2::Zero());
+  double extent = std::max({bounds.xmax - bounds.xmin, bounds.ymax - bounds.ymin, 1e-3});
+
+  // Force arrows: one mm-per-newton scale for the picture, a 1-2-5 value that draws the largest
+  // force at about a tenth of the picture's extent (longer arrows pile up along the push).
+  double max_force = 0.0;
+  for (std::size_t i : marked)
+    if (states[i].force) max_force = std::max(max_force, states[i].force->norm());
+  for (const auto& s : measured.force) max_force = std::max(max_force, s.force.norm());
+  if (truth)
+    for (const auto& s : truth->force) max_force = std::max(max_force, s.force.norm());
+  const bool draw_forces = options.forces && max_force > 0.0 && std::isfinite(max_force);
+  const double mm_per_newton = draw_forces ? NiceFloor(0.12 * extent * 1e3 / max_force) : 0.0;
+  const double m_per_newton = mm_per_newton * 1e-3;
+
+  // Arrows: estimated at the estimated contact, measured at the measured contact (else the
+  // estimated one), ground truth at the true contact; samples within half a marked interval.
+  struct ArrowSpec {
+    Vec2 from, force;
+  };
+  std::vector<ArrowSpec> arrows_estimated, arrows_measured, arrows_truth;
+  if (draw_forces) {
+    const double tolerance = 0.5 * std::max(1e-9, (states.back().t - states.front().t) / std::max<double>(1, n - 1));
+    for (std::size_t i : marked) {
+      const graph::StateEstimate& s = states[i];
+      if (s.force && s.contact) arrows_estimated.push_back({*s.contact, *s.force});
+      if (const auto* f = Nearest(measured.force, s.t, tolerance); f && f->force.norm() > 0.0) {
+        const auto* c = Nearest(measured.contact_point, s.t, tolerance);
+        if (c) arrows_measured.push_back({c->point, f->force});
+        else if (s.contact) arrows_measured.push_back({*s.contact, f->force});
+      }
+      if (truth) {
+        const auto* f = Nearest(truth->force, s.t, tolerance);
+        const auto* c = Nearest(truth->contact_point, s.t, tolerance);
+        if (f && c && f->force.norm() > 0.0) arrows_truth.push_back({c->point, f->force});
+      }
+    }
+    for (const auto* set : {&arrows_estimated, &arrows_measured, &arrows_truth})
+      for (const ArrowSpec& a : *set) bounds.Add(a.from + m_per_newton * a.force);
+  }
+  const double pad = 0.04 * std::max(bounds.xmax - bounds.xmin, bounds.ymax - bounds.ymin) + 1e-3;
+  bounds.xmin -= pad, bounds.xmax += pad, bounds.ymin -= pad, bounds.ymax += pad;
+  extent = std::max(bounds.xmax - bounds.xmin, bounds.ymax - bounds.ymin);
+
+  // Layout: map (equal aspect) on the left, legend on the right, error panel below.
+  const double width = std::max(480, options.width_px);
+  const double legend_width = 270.0, margin_left = 58.0, margin_top = options.title.empty() ? 16.0 : 40.0;
+  const double map_width_max = width - legend_width - margin_left - 10.0;
+  const double map_height_max = 1.1 * width;
+  const double scale = std::min(map_width_max / (bounds.xmax - bounds.xmin), map_height_max / (bounds.ymax - bounds.ymin));
+  WorldView view;
+  view.scale = scale;
+  view.xmin = bounds.xmin;
+  view.ymax = bounds.ymax;
+  view.x0 = margin_left;
+  view.y0 = margin_top;
+  const double map_w = (bounds.xmax - bounds.xmin) * scale, map_h = (bounds.ymax - bounds.ymin) * scale;
+  const double legend_x = margin_left + map_w + 22.0;
+
+  const bool error_panel = options.error_panel && truth_poses;
+  const std::vector<TimeSeries> errors =
+      error_panel ? ObjectPositionErrorSeries(trajectory, {{ModelLabel(result), &result}}) : std::vector<TimeSeries>{};
+  const double panel_height = 230.0;
+  const double map_bottom = margin_top + map_h + 44.0;
+
+  std::string body;
+  if (!options.title.empty()) body += Text(width / 2.0, 26.0, options.title, 16, "middle", "font-weight='bold'");
+
+  // Axis ticks in millimetres on the map's frame.
+  body += "<rect x='" + Num(view.x0) + "' y='" + Num(view.y0) + "' width='" + Num(map_w) + "' height='" + Num(map_h) +
+          "' fill='none' stroke='#999999'/>\n";
+  const int tick_count = std::max(3, static_cast<int>(map_w / 110.0));
+  const double tick_step_mm = NiceNumber(extent * 1e3 / tick_count, true);
+  for (double v = std::ceil(bounds.xmin * 1e3 / tick_step_mm) * tick_step_mm; v <= bounds.xmax * 1e3; v += tick_step_mm) {
+    const double px = view.X(v * 1e-3);
+    body += "<line x1='" + Num(px) + "' y1='" + Num(view.y0 + map_h) + "' x2='" + Num(px) + "' y2='" +
+            Num(view.y0 + map_h + 4.0) + "' stroke='#666666'/>\n";
+    body += Text(px, view.y0 + map_h + 16.0, TickLabel(std::abs(v) < 1e-9 ? 0.0 : v), 10, "middle", "fill='#444444'");
+  }
+  for (double v = std::ceil(bounds.ymin * 1e3 / tick_step_mm) * tick_step_mm; v <= bounds.ymax * 1e3; v += tick_step_mm) {
+    const double py = view.Y(v * 1e-3);
+    body += "<line x1='" + Num(view.x0 - 4.0) + "' y1='" + Num(py) + "' x2='" + Num(view.x0) + "' y2='" + Num(py) +
+            "' stroke='#666666'/>\n";
+    body += Text(view.x0 - 6.0, py + 3.5, TickLabel(std::abs(v) < 1e-9 ? 0.0 : v), 10, "end", "fill='#444444'");
+  }
+  body += Text(view.x0 + map_w / 2.0, view.y0 + map_h + 32.0, "x [mm]", 11, "middle", "fill='#444444'");
+  body += Text(14.0, view.y0 + map_h / 2.0, "y [mm]", 11, "middle",
+               "fill='#444444' transform='rotate(-90 14 " + Num(view.y0 + map_h / 2.0) + ")'");
+
+  // Footprints: estimated faint filled, ground truth dashed outline; finger shapes grey.
+  body += "<g class='footprints'>\n";
+  // Overlapping fills would pile up into a dark blot: only the last footprint is filled, the
+  // others are outlines.
+  for (std::size_t k = 0; k < estimated_footprints.size(); ++k) {
+    const bool last = k + 1 == estimated_footprints.size();
+    body += "<path class='footprint-estimated' d='" + RingsPath(estimated_footprints[k], view) + "' fill='" +
+            kEstimatedColor + "' fill-opacity='" + (last ? "0.12" : "0") + "' fill-rule='evenodd' stroke='" +
+            kEstimatedColor + "' stroke-opacity='" + (last ? "0.8" : "0.4") + "' stroke-width='" +
+            (last ? "1.2" : "0.8") + "'/>\n";
+  }
+  for (const auto& rings : truth_footprints)
+    body += "<path class='footprint-truth' d='" + RingsPath(rings, view) + "' fill='none' stroke='" + kTruthColor +
+            "' stroke-opacity='0.45' stroke-width='0.7' stroke-dasharray='3 3'/>\n";
+  body += "</g>\n";
+
+  // Paths of the object's reference point and of the finger.
+  auto times_points = [](const std::vector<push::PoseSample>& s) {
+    std::pair<std::vector<double>, std::vector<Vec2>> out;
+    for (const auto& p : s) out.first.push_back(p.t), out.second.push_back(p.pose.translation());
+    return out;
+  };
+  std::vector<double> state_t;
+  std::vector<Vec2> object_path, finger_path;
+  for (const graph::StateEstimate& s : states) {
+    state_t.push_back(s.t);
+    object_path.push_back(s.object_pose.translation());
+    finger_path.push_back(s.finger_pose.translation());
+  }
+  const double infinite_gap = std::numeric_limits<double>::infinity();
+  if (truth_poses) {
+    const auto [t, p] = times_points(truth->object_pose);
+    body += "<path class='path-truth' d='" + PolylinePath(t, p, infinite_gap, view) + "' fill='none' stroke='" +
+            kTruthColor + "' stroke-width='1.6' stroke-dasharray='6 4'/>\n";
+  }
+  if (truth && !truth->finger_pose.empty()) {
+    const auto [t, p] = times_points(truth->finger_pose);
+    body += "<path class='finger-path-truth' d='" + PolylinePath(t, p, infinite_gap, view) + "' fill='none' stroke='" +
+            kTruthColor + "' stroke-opacity='0.6' stroke-width='1.2' stroke-dasharray='6 4'/>\n";
+  }
+  for (const auto& rings : finger_shapes)
+    body += "<path class='finger' d='" + RingsPath(rings, view) + "' fill='" + kFingerColor +
+            "' fill-opacity='0.35' fill-rule='evenodd' stroke='#555555' stroke-width='0.8'/>\n";
+  body += "<path class='finger-path-estimated' d='" + PolylinePath(state_t, finger_path, infinite_gap, view) +
+          "' fill='none' stroke='#555555' stroke-width='1.4'/>\n";
+  {
+    std::string dots;
+    for (const auto& s : measured.finger_pose)
+      dots += "M" + view.P(s.pose.translation()) + " h0.01 ";
+    if (!dots.empty())
+      body += "<path class='finger-measured' d='" + dots + "' stroke='" + kMeasuredColor +
+              "' stroke-opacity='0.5' stroke-width='2' stroke-linecap='round' fill='none'/>\n";
+  }
+  body += "<path class='path-estimated' d='" + PolylinePath(state_t, object_path, infinite_gap, view) +
+          "' fill='none' stroke='" + kEstimatedColor + "' stroke-width='2'/>\n";
+  for (const auto& s : measured.object_pose)
+    body += "<circle class='object-measured' cx='" + Num(view.X(s.pose.x)) + "' cy='" + Num(view.Y(s.pose.y)) +
+            "' r='2.2' fill='" + kMeasuredColor + "' fill-opacity='0.85'/>\n";
+
+  // Estimated contact points at the marked steps, then ellipses and force arrows on top.
+  for (std::size_t i : marked)
+    if (states[i].contact)
+      body += "<circle class='contact-estimated' cx='" + Num(view.X(states[i].contact->x())) + "' cy='" +
+              Num(view.Y(states[i].contact->y())) + "' r='2.4' fill='" + kContactColor + "'/>\n";
+  int ellipse_count = 0;
+  if (options.ellipses) {
+    const std::string object_style = std::string("fill='") + kEstimatedColor + "' fill-opacity='0.15' stroke='" +
+                                     kEstimatedColor + "' stroke-width='1.2'";
+    const std::string finger_style = "fill='#555555' fill-opacity='0.12' stroke='#333333' stroke-width='1'";
+    const std::string contact_style = std::string("fill='") + kContactColor + "' fill-opacity='0.15' stroke='" +
+                                      kContactColor + "' stroke-width='1.2'";
+    for (std::size_t i : marked) {
+      const graph::StateEstimate& s = states[i];
+      std::string e;
+      if (s.object_pose_cov)
+        e += Ellipse(s.object_pose_cov->topLeftCorner<2, 2>(), s.object_pose.translation(), view, "ellipse-object",
+                     object_style);
+      if (s.finger_pose_cov)
+        e += Ellipse(s.finger_pose_cov->topLeftCorner<2, 2>(), s.finger_pose.translation(), view, "ellipse-finger",
+                     finger_style);
+      if (s.contact_cov && s.contact) e += Ellipse(*s.contact_cov, *s.contact, view, "ellipse-contact", contact_style);
+      ellipse_count += !e.empty();
+      body += e;
+    }
+  }
+  auto draw_arrows = [&](const std::vector<ArrowSpec>& arrows, const std::string& cls, const std::string& color,
+                         double stroke, const std::string& extra) {
+    for (const ArrowSpec& a : arrows) {
+      const Vec2 to = a.from + m_per_newton * a.force;
+      body += Arrow(view.X(a.from.x()), view.Y(a.from.y()), view.X(to.x()), view.Y(to.y()), cls, color, stroke, extra);
+    }
+  };
+  draw_arrows(arrows_truth, "force-truth", kTruthColor, 1.2, "stroke-opacity='0.7' fill-opacity='0.7'");
+  draw_arrows(arrows_measured, "force-measured", kMeasuredColor, 1.2, "stroke-opacity='0.8' fill-opacity='0.8'");
+  draw_arrows(arrows_estimated, "force-estimated", kForceColor, 2.0, "");
+
+  // Scale bar (mm), bottom left inside the map.
+  {
+    const double bar_mm = NiceFloor(0.2 * (bounds.xmax - bounds.xmin) * 1e3);
+    const double bx = view.x0 + 12.0, by = view.y0 + map_h - 12.0, bw = bar_mm * 1e-3 * scale;
+    body += "<rect x='" + Num(bx - 4.0) + "' y='" + Num(by - 20.0) + "' width='" + Num(bw + 8.0) +
+            "' height='27' fill='white' fill-opacity='0.8'/>\n";
+    body += "<path class='scale-bar' d='M" + Num(bx) + "," + Num(by - 4.0) + " V" + Num(by) + " H" + Num(bx + bw) +
+            " V" + Num(by - 4.0) + "' fill='none' stroke='black' stroke-width='1.5'/>\n";
+    body += Text(bx + bw / 2.0, by - 7.0, TickLabel(bar_mm) + " mm", 11, "middle");
+  }
+
+  // Legend.
+  std::vector<LegendEntry> legend;
+  const std::string dot = std::string("<circle cx='14' cy='0' r='2.6' fill='") + kMeasuredColor + "'/>";
+  legend.push_back({dot, "object position, measured"});
+  legend.push_back({std::string("<line x1='0' y1='0' x2='28' y2='0' stroke='") + kEstimatedColor +
+                        "' stroke-width='2'/>",
+                    "object position, " + ModelLabel(result) + " estimate"});
+  if (truth_poses)
+    legend.push_back({std::string("<line x1='0' y1='0' x2='28' y2='0' stroke='") + kTruthColor +
+                          "' stroke-width='1.6' stroke-dasharray='6 4'/>",
+                      "object position, ground truth"});
+  legend.push_back({std::string("<rect x='2' y='-6' width='24' height='12' fill='none' stroke='") + kEstimatedColor +
+                        "' stroke-opacity='0.6'/>",
+                    "footprint at estimate (last filled)"});
+  if (truth_poses)
+    legend.push_back({std::string("<rect x='2' y='-6' width='24' height='12' fill='none' stroke='") + kTruthColor +
+                          "' stroke-dasharray='4 3'/>",
+                      "footprint, ground truth"});
+  legend.push_back({"<circle cx='14' cy='0' r='5' fill='#7f7f7f' fill-opacity='0.35' stroke='#555555'/>"
+                    "<line x1='0' y1='0' x2='8' y2='0' stroke='#555555' stroke-width='1.4'/>",
+                    "finger: shape, estimated path"});
+  if (std::any_of(marked.begin(), marked.end(), [&](std::size_t i) { return states[i].contact.has_value(); }))
+    legend.push_back({std::string("<circle cx='14' cy='0' r='2.4' fill='") + kContactColor + "'/>",
+                      "contact point, estimate"});
+  if (ellipse_count > 0) {
+    legend.push_back({std::string("<ellipse cx='14' cy='0' rx='12' ry='5' fill='") + kEstimatedColor +
+                          "' fill-opacity='0.15' stroke='" + kEstimatedColor + "'/>",
+                      "2-sigma ellipse (86.5%)"});
+    legend.push_back({"", "  of object, finger, contact"});
+  }
+  if (!arrows_estimated.empty())
+    legend.push_back({Arrow(0, 0, 28, 0, "legend", kForceColor, 2.0), "force, estimate"});
+  if (!arrows_measured.empty())
+    legend.push_back({Arrow(0, 0, 28, 0, "legend", kMeasuredColor, 1.2), "force, measured"});
+  if (!arrows_truth.empty()) legend.push_back({Arrow(0, 0, 28, 0, "legend", kTruthColor, 1.2), "force, ground truth"});
+  if (draw_forces && (arrows_estimated.size() + arrows_measured.size() + arrows_truth.size()) > 0)
+    legend.push_back({"", "  arrows: 1 N = " + TickLabel(mm_per_newton) + " mm"});
+  legend.push_back({"", "marks every " + std::to_string(every) + (every == 1 ? " step (" : " steps (") +
+                            std::to_string(n) + (n == 1 ? " step)" : " steps)")});
+  if (auto it = result.metrics.find("object_position_rms"); it != result.metrics.end()) {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "object position RMS error: %.2f mm", it->second * 1e3);
+    legend.push_back({"", buf});
+    if (auto m = result.metrics.find("measured_object_position_rms"); m != result.metrics.end()) {
+      std::snprintf(buf, sizeof buf, "  (measured: %.2f mm)", m->second * 1e3);
+      legend.push_back({"", buf});
+    }
+  }
+  double ly = view.y0 + 10.0;
+  body += "<g class='legend-box'>\n";
+  for (const LegendEntry& e : legend) {
+    if (!e.sample.empty())
+      body += "<g transform='translate(" + Num(legend_x) + "," + Num(ly) + ")'>" + e.sample + "</g>\n";
+    body += Text(legend_x + 36.0, ly + 4.0, e.text, 12);
+    ly += 20.0;
+  }
+  body += "</g>\n";
+
+  double height = std::max(map_bottom, ly + 10.0);
+  if (error_panel && !errors.empty()) {
+    std::vector<double> object_t;
+    for (const auto& s : measured.object_pose) object_t.push_back(s.t);
+    body += TimeSeriesPanel(errors, "object position error", "error [mm]", StreamGaps(object_t), 0.0, height, width,
+                            panel_height);
+    height += panel_height;
+  }
+  return SvgOpen(width, height) + body + "</svg>\n";
+}
+
+void WriteSvgFile(const std::string& path, const std::string& svg) {
+  if (const std::string error = geometry::WriteFileAtomically(path, svg); !error.empty()) throw EvaluationError(error);
+}
+
+void WriteTrajectorySvg(const std::string& path, const push::Trajectory& trajectory,
+                        const graph::EstimationResult& result, const TrajectoryPlotOptions& options) {
+  if (result.states.empty()) throw EvaluationError(path + ": cannot plot an estimation result without states");
+  WriteSvgFile(path, TrajectorySvg(trajectory, result, options));
+}
+
+std::string TimeSeriesSvg(const std::vector<TimeSeries>& series, const std::string& title, const std::string& y_label,
+                          const std::vector<std::pair<double, double>>& shaded) {
+  const double width = 960.0, height = 300.0;
+  return SvgOpen(width, height) + TimeSeriesPanel(series, title, y_label, shaded, 0.0, 0.0, width, height) + "</svg>\n";
+}
+
+std::vector<TimeSeries> ObjectPositionErrorSeries(
+    const push::Trajectory& trajectory,
+    const std::vector<std::pair<std::string, const graph::EstimationResult*>>& results) {
+  std::vector<TimeSeries> series;
+  if (!trajectory.ground_truth || trajectory.ground_truth->object_pose.empty()) return series;
+  const auto& truth = trajectory.ground_truth->object_pose;
+  // push/scoring.h's rule: no error where the truth has a gap (an occluded recording's hole).
+  auto add = [&](TimeSeries& series, double t, const Vec2& p) {
+    Eigen::Vector3d g;
+    if (!push::TruthPoseAt(truth, t, &g)) return;
+    series.t.push_back(t);
+    series.value.push_back(1e3 * (p - g.head<2>()).norm());
+  };
+  TimeSeries raw{"raw", {}, {}};
+  for (const auto& s : trajectory.measured.object_pose) add(raw, s.t, s.pose.translation());
+  series.push_back(std::move(raw));
+  for (const auto& [label, result] : results) {
+    if (result == nullptr) throw EvaluationError("object position error: result '" + label + "' is null");
+    TimeSeries s{label, {}, {}};
+    for (const graph::StateEstimate& state : result->states) add(s, state.t, state.object_pose.translation());
+    series.push_back(std::move(s));
+  }
+  return series;
+}
+
+std::string StackSvgVertically(const std::vector<std::string>& pictures) {
+  double width = 0.0, height = 0.0;
+  std::string body;
+  for (const std::string& svg : pictures) {
+    const std::size_t open = svg.find("<svg");
+    const std::size_t open_end = svg.find('>', open);
+    const std::size_t close = svg.rfind("</svg>");
+    if (open == std::string::npos || open_end == std::string::npos || close == std::string::npos)
+      throw EvaluationError("stacking SVG pictures: a picture is not an <svg> element");
+    const std::string tag = svg.substr(open, open_end - open);
+    auto attribute = [&](const std::string& name) {
+      const std::size_t at = tag.find(" " + name + "='");
+      if (at == std::string::npos) throw EvaluationError("stacking SVG pictures: a picture has no " + name);
+      return std::stod(tag.substr(at + name.size() + 3));
+    };
+    const double w = attribute("width"), h = attribute("height");
+    body += "<svg x='0' y='" + Num(height) + "' width='" + Num(w) + "' height='" + Num(h) + "' viewBox='0 0 " +
+            Num(w) + " " + Num(h) + "'>\n" + svg.substr(open_end + 1, close - open_end - 1) + "</svg>\n";
+    width = std::max(width, w);
+    height += h;
+  }
+  return SvgOpen(width, height) + body + "</svg>\n";
+}
+
+}  // namespace pushgraph::evaluation

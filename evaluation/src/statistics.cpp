@@ -1,0 +1,169 @@
+// Sufficient statistics of one estimate against ground truth (Lambert et al. 2019, Sec. V:
+// RMS errors, marginal sigmas, NEES with its 95% chi-square interval), by push/scoring.h's rule.
+#include "internal.h"
+
+#include <pushgraph/push/scoring.h>
+
+#include <Eigen/Cholesky>
+
+#include <algorithm>
+#include <cmath>
+
+namespace pushgraph::evaluation::internal {
+namespace {
+
+using geometry::Vec2;
+
+constexpr double kDirectionMinForce = 0.25;  // N: force directions below this are not compared
+
+// Two-sided 95% interval of a chi-square variable with 2 and 3 degrees of freedom
+// (quantiles 0.025 and 0.975; e.g. Bar-Shalom, Li, Kirubarajan 2001, Table 5.2 style values).
+constexpr double kChi2Lo[4] = {0.0, 0.000982, 0.05064, 0.2158};
+constexpr double kChi2Hi[4] = {0.0, 5.0239, 7.3778, 9.3484};
+
+template <int N>
+double NeesOf(const Eigen::Matrix<double, N, 1>& e, const Eigen::Matrix<double, N, N>& cov) {
+  return e.dot(cov.ldlt().solve(e));
+}
+
+double SignedAngle(const Vec2& a, const Vec2& b) {  // from b to a
+  return std::atan2(b.x() * a.y() - b.y() * a.x(), b.dot(a));
+}
+
+
+}  // namespace
+
+void StatSink::Error(const std::string& key, double e) {
+  Add(key + "/n", 1.0);
+  Add(key + "/sum", e);
+  Add(key + "/abs", std::abs(e));
+  Add(key + "/sq", e * e);
+}
+
+void StatSink::Variance(const std::string& key, double var) {
+  Add(key + "/var", var);
+  Add(key + "/nvar", 1.0);
+}
+
+void StatSink::Nees(const std::string& key, double nees, int dim) {
+  Add(key + "/nees", nees);
+  Add(key + "/nees_n", 1.0);
+  Add(key + "/nees_in", (nees >= kChi2Lo[dim] && nees <= kChi2Hi[dim]) ? 1.0 : 0.0);
+  (*stats_)[key + "/dim"] = dim;  // constant: aggregated as max
+}
+
+void StatSink::Max(const std::string& key, double v) {
+  auto [it, inserted] = stats_->emplace(key, v);
+  if (!inserted) it->second = std::max(it->second, v);
+}
+
+void AccumulateRun(const push::Trajectory& traj, const graph::EstimationResult& r, const std::string& prefix,
+                   const Window& occluded, StatSink& sink) {
+  const push::Streams& gt = *traj.ground_truth;
+  for (const graph::StateEstimate& s : r.states) {
+    Eigen::Vector3d g;
+    if (push::TruthPoseAt(gt.object_pose, s.t, &g)) {
+      const Eigen::Vector3d e = push::PoseError(s.object_pose, g);
+      const double ep = e.head<2>().norm(), er = std::abs(e.z());
+      sink.Error(prefix + "/object_position", ep);
+      sink.Error(prefix + "/object_rotation", er);
+      const bool moving = push::ObjectMovingAt(gt.object_pose, s.t);
+      if (moving) {
+        sink.Error(prefix + "/object_position_moving", ep);
+        sink.Error(prefix + "/object_rotation_moving", er);
+      }
+      if (occluded.Contains(s.t)) {
+        sink.Error(prefix + "/object_position_occluded", ep);
+        sink.Error(prefix + "/object_rotation_occluded", er);
+      } else if (occluded.t1 >= occluded.t0) {
+        sink.Error(prefix + "/object_position_visible", ep);
+        sink.Error(prefix + "/object_rotation_visible", er);
+      }
+      if (s.object_pose_cov) {
+        const Eigen::Matrix3d& P = *s.object_pose_cov;
+        sink.Variance(prefix + "/object_position", P(0, 0) + P(1, 1));
+        sink.Variance(prefix + "/object_rotation", P(2, 2));
+        if (moving) {
+          sink.Variance(prefix + "/object_position_moving", P(0, 0) + P(1, 1));
+          sink.Variance(prefix + "/object_rotation_moving", P(2, 2));
+        }
+        sink.Nees(prefix + "/object_pose", NeesOf<3>(e, P), 3);
+      }
+    }
+    if (push::TruthPoseAt(gt.finger_pose, s.t, &g)) {
+      const Eigen::Vector2d e(s.finger_pose.x - g.x(), s.finger_pose.y - g.y());
+      sink.Error(prefix + "/finger_position", e.norm());
+      if (s.finger_pose_cov) {
+        // Position block only: the finger's angle is not measured meaningfully (pinned).
+        const Eigen::Matrix2d P = s.finger_pose_cov->topLeftCorner<2, 2>();
+        sink.Variance(prefix + "/finger_position", P.trace());
+        sink.Nees(prefix + "/finger_position", NeesOf<2>(e, P), 2);
+      }
+    }
+    Vec2 v;
+    if (s.contact && push::TruthPointAt(gt.contact_point, s.t, &v)) {
+      const Eigen::Vector2d e = *s.contact - v;
+      sink.Error(prefix + "/contact", e.norm());
+      if (s.contact_cov) {
+        sink.Variance(prefix + "/contact", s.contact_cov->trace());
+        sink.Nees(prefix + "/contact", NeesOf<2>(e, *s.contact_cov), 2);
+      }
+    }
+    if (s.force && push::TruthForceAt(gt.force, s.t, &v)) {
+      const Eigen::Vector2d e = *s.force - v;
+      sink.Error(prefix + "/force", e.norm());
+      sink.Error(prefix + "/force_magnitude", s.force->norm() - v.norm());
+      if (v.norm() >= kDirectionMinForce) sink.Error(prefix + "/force_direction", SignedAngle(*s.force, v) * 180.0 / M_PI);
+      if (s.force_cov) {
+        sink.Variance(prefix + "/force", s.force_cov->trace());
+        sink.Nees(prefix + "/force", NeesOf<2>(e, *s.force_cov), 2);
+      }
+    }
+  }
+  const graph::SolverStats& st = r.solver;
+  sink.Add(prefix + "/time/sum", st.time_s);
+  sink.Add(prefix + "/time/n", 1.0);
+  sink.Max(prefix + "/time/max", st.time_s);
+  sink.Add(prefix + "/steps/sum", static_cast<double>(r.states.size()));
+  if (r.mode == graph::Mode::kIncremental && st.updates > 0) {
+    sink.Add(prefix + "/update_time/sum", st.mean_update_time_s * st.updates);
+    sink.Add(prefix + "/update_time/n", st.updates);
+    sink.Max(prefix + "/update_time/max", st.max_update_time_s);
+  }
+}
+
+// The raw measurements against the same ground truth.
+void AccumulateRaw(const push::Trajectory& traj, const std::string& prefix, StatSink& sink) {
+  const push::Streams& gt = *traj.ground_truth;
+  const push::Streams& m = traj.measured;
+  for (const push::PoseSample& s : m.object_pose) {
+    Eigen::Vector3d g;
+    if (!push::TruthPoseAt(gt.object_pose, s.t, &g)) continue;
+    const double ep = std::hypot(s.pose.x - g.x(), s.pose.y - g.y());
+    const double er = std::abs(geometry::WrapAngle(s.pose.theta - g.z()));
+    sink.Error(prefix + "/object_position", ep);
+    sink.Error(prefix + "/object_rotation", er);
+    if (push::ObjectMovingAt(gt.object_pose, s.t)) {
+      sink.Error(prefix + "/object_position_moving", ep);
+      sink.Error(prefix + "/object_rotation_moving", er);
+    }
+  }
+  for (const push::PoseSample& s : m.finger_pose) {
+    Eigen::Vector3d g;
+    if (push::TruthPoseAt(gt.finger_pose, s.t, &g)) sink.Error(prefix + "/finger_position", std::hypot(s.pose.x - g.x(), s.pose.y - g.y()));
+  }
+  for (const push::PointSample& s : m.contact_point) {
+    Vec2 v;
+    if (push::TruthPointAt(gt.contact_point, s.t, &v)) sink.Error(prefix + "/contact", (s.point - v).norm());
+  }
+  for (const push::ForceSample& s : m.force) {
+    Vec2 v;
+    if (!push::TruthForceAt(gt.force, s.t, &v)) continue;
+    sink.Error(prefix + "/force", (s.force - v).norm());
+    sink.Error(prefix + "/force_magnitude", s.force.norm() - v.norm());
+    if (v.norm() >= kDirectionMinForce) sink.Error(prefix + "/force_direction", SignedAngle(s.force, v) * 180.0 / M_PI);
+  }
+}
+
+
+}  // namespace pushgraph::evaluation::internal
