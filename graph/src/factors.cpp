@@ -1,6 +1,6 @@
 #include <pushgraph/graph/factors.h>
 
-#include "graph_builder.h"
+#include "solver_log.h"
 
 #include <pushgraph/geometry/point_query.h>
 

@@ -4,6 +4,8 @@
 #include <pushgraph/graph/estimator.h>
 #include <pushgraph/graph/incremental.h>
 
+#include "solver_log.h"
+
 #include <ceres/ceres.h>
 
 #include <cmath>
@@ -241,17 +243,15 @@ struct FrameState {
 Diagnostics Diagnose(const push::Trajectory& trajectory, Model model, const EstimatorConfig& config,
                      const EstimationResult& result, const FrameState* frame);
 
-ceres::Solver::Options SolverOptions(int max_iterations, double function_tolerance);
+/// Refuses a trajectory the estimator cannot use (trajectory_checks.cpp; GraphError naming the
+/// stream, sample and value): missing shapes or streams, NaN, unsupported magnitudes, unsorted
+/// samples, clock jumps within or between streams.
+void ValidateTrajectory(const push::Trajectory& trajectory);
 /// The 95th percentile of `values` (non-empty).
 double Percentile95(std::vector<double> values);
 /// A force sample above this is a sensor fault (docs/estimation.md, Input checks): 50 times the
 /// larger of the forces' 95th percentile and the object's mu m g (when known), at least 1 N.
 /// Used by the batch estimator (all forces) and OnlineEstimator (the newest 512).
 double ForceFaultBound(double force_p95, const push::ObjectDescription& object);
-/// Diagnostics level from the environment, read once: PUSHGRAPH_SOLVER_LOG=1 prints every solve's
-/// Ceres report and why a factor evaluation failed, =2 also the per-iteration trace; unset: 0.
-int SolverLogLevel();
-/// Prints the solver's full report to stderr when SolverLogLevel() >= 1.
-void LogSummary(const char* what, const ceres::Solver::Summary& summary);
 
 }  // namespace pushgraph::graph::internal

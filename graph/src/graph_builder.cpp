@@ -1,0 +1,566 @@
+#include "graph_builder.h"
+
+#include <ceres/normal_prior.h>
+
+#include <pushgraph/geometry/point_query.h>
+#include <pushgraph/graph/incremental.h>
+#include <pushgraph/graph/marginals.h>
+#include <pushgraph/graph/shape_frame.h>
+#include <pushgraph/limit_surface/limit_surface.h>
+#include <pushgraph/limit_surface/support.h>
+
+#include <Eigen/Cholesky>
+
+#include <algorithm>
+#include <cstdio>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <functional>
+#include <iostream>
+#include <sstream>
+#include <tuple>
+
+
+// GraphBuilder (graph_builder.h): the paper's graphs step by step, shared by the batch and
+// incremental estimators.
+namespace pushgraph::graph::internal {
+namespace {
+
+Pose2 InterpolatePose(const std::vector<push::PoseSample>& all, double t, double limit) {
+  // Only the samples up to `limit`.
+  const auto end = std::upper_bound(all.begin(), all.end(), limit,
+                                    [](double tt, const push::PoseSample& a) { return tt < a.t; });
+  if (end == all.begin()) return all.front().pose;
+  return push::PoseAtClamped(all.begin(), end, t);
+}
+
+template <class Sample>
+double NearestGap(const std::vector<Sample>& s, double t, int* index = nullptr) {
+  if (s.empty()) return INFINITY;
+  auto it = std::lower_bound(s.begin(), s.end(), t, [](const Sample& a, double tt) { return a.t < tt; });
+  double best = INFINITY;
+  int bi = -1;
+  if (it != s.end()) { best = it->t - t; bi = static_cast<int>(it - s.begin()); }
+  if (it != s.begin() && t - (it - 1)->t < best) { best = t - (it - 1)->t; bi = static_cast<int>(it - s.begin()) - 1; }
+  if (index != nullptr) *index = bi;
+  return best;
+}
+
+}  // namespace
+
+GraphBuilder::GraphBuilder(const push::Trajectory& trajectory, Model model,
+                           const EstimatorConfig& config)
+    : traj_(trajectory), model_(model), cfg_(config) {
+  ValidateConfig(cfg_);
+  ValidateTrajectory(traj_);
+  streams_.contact_point = !traj_.measured.contact_point.empty();
+  streams_.force = !traj_.measured.force.empty();
+  AppendSteps(INFINITY);
+  SetUpShapes();
+}
+
+GraphBuilder::GraphBuilder(const push::Trajectory& trajectory, Model model,
+                           const EstimatorConfig& config, const OnlineStreams& streams)
+    : traj_(trajectory), model_(model), cfg_(config), streams_(streams) {
+  ValidateConfig(cfg_);
+  if (traj_.object.shape.empty()) throw GraphError("trajectory: object.shape is missing or empty");
+  if (traj_.finger.shape.empty()) throw GraphError("trajectory: finger.shape is missing or empty");
+  SetUpShapes();
+}
+
+int GraphBuilder::AppendSteps(double until) {
+  const auto& m = traj_.measured;
+  // Steps: the union of all time stamps (merged when closer than 1e-9 s).
+  std::vector<std::tuple<double, int, int>> events;  // t, stream, index
+  auto take = [&](const auto& stream, int id) {
+    std::size_t& i = used_[id];
+    for (; i < stream.size() && stream[i].t <= until; ++i) events.emplace_back(stream[i].t, id, int(i));
+  };
+  take(m.object_pose, 0);
+  take(m.finger_pose, 1);
+  take(m.contact_point, 2);
+  take(m.force, 3);
+  std::sort(events.begin(), events.end());
+  const std::size_t first_new = steps_.size();
+  for (const auto& [t, stream, index] : events) {
+    // (OnlineEstimator only accepts samples more than 1e-9 s after the last update's steps.)
+    if (steps_.size() == first_new || t - steps_.back().t > 1e-9) {
+      steps_.push_back(Step{});
+      steps_.back().t = t;
+    }
+    Step& s = steps_.back();
+    int* slot = stream == 0 ? &s.object : stream == 1 ? &s.finger : stream == 2 ? &s.contact : &s.force;
+    *slot = index;
+  }
+  // Contact gating, on the samples received so far (all of them in batch).
+  for (std::size_t i = first_new; i < steps_.size(); ++i) {
+    Step& s = steps_[i];
+    if (streams_.contact_point) {
+      s.in_contact = NearestGap(m.contact_point, s.t) <= cfg_.contact_max_gap;
+    } else if (streams_.force) {
+      int k = -1;
+      const double gap = NearestGap(m.force, s.t, &k);
+      s.in_contact = k >= 0 && gap <= cfg_.contact_max_gap && m.force[k].force.norm() >= cfg_.contact_force_threshold;
+    } else {
+      s.in_contact = true;
+    }
+  }
+  vars_.resize(steps_.size());
+  return static_cast<int>(steps_.size() - first_new);
+}
+
+void GraphBuilder::SetUpShapes() {
+  geometry::ShapePairQuerier::Options pair_options;
+  pair_options.angle_cache_resolution = cfg_.finger_angle_resolution;
+  pair_options.max_cached_angles = 4096;
+  pair_options.check_rounded_depth = false;  // the factors never read depth_exact: no second query
+  querier_ = std::make_shared<geometry::ShapePairQuerier>(traj_.object.shape, traj_.finger.shape, pair_options);
+  if (ModelHasForce(model_)) qs_ = QuasiStaticGeometryFor(traj_, cfg_);
+  if (traj_.object.mass > 0.0 && traj_.object.mu_surface > 0.0) {
+    mu_surface_ = traj_.object.mu_surface;
+    normal_load_ = traj_.object.mass * limit_surface::kStandardGravity;
+    f_max_ = mu_surface_ * normal_load_;
+  }
+  using Load = EstimatorConfig::LimitSurfaceLoad;
+  use_load_factor_ = f_max_ > 0.0 && (cfg_.limit_surface_load == Load::kOn ||
+                                      (cfg_.limit_surface_load == Load::kAuto && !streams_.force));
+}
+
+void GraphBuilder::EnableCEstimation() {
+  if (model_ != Model::kQs) return;
+  estimate_c_ = true;
+  c_var_[0] = qs_.c;
+}
+
+namespace {
+// A shared scalar parameter (c, mu): a Gaussian prior of relative sigma around its nominal
+// value and bounds [0.2, 5] times it.
+void AddSharedParameterPrior(GraphBuilder& builder, ceres::Problem& problem, double* parameter, double nominal,
+                             double relative_sigma) {
+  ceres::Matrix A(1, 1);
+  ceres::Vector b(1);
+  A(0, 0) = 1.0 / (relative_sigma * nominal);
+  b(0) = nominal;
+  builder.Add(problem, FactorType::kPrior, new ceres::NormalPrior(A, b), nullptr, {parameter});
+  problem.SetParameterLowerBound(parameter, 0, 0.2 * nominal);
+  problem.SetParameterUpperBound(parameter, 0, 5.0 * nominal);
+}
+}  // namespace
+
+const char* FactorTypeName(FactorType t) {
+  switch (t) {
+    case FactorType::kObjectPose: return "object_pose";
+    case FactorType::kFingerPose: return "finger_pose";
+    case FactorType::kContactPoint: return "contact_point";
+    case FactorType::kForce: return "force";
+    case FactorType::kContactOnObject: return "contact_on_object";
+    case FactorType::kContactOnFinger: return "contact_on_finger";
+    case FactorType::kTouching: return "touching";
+    case FactorType::kIntersection: return "intersection";
+    case FactorType::kConstantVelocity: return "constant_velocity";
+    case FactorType::kZeroVelocity: return "zero_velocity";
+    case FactorType::kForceContinuity: return "force_continuity";
+    case FactorType::kForcePrior: return "force_prior";
+    case FactorType::kQuasiStatic: return "quasi_static";
+    case FactorType::kLimitSurfaceLoad: return "limit_surface_load";
+    case FactorType::kPrior: return "priors";
+  }
+  return "?";
+}
+
+std::string GraphBuilder::Describe(ceres::ResidualBlockId id) const {
+  const auto it = origin_.find(id);
+  if (it == origin_.end()) return "a marginal prior or unnamed factor";
+  const auto [type, step] = it->second;
+  std::string s = std::string(FactorTypeName(type)) + " factor";
+  if (step >= 0 && step < static_cast<int>(steps_.size())) {
+    char t[48];
+    std::snprintf(t, sizeof t, "%.9g", steps_[step].t);
+    s += " at step " + std::to_string(step) + " (t = " + t + " s)";
+  } else {
+    s += " (shared by the trajectory)";
+  }
+  return s;
+}
+
+SolveOutcome GraphBuilder::Solve(ceres::Problem& problem, int max_iterations, double function_tolerance,
+                                 const char* what) const {
+  SolveOutcome out;
+  if (cfg_.solver == EstimatorConfig::Solver::kCeres) {
+    ceres::Solver::Summary summary;
+    ceres::Solve(SolverOptions(max_iterations, function_tolerance), &problem, &summary);
+    LogSummary(what, summary);
+    if (summary.termination_type == ceres::FAILURE) throw GraphError(std::string(what) + " failed: " + summary.message);
+    out.iterations = summary.num_successful_steps + summary.num_unsuccessful_steps;
+    out.final_cost = summary.final_cost;
+    out.converged = summary.termination_type == ceres::CONVERGENCE;
+    out.termination = summary.message;
+    return out;
+  }
+  ChainSolverOptions options;
+  options.max_iterations = max_iterations;
+  options.function_tolerance = function_tolerance;
+  options.describe = [this](ceres::ResidualBlockId id) { return Describe(id); };
+  options.log_iterations = SolverLogLevel() >= 2;
+  out.chain = std::make_unique<ChainSolver>(problem);
+  ChainSolverSummary summary;
+  try {
+    summary = out.chain->Solve(options);
+  } catch (const GraphError& e) {
+    throw GraphError(std::string(what) + ": " + e.what());
+  }
+  if (SolverLogLevel() >= 1) {
+    std::fprintf(stderr,
+                 "pushgraph %s (chain solver): %d unknowns, %d iterations (%d successful), cost %.6e -> %.6e, %s; "
+                 "%.3f ms (evaluation %.3f, linear %.3f), J^T J nonzeros %ld, factor nonzeros %ld, %.3g flops per "
+                 "factorization\n",
+                 what, summary.unknowns, summary.iterations, summary.successful_steps, summary.initial_cost,
+                 summary.final_cost, summary.termination.c_str(), 1e3 * summary.total_s, 1e3 * summary.evaluate_s,
+                 1e3 * summary.linear_solve_s, summary.hessian_nonzeros, summary.factor_nonzeros, summary.factor_flops);
+  }
+  out.iterations = summary.iterations;
+  out.final_cost = summary.final_cost;
+  out.converged = summary.converged;
+  out.termination = summary.termination;
+  out.evaluation_s = summary.evaluate_s;
+  out.linear_solve_s = summary.linear_solve_s;
+  out.factor_flops = summary.factor_flops;
+  return out;
+}
+
+void GraphBuilder::EnableShapeFrame(const Vec2& centroid, double sigma_centroid, double sigma_theta, bool rotation) {
+  shape_frame_ = true;
+  frame_centroid_ = centroid;
+  frame_sigma_centroid_ = sigma_centroid;
+  frame_sigma_theta_ = sigma_theta;
+  frame_rotation_ = rotation;
+}
+
+ceres::ResidualBlockId GraphBuilder::Add(ceres::Problem& problem, FactorType type, ceres::CostFunction* cost,
+                                         ceres::LossFunction* loss, std::vector<double*> blocks,
+                                         std::vector<int> object_pose_blocks) {
+  if (shape_frame_ && !object_pose_blocks.empty()) {
+    blocks.push_back(frame_);
+    cost = new ShapeFrameFactor(cost, std::move(object_pose_blocks));
+    if (!frame_in_problem_) {
+      frame_in_problem_ = true;
+      // A circular outline's angle is unobservable: a stiff prior holds it (SparseMarginals takes
+      // no manifolds), and its sigma is not reported.
+      const double sigma_theta = frame_rotation_ ? frame_sigma_theta_ : 1e-6;
+      Add(problem, FactorType::kPrior, new ShapeFramePrior(frame_centroid_, frame_sigma_centroid_, sigma_theta), nullptr,
+          {frame_});
+    }
+  }
+  const ceres::ResidualBlockId id = problem.AddResidualBlock(cost, loss, blocks);
+  if (tags_ != nullptr) tags_->push_back({type, id});
+  origin_[id] = {type, type == FactorType::kPrior ? -1 : adding_step_};
+  return id;
+}
+
+void GraphBuilder::EnableMuEstimation() {
+  if (model_ != Model::kQs) return;
+  if (!(f_max_ > 0.0)) {
+    throw GraphError("estimate_mu needs the object's mass and mu_surface in the trajectory");
+  }
+  if (!streams_.force) {
+    // Scaling every force and mu together leaves D and the load factor unchanged: only the
+    // force priors would decide, and they pull mu down (measured: to its lower bound, with a
+    // confident sigma). Refuse rather than report that.
+    throw GraphError("estimate_mu needs a force stream: without force measurements mu is not observable");
+  }
+  estimate_mu_ = true;
+  use_load_factor_ = true;
+  mu_var_[0] = mu_surface_;
+}
+
+void GraphBuilder::Initialize(int i, double limit) {
+  const bool causal = std::isfinite(limit);
+  const auto& m = traj_.measured;
+  const Step& s = steps_[i];
+  StepVars& v = vars_[i];
+  const StepVars* prev = i > 0 ? &vars_[i - 1] : nullptr;
+  auto set_pose = [](double* dst, const Pose2& p) { dst[0] = p.x; dst[1] = p.y; dst[2] = p.theta; };
+  auto continuous = [](double* dst, const double* ref) {  // keep theta continuous with ref
+    dst[2] = ref[2] + geometry::WrapAngle(dst[2] - ref[2]);
+  };
+  // Measurements interpolated, using only samples up to `limit` (causal in incremental mode;
+  // beyond the newest sample its value is held).
+  if (s.object >= 0) set_pose(v.x, m.object_pose[s.object].pose);
+  else set_pose(v.x, InterpolatePose(m.object_pose, s.t, limit));
+  if (s.finger >= 0) set_pose(v.e, m.finger_pose[s.finger].pose);
+  else set_pose(v.e, InterpolatePose(m.finger_pose, s.t, limit));
+  if (prev != nullptr) {
+    continuous(v.x, prev->x);
+    continuous(v.e, prev->e);
+  }
+  if (s.in_contact) {
+    if (s.contact >= 0) {
+      const Vec2 c = m.contact_point[s.contact].point;
+      v.p[0] = c.x(); v.p[1] = c.y();
+    } else if (!m.contact_point.empty() && !causal) {
+      const Vec2 c = push::StreamValueClamped(m.contact_point, s.t, [](const push::PointSample& a) { return Vec2(a.point); });
+      v.p[0] = c.x(); v.p[1] = c.y();
+    } else if (causal && prev != nullptr && steps_[i - 1].in_contact) {
+      v.p[0] = prev->p[0]; v.p[1] = prev->p[1];
+    } else {
+      // The object boundary point closest to the finger's reference point.
+      const auto q = geometry::QueryPoint(traj_.object.shape, Pose2{v.x[0], v.x[1], v.x[2]}, Vec2(v.e[0], v.e[1]));
+      v.p[0] = q.closest_point.x(); v.p[1] = q.closest_point.y();
+    }
+    if (s.force >= 0) {
+      v.f[0] = m.force[s.force].force.x(); v.f[1] = m.force[s.force].force.y();
+    } else if (!m.force.empty() && !causal) {
+      const Vec2 f = push::StreamValueClamped(m.force, s.t, [](const push::ForceSample& a) { return Vec2(a.force); });
+      v.f[0] = f.x(); v.f[1] = f.y();
+    } else if (causal && prev != nullptr && steps_[i - 1].in_contact) {
+      v.f[0] = prev->f[0]; v.f[1] = prev->f[1];
+    } else {
+      // Towards the object's centre, small: D's gradient in f is well defined for any f.
+      Vec2 d = Vec2(v.x[0], v.x[1]) - Vec2(v.p[0], v.p[1]);
+      d = d.norm() > 0 ? Vec2(0.1 * d.normalized()) : Vec2(0.1, 0.0);
+      v.f[0] = d.x(); v.f[1] = d.y();
+    }
+  }
+}
+
+int GraphBuilder::SmoothInitialMotion(int max_iterations, double function_tolerance, int first, int last) {
+  ceres::Problem problem;
+  const int n = last < 0 ? static_cast<int>(steps_.size()) : last;
+  for (int i = first; i < n; ++i) {
+    AddPoseMeasurementFactors(problem, i);
+    AddConstantVelocityFactors(problem, i);
+  }
+  // A pose with neither measurement nor neighbours (a one- or two-step input) keeps its value;
+  // steps before `first` (already estimated, incremental mode) are held fixed.
+  for (int i = std::max(0, first - 2); i < n; ++i) {
+    if (!problem.HasParameterBlock(vars_[i].x)) problem.AddParameterBlock(vars_[i].x, 3);
+    if (!problem.HasParameterBlock(vars_[i].e)) problem.AddParameterBlock(vars_[i].e, 3);
+    if (i < first) {
+      problem.SetParameterBlockConstant(vars_[i].x);
+      problem.SetParameterBlockConstant(vars_[i].e);
+    }
+  }
+  const SolveOutcome outcome = Solve(problem, max_iterations, function_tolerance, "motion-only initialization");
+  if (!streams_.contact_point) {
+    for (int i = first; i < n; ++i) {
+      if (!steps_[i].in_contact) continue;
+      StepVars& v = vars_[i];
+      const auto q = geometry::QueryPoint(traj_.object.shape, Pose2{v.x[0], v.x[1], v.x[2]}, Vec2(v.e[0], v.e[1]));
+      v.p[0] = q.closest_point.x();
+      v.p[1] = q.closest_point.y();
+    }
+  }
+  return outcome.iterations;
+}
+
+ceres::LossFunction* GraphBuilder::MakeLoss(const LossConfig& loss) const {
+  switch (loss.type) {
+    case LossConfig::Type::kNone: return nullptr;
+    case LossConfig::Type::kHuber: return new ceres::HuberLoss(loss.scale);
+    case LossConfig::Type::kCauchy: return new ceres::CauchyLoss(loss.scale);
+  }
+  return nullptr;
+}
+
+void GraphBuilder::AddFactors(ceres::Problem& problem, int i, int parts) {
+  const Step& s = steps_[i];
+  StepVars& v = vars_[i];
+  if (parts & kKinematic) {
+    problem.AddParameterBlock(v.x, 3);
+    problem.AddParameterBlock(v.e, 3);
+    if (s.in_contact) problem.AddParameterBlock(v.p, 2);
+    AddKinematicFactors(problem, i);
+  }
+  if ((parts & kDynamic) && HasForceVars(i)) {
+    problem.AddParameterBlock(v.f, 2);
+    AddDynamicFactors(problem, i);
+  }
+}
+
+void GraphBuilder::AddKinematicFactors(ceres::Problem& problem, int i) {
+  adding_step_ = i;
+  const auto& m = traj_.measured;
+  const Step& s = steps_[i];
+  StepVars& v = vars_[i];
+  AddPoseMeasurementFactors(problem, i);  // M
+  if (s.in_contact) {
+    if (s.contact >= 0) {
+      Add(problem, FactorType::kContactPoint, new VectorMeasurementFactor(m.contact_point[s.contact].point, cfg_.measurement.contact),
+          MakeLoss(cfg_.contact_loss), {v.p});
+    }
+    // C: contact point on both boundaries, finger touching the object.
+    Add(problem, FactorType::kContactOnObject, new BoundaryPointFactor(traj_.object.shape, cfg_.contact_object_sigma), nullptr,
+        {v.x, v.p}, {0});
+    if (cfg_.contact_finger == EstimatorConfig::ContactFinger::kWitness) {
+      Add(problem, FactorType::kContactOnFinger, new ContactWitnessFactor(querier_, cfg_.contact_finger_sigma), nullptr,
+          {v.x, v.e, v.p}, {0});
+    } else {
+      Add(problem, FactorType::kContactOnFinger, new BoundaryPointFactor(traj_.finger.shape, cfg_.contact_finger_sigma), nullptr,
+          {v.e, v.p});
+    }
+    // The finger touches the object (signed separation 0): in QS and the baseline (Yu and
+    // Rodriguez's contact factor). CP and SDF link finger and object through p only (Fig. 2a-b).
+    if (model_ == Model::kQs || model_ == Model::kYu) {
+      Add(problem, FactorType::kTouching, new TouchingFactor(querier_, cfg_.touching_sigma), nullptr, {v.x, v.e}, {0});
+    }
+  }
+  // S
+  if (model_ == Model::kSdf || model_ == Model::kQs) {
+    Add(problem, FactorType::kIntersection, new IntersectionFactor(querier_, cfg_.intersection_sigma), nullptr, {v.x, v.e}, {0});
+  }
+  // V or the baseline's zero-velocity priors.
+  if (model_ == Model::kYu) {
+    if (i >= 1) {
+      const double dt = s.t - steps_[i - 1].t;
+      Add(problem, FactorType::kZeroVelocity, new RandomWalkFactor(dt, cfg_.random_walk_trans, cfg_.random_walk_rot), nullptr,
+          {vars_[i - 1].x, v.x});
+      Add(problem, FactorType::kZeroVelocity, new RandomWalkFactor(dt, cfg_.random_walk_trans, cfg_.random_walk_rot), nullptr,
+          {vars_[i - 1].e, v.e});
+    }
+  } else {
+    AddConstantVelocityFactors(problem, i);
+  }
+}
+
+void GraphBuilder::AddPoseMeasurementFactors(ceres::Problem& problem, int i) {
+  adding_step_ = i;
+  const auto& m = traj_.measured;
+  const Step& s = steps_[i];
+  StepVars& v = vars_[i];
+  if (s.object >= 0) {
+    Add(problem, FactorType::kObjectPose,
+        new PoseMeasurementFactor(m.object_pose[s.object].pose, cfg_.measurement.object_trans, cfg_.measurement.object_rot),
+        MakeLoss(cfg_.object_pose_loss), {v.x});
+  }
+  if (s.finger >= 0) {
+    Add(problem, FactorType::kFingerPose,
+        new PoseMeasurementFactor(m.finger_pose[s.finger].pose, cfg_.measurement.finger_trans, cfg_.measurement.finger_rot),
+        MakeLoss(cfg_.finger_pose_loss), {v.e});
+  }
+}
+
+void GraphBuilder::AddConstantVelocityFactors(ceres::Problem& problem, int i) {
+  adding_step_ = i;
+  if (i < 2) return;
+  const double dt1 = steps_[i - 1].t - steps_[i - 2].t, dt2 = steps_[i].t - steps_[i - 1].t;
+  const double st = ConstantVelocitySigma(cfg_.accel_trans, dt1, dt2);
+  const double sr = ConstantVelocitySigma(cfg_.accel_rot, dt1, dt2);
+  Add(problem, FactorType::kConstantVelocity, new ConstantVelocityFactor(dt1, dt2, st, sr), nullptr,
+      {vars_[i - 2].x, vars_[i - 1].x, vars_[i].x});
+  Add(problem, FactorType::kConstantVelocity, new ConstantVelocityFactor(dt1, dt2, st, sr), nullptr,
+      {vars_[i - 2].e, vars_[i - 1].e, vars_[i].e});
+}
+
+void GraphBuilder::AddDynamicFactors(ceres::Problem& problem, int i) {
+  adding_step_ = i;
+  const auto& m = traj_.measured;
+  const Step& s = steps_[i];
+  StepVars& v = vars_[i];
+  // Force: measurement, weak prior, quasi-static factor.
+  {
+    if (s.force >= 0) {
+      Add(problem, FactorType::kForce, new VectorMeasurementFactor(m.force[s.force].force, cfg_.measurement.force),
+          MakeLoss(cfg_.force_loss), {v.f});
+    }
+    Add(problem, FactorType::kForcePrior, new VectorMeasurementFactor(Vec2::Zero(), cfg_.force_prior_sigma), nullptr, {v.f});
+    if (i >= 1 && HasForceVars(i - 1)) {
+      Add(problem, FactorType::kForceContinuity, new VectorRandomWalkFactor(s.t - steps_[i - 1].t, cfg_.force_random_walk),
+          nullptr, {vars_[i - 1].f, v.f});
+    }
+    if (i >= 1) {
+      QuasiStaticGeometry g = qs_;
+      g.dt = s.t - steps_[i - 1].t;
+      const double rate_scale = std::sqrt(0.01 / g.dt);  // per-10-ms sigmas (config.h)
+      if (model_ == Model::kQs) {
+        if (estimate_c_) {
+          Add(problem, FactorType::kQuasiStatic,
+                         new QuasiStaticFactorWithC(g, cfg_.eps_velocity, cfg_.eps_force, cfg_.quasi_static_sigma * rate_scale),
+                         nullptr, {vars_[i - 1].x, v.x, v.p, v.f, c_var_}, {0, 1});
+          // Prior around the geometric value; bounds keep c physical (tau / c in D).
+          if (!c_in_problem_) AddSharedParameterPrior(*this, problem, c_var_, qs_.c, cfg_.c_prior_sigma);
+          c_in_problem_ = true;
+        } else {
+          Add(problem, FactorType::kQuasiStatic,
+                         new QuasiStaticFactor(g, cfg_.eps_velocity, cfg_.eps_force, cfg_.quasi_static_sigma * rate_scale),
+                         nullptr, {vars_[i - 1].x, v.x, v.p, v.f}, {0, 1});
+        }
+        if (use_load_factor_ && (estimate_c_ || estimate_mu_)) {
+          // The same c as D's (estimated) and/or mu as variables.
+          std::vector<double*> blocks{vars_[i - 1].x, v.x, v.p, v.f};
+          if (estimate_c_) blocks.push_back(c_var_);
+          if (estimate_mu_) blocks.push_back(mu_var_);
+          Add(problem, FactorType::kLimitSurfaceLoad,
+                         new LimitSurfaceLoadFactorWithParameters(g, normal_load_, mu_surface_, {estimate_c_, estimate_mu_},
+                                                                  cfg_.eps_velocity, cfg_.eps_force,
+                                                                  cfg_.limit_surface_sigma * rate_scale),
+                         nullptr, blocks, {0, 1});
+          // Prior around the trajectory's mu; bounds keep f_max physical.
+          if (estimate_mu_ && !mu_in_problem_) AddSharedParameterPrior(*this, problem, mu_var_, mu_surface_, cfg_.mu_prior_sigma);
+          mu_in_problem_ = mu_in_problem_ || estimate_mu_;
+        } else if (use_load_factor_) {
+          Add(problem, FactorType::kLimitSurfaceLoad,
+                         new LimitSurfaceLoadFactor(g, f_max_, cfg_.eps_velocity, cfg_.eps_force,
+                                                    cfg_.limit_surface_sigma * rate_scale),
+                         nullptr, {vars_[i - 1].x, v.x, v.p, v.f}, {0, 1});
+        }
+      } else {
+        Add(problem, FactorType::kQuasiStatic, new CrossMultipliedQuasiStaticFactor(g, cfg_.yu_quasi_static_sigma * rate_scale), nullptr,
+                       {vars_[i - 1].x, v.x, v.p, v.f}, {0, 1});
+      }
+    }
+  }
+}
+
+std::vector<double*> GraphBuilder::Blocks(int i) {
+  std::vector<double*> b{vars_[i].x, vars_[i].e};
+  if (HasContactVars(i)) b.push_back(vars_[i].p);
+  if (HasForceVars(i)) b.push_back(vars_[i].f);
+  return b;
+}
+
+void GraphBuilder::DropUnobservableForces(EstimationResult& result) const {
+  if (ForceScaleObservable()) return;
+  for (StateEstimate& s : result.states) {
+    s.force.reset();
+    s.force_cov.reset();
+  }
+  const std::string how = model_ == Model::kYu
+                              ? "the baseline has no limit-surface load"
+                              : (f_max_ > 0.0 ? "limit_surface_load is off"
+                                              : "the object's mass or mu_surface is missing, so there is no limit-surface load");
+  result.warnings.push_back("forces not reported: there is no force stream and " + how +
+                            ", so nothing fixes their size (the quasi-static factor fixes only their direction)");
+}
+
+void GraphBuilder::SetState(int i, const StateEstimate& st) {
+  StepVars& v = vars_[i];
+  v.x[0] = st.object_pose.x; v.x[1] = st.object_pose.y; v.x[2] = st.object_pose.theta;
+  v.e[0] = st.finger_pose.x; v.e[1] = st.finger_pose.y; v.e[2] = st.finger_pose.theta;
+  if (st.contact) {
+    v.p[0] = st.contact->x(); v.p[1] = st.contact->y();
+  } else if (HasContactVars(i)) {
+    const auto q = geometry::QueryPoint(traj_.object.shape, Pose2{v.x[0], v.x[1], v.x[2]}, Vec2(v.e[0], v.e[1]));
+    v.p[0] = q.closest_point.x(); v.p[1] = q.closest_point.y();
+  }
+  v.f[0] = st.force ? st.force->x() : 0.0;
+  v.f[1] = st.force ? st.force->y() : 0.0;
+}
+
+void GraphBuilder::SetSharedParameters(std::optional<double> c, std::optional<double> mu) {
+  if (c && estimate_c_) c_var_[0] = *c;
+  if (mu && estimate_mu_) mu_var_[0] = *mu;
+}
+
+StateEstimate GraphBuilder::State(int i) const {
+  StateEstimate s;
+  const StepVars& v = vars_[i];
+  s.t = steps_[i].t;
+  s.object_pose = {v.x[0], v.x[1], v.x[2]};
+  s.finger_pose = {v.e[0], v.e[1], v.e[2]};
+  if (HasContactVars(i)) s.contact = Vec2(v.p[0], v.p[1]);
+  if (HasForceVars(i)) s.force = Vec2(v.f[0], v.f[1]);
+  return s;
+}
+
+}  // namespace pushgraph::graph::internal
