@@ -7,14 +7,14 @@ cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 jobs=$(nproc)
 if [ "${1:-}" = "--sanitize" ] || [ "${1:-}" = "--sanitize-all" ]; then
-  # --sanitize (CI): the geometry tests. --sanitize-all: also limit_surface, io and the tool's
+  # --sanitize (CI): the geometry tests. --sanitize-all: also limit_surface, push, io and the tool's
   # tests (115 more; a cold build of the sanitized estimation and io code takes about 17 min on 2
   # cores, too long for CI's budget beside the main stage; run it before a release).
   targets=(pushgraph_geometry_tests)
   labels=geometry
   if [ "${1:-}" = "--sanitize-all" ]; then
-    targets+=(pushgraph_limit_surface_tests pushgraph_io_tests pushgraph_tools_tests)
-    labels="geometry|limit_surface|io|tools"
+    targets+=(pushgraph_limit_surface_tests pushgraph_push_tests pushgraph_io_tests pushgraph_tools_tests)
+    labels="geometry|limit_surface|push|io|tools"
   fi
   cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPUSHGRAPH_SANITIZE=ON -DPUSHGRAPH_BUILD_BENCH=OFF >/dev/null
   cmake --build build-asan --target "${targets[@]}" -j"$jobs"
