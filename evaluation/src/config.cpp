@@ -16,29 +16,31 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A shape in the config: "shape.json", or {"mesh": "x.obj", "up": "z", "scale": 1}.
+// A shape in the config: "shape.json", or {"mesh": "x.obj", "up": "z", "scale": 1}. The readers'
+// errors (GeometryError, IoError) get the config's place in front.
 geometry::Shape ConfigShape(const nlohmann::json& j, const fs::path& base, const std::string& where) {
   auto resolve = [&](const std::string& p) { return fs::path(p).is_absolute() ? p : (base / p).string(); };
-  try {
-    if (j.is_string()) return geometry::LoadShapeJson(resolve(j.get<std::string>()));
-    if (j.is_object() && j.contains("mesh")) {
-      io::FootprintOptions o;
-      for (const auto& [k, v] : j.items()) {
-        if (k != "mesh" && k != "up" && k != "scale")
-          throw EvaluationError(where + ": unknown key '" + k + "' (mesh, up, scale)");
-      }
-      if (j.contains("up")) o.up = io::ParseUpAxis(j["up"].get<std::string>());
-      if (j.contains("scale")) o.scale = j["scale"].get<double>();
-      return io::MeshFootprint(resolve(j["mesh"].get<std::string>()), o);
+  auto named = [&](auto&& read) {
+    try {
+      return read();
+    } catch (const nlohmann::json::exception&) {
+      throw;  // a wrong value type: LoadEvaluationConfig names the file
+    } catch (const std::exception& e) {
+      throw EvaluationError(where + ": " + e.what());
     }
-  } catch (const EvaluationError&) {
-    throw;
-  } catch (const nlohmann::json::exception&) {
-    throw;
-  } catch (const std::exception& e) {
-    throw EvaluationError(where + ": " + e.what());
+  };
+  if (j.is_string()) return named([&] { return geometry::LoadShapeJson(resolve(j.get<std::string>())); });
+  if (!j.is_object() || !j.contains("mesh"))
+    throw EvaluationError(where + ": expected a shape file name or {\"mesh\": FILE.obj, \"up\": \"z\", \"scale\": 1}");
+  for (const auto& [k, v] : j.items()) {
+    if (k != "mesh" && k != "up" && k != "scale") throw EvaluationError(where + ": unknown key '" + k + "' (mesh, up, scale)");
   }
-  throw EvaluationError(where + ": expected a shape file name or {\"mesh\": FILE.obj, \"up\": \"z\", \"scale\": 1}");
+  return named([&] {
+    io::FootprintOptions o;
+    if (j.contains("up")) o.up = io::ParseUpAxis(j["up"].get<std::string>());
+    if (j.contains("scale")) o.scale = j["scale"].get<double>();
+    return io::MeshFootprint(resolve(j["mesh"].get<std::string>()), o);
+  });
 }
 
 }  // namespace

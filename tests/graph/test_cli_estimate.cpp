@@ -202,6 +202,10 @@ TEST_F(EstimateCli, RefusesInputsItWouldMisread) {
   r = Tool("estimate " + in + " --mu -0.1 -o " + out);
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find("--mu"), std::string::npos) << r.err;
+  // --mu-contact was removed (no factor used it): giving it is an error, not silently ignored.
+  r = Tool("estimate " + in + " --mu-contact 0.3 -o " + out);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--mu-contact"), std::string::npos) << r.err;
   for (const std::string flag : {"--mass", "--mu"}) {  // CLI11's range checks pass NaN
     r = Tool("estimate " + in + " " + flag + " nan -o " + out);
     EXPECT_NE(r.status, 0) << flag;

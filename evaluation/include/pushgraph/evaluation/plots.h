@@ -61,7 +61,8 @@ std::string TimeSeriesSvg(const std::vector<TimeSeries>& series, const std::stri
                           const std::vector<std::pair<double, double>>& shaded = {});
 
 /// Object position error over time (in mm) of the raw measurements ("raw") and of each result
-/// against trajectory.ground_truth (ground truth interpolated linearly at the sample times).
+/// against trajectory.ground_truth by push/scoring.h's rule (interpolated at the sample times, no
+/// point where the truth has a gap over 0.1 s).
 /// Empty without ground truth.
 std::vector<TimeSeries> ObjectPositionErrorSeries(
     const push::Trajectory& trajectory,
