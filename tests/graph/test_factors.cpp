@@ -1,17 +1,22 @@
-// Every factor's analytic Jacobians against central differences (the geometry tests' harness,
+// Every factor's analytic Jacobians (factor_check.h: the shared harness over the geometry tests'
 // with its kink detector) over many seeded random configurations, including contact at a
 // vertex, pure translation, pure rotation and near-zero rotation; plus the semantics of D.
 #include <pushgraph/graph/factors.h>
+#include <pushgraph/graph/incremental.h>
 #include <pushgraph/graph/shape_frame.h>
 
 #include <pushgraph/geometry/point_query.h>
 
-#include "geometry/numeric_diff.h"
+#include "graph/factor_check.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <regex>
+#include <set>
+#include <sstream>
 #include <memory>
 #include <random>
 #include <vector>
@@ -20,68 +25,10 @@ namespace pushgraph::graph {
 namespace {
 
 using geometry::Shape;
-using geometry::testing::CheckJacobian;
 using geometry::testing::JacobianTally;
-using geometry::testing::NumericDiffOptions;
-
-// Worst relative error of all checked Jacobians, per factor (printed for the report).
-struct WorstError {
-  const char* name;
-  double worst = 0.0;
-  ~WorstError() { std::printf("[jacobian] %-28s worst |J - Jnum| / max(1, max|Jnum|) = %.3g\n", name, worst); }
-};
-
-// Checks all parameter blocks of `cost` at `values` (one vector per block).
-void CheckCost(const ceres::CostFunction& cost, std::vector<Eigen::VectorXd> values, JacobianTally& tally,
-               WorstError& worst, const std::string& context) {
-  const int m = cost.num_residuals();
-  const auto& sizes = cost.parameter_block_sizes();
-  ASSERT_EQ(values.size(), sizes.size());
-  std::vector<const double*> ptrs;
-  for (auto& v : values) ptrs.push_back(v.data());
-  Eigen::VectorXd r(m);
-  std::vector<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> J(sizes.size());
-  std::vector<double*> jp;
-  for (std::size_t k = 0; k < sizes.size(); ++k) {
-    J[k].resize(m, sizes[k]);
-    jp.push_back(J[k].data());
-  }
-  ASSERT_TRUE(cost.Evaluate(ptrs.data(), r.data(), jp.data())) << context;
-  for (std::size_t k = 0; k < sizes.size(); ++k) {
-    auto f = [&](const Eigen::VectorXd& v) {
-      std::vector<Eigen::VectorXd> vv = values;
-      vv[k] = v;
-      std::vector<const double*> pp;
-      for (auto& x : vv) pp.push_back(x.data());
-      Eigen::VectorXd out(m);
-      if (!cost.Evaluate(pp.data(), out.data(), nullptr)) out.setConstant(NAN);
-      return out;
-    };
-    NumericDiffOptions o;
-    o.h = 1e-7;
-    o.rel_tol = 1e-5;
-    // Entries are compared relative to the whole block's scale: whitened residuals and
-    // 1/dt velocities make some entries 1e5 times larger than others in the same block.
-    o.abs_tol = 1e-5 + 1e-6 * J[k].cwiseAbs().maxCoeff();
-    const auto rep = CheckJacobian(f, values[k], Eigen::MatrixXd(J[k]), o);
-    if (rep.status == geometry::testing::JacobianCheck::kPassed) {
-      const Eigen::MatrixXd d = Eigen::MatrixXd(J[k]) - rep.numeric;
-      for (int i = 0; i < d.rows(); ++i)
-        for (int j = 0; j < d.cols(); ++j)
-          worst.worst = std::max(worst.worst, std::abs(d(i, j)) / std::max(1.0, rep.numeric.cwiseAbs().maxCoeff()));
-    }
-    EXPECT_TRUE(tally.Record(rep, context + " block " + std::to_string(k)));
-  }
-}
-
-Eigen::VectorXd V(std::initializer_list<double> l) {
-  Eigen::VectorXd v(l.size());
-  int i = 0;
-  for (double x : l) v[i++] = x;
-  return v;
-}
-Eigen::VectorXd V(const Pose2& p) { return p.vector(); }
-Eigen::VectorXd V(const Vec2& p) { return Eigen::VectorXd(p); }
+using testing::CheckCost;
+using testing::V;
+using testing::WorstError;
 
 struct Rng {
   std::mt19937_64 g{12345};
@@ -518,6 +465,76 @@ TEST(FactorSemantics, BadSigmasAndStepsAreRejected) {
   g.c = -1.0;
   EXPECT_THROW(QuasiStaticFactor(g, 1e-3, 0.05, 0.1), GraphError);
   EXPECT_THROW(BoundaryPointFactor(geometry::Shape(), 1.0), GraphError);
+}
+
+// The marginalization prior of the fixed-lag smoother: linear in the chart coordinates, so its
+// Jacobians are S's column blocks; checked like every factor over random sizes and points (angles
+// near +-pi included), and its quadratic form against H = S^T S, b = S^T r0.
+TEST(FactorJacobians, MarginalPrior) {
+  Rng rng;
+  JacobianTally tally("marginal prior");
+  WorstError worst{"marginal prior"};
+  for (int i = 0; i < 40; ++i) {
+    const std::vector<int> sizes = i % 2 == 0 ? std::vector<int>{3, 3, 2, 2} : std::vector<int>{3, 2, 1};
+    int n = 0;
+    for (int s : sizes) n += s;
+    const int m = 1 + i % n;
+    Eigen::MatrixXd S(m, n);
+    for (int r = 0; r < m; ++r)
+      for (int c = 0; c < n; ++c) S(r, c) = rng.U(-50, 50);
+    Eigen::VectorXd x_bar(n), r0(m), x(n);
+    for (int k = 0; k < n; ++k) x_bar[k] = rng.U(-M_PI, M_PI);
+    for (int k = 0; k < m; ++k) r0[k] = rng.U(-1, 1);
+    for (int k = 0; k < n; ++k) x[k] = x_bar[k] + rng.U(-0.1, 0.1);
+    const MarginalPriorFactor prior(sizes, x_bar, S, r0);
+    std::vector<Eigen::VectorXd> blocks;
+    int off = 0;
+    for (int s : sizes) {
+      blocks.push_back(x.segment(off, s));
+      off += s;
+    }
+    CheckCost(prior, blocks, tally, worst, "case " + std::to_string(i));
+    // 1/2 |r|^2 = 1/2 dx^T H dx + b^T dx + 1/2 |r0|^2.
+    std::vector<const double*> ptrs;
+    for (const auto& b : blocks) ptrs.push_back(b.data());
+    Eigen::VectorXd r(m);
+    ASSERT_TRUE(prior.Evaluate(ptrs.data(), r.data(), nullptr));
+    const Eigen::VectorXd dx = x - x_bar;
+    const double expected = 0.5 * dx.dot(S.transpose() * S * dx) + (S.transpose() * r0).dot(dx) + 0.5 * r0.squaredNorm();
+    EXPECT_NEAR(0.5 * r.squaredNorm(), expected, 1e-9 * std::max(1.0, expected));
+  }
+  EXPECT_TRUE(tally.MostlyChecked(0.99));
+  EXPECT_THROW(MarginalPriorFactor({3, 2}, Eigen::VectorXd::Zero(5), Eigen::MatrixXd::Zero(2, 4), Eigen::VectorXd::Zero(2)),
+               GraphError);
+}
+
+// The harness covers the module: every cost function class the graph module declares (public
+// headers and sources) is constructed in this file, where every construction is checked with
+// CheckCost. A new factor without a check fails here, by name.
+TEST(FactorJacobians, EveryCostFunctionOfTheModuleIsChecked) {
+  std::set<std::string> declared;
+  const std::regex cls(R"(class (\w+) : public ceres::(Sized)?CostFunction)");
+  for (const char* header : {"graph/include/pushgraph/graph/factors.h", "graph/include/pushgraph/graph/incremental.h",
+                             "graph/include/pushgraph/graph/shape_frame.h", "graph/src/graph_builder.h"}) {
+    std::ifstream in(std::string(PUSHGRAPH_SOURCE_DIR) + "/" + header);
+    ASSERT_TRUE(in) << header;
+    std::stringstream text;
+    text << in.rdbuf();
+    const std::string s = text.str();
+    for (auto it = std::sregex_iterator(s.begin(), s.end(), cls); it != std::sregex_iterator(); ++it)
+      declared.insert((*it)[1]);
+  }
+  EXPECT_GE(declared.size(), 17u);
+  std::ifstream in(std::string(PUSHGRAPH_SOURCE_DIR) + "/tests/graph/test_factors.cpp");
+  ASSERT_TRUE(in);
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string tests = text.str();
+  for (const std::string& name : declared) {
+    // Constructed as a variable or with new (not only named in a comment).
+    const std::regex use("\\b" + name + "\\s*(\\w+\\s*\\(|\\()");
+    EXPECT_TRUE(std::regex_search(tests, use)) << name << " has no Jacobian check in tests/graph/test_factors.cpp";
+  }
 }
 
 }  // namespace
