@@ -1,5 +1,5 @@
 // Every factor's analytic Jacobians (factor_check.h: the shared harness over the geometry tests'
-// with its kink detector) over many seeded random configurations, including contact at a
+// CheckJacobian, with its kink detector) over many seeded random configurations, including contact at a
 // vertex, pure translation, pure rotation and near-zero rotation; plus the semantics of D.
 #include <pushgraph/graph/factors.h>
 #include <pushgraph/graph/incremental.h>
