@@ -1,0 +1,183 @@
+// Contacts of recordings and the helpers of shape registration (contact_fit.h).
+#include "contact_fit.h"
+
+#include <pushgraph/graph/factors.h>
+
+#include "text.h"
+
+#include <ceres/ceres.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <cmath>
+
+namespace pushgraph::graph::internal::registration {
+
+using internal::Median;
+
+Vec2 Rotate(const Vec2& p, double angle) {
+  const double c = std::cos(angle), s = std::sin(angle);
+  return {c * p.x() - s * p.y(), s * p.x() + c * p.y()};
+}
+
+const char* UnitName(double scale) {
+  if (scale == 0.001) return "millimetres";
+  if (scale == 0.01) return "centimetres";
+  if (scale == 0.0254) return "inches";
+  return "metres";
+}
+
+// The outer rings of the core polygons as one shape without holes: what a finger can touch
+// from outside, and what symmetry is judged on.
+Shape OutlineOf(const Shape& shape) {
+  std::vector<geometry::Polygon> outers;
+  for (const geometry::Polygon& p : shape.polygons()) outers.push_back({p.outer, {}});
+  return Shape::FromPolygons(std::move(outers), shape.radius());
+}
+
+// Points on the outline: vertices and edge midpoints of the outer rings (at most 400).
+std::vector<Vec2> OutlineSamples(const Shape& shape) {
+  std::vector<Vec2> pts;
+  for (const geometry::Polygon& p : shape.polygons()) {
+    const int n = static_cast<int>(p.outer.size());
+    for (int i = 0; i < n; ++i) {
+      pts.push_back(p.outer[i]);
+      if (n > 1) pts.push_back(0.5 * (p.outer[i] + p.outer[(i + 1) % n]));
+    }
+  }
+  if (pts.size() > 400) {
+    std::vector<Vec2> fewer;
+    const double step = static_cast<double>(pts.size()) / 400.0;
+    for (int i = 0; i < 400; ++i) fewer.push_back(pts[static_cast<std::size_t>(i * step)]);
+    pts = std::move(fewer);
+  }
+  return pts;
+}
+
+// Whether placements a and b of a shape coincide on its outline within tolerance.
+bool SamePlacement(const Shape& outline, const std::vector<Vec2>& samples, const Placement& a, const Placement& b,
+                   double tolerance) {
+  const Pose2 Ta{a.x.x(), a.x.y(), a.x.z()}, Tb{b.x.x(), b.x.y(), b.x.z()};
+  const Pose2 rel = geometry::Between(Tb, Ta);  // Tb^-1 Ta
+  const double sa = std::exp(a.log_scale), sb = std::exp(b.log_scale);
+  for (const Vec2& p : samples) {
+    const Vec2 w = geometry::Act(rel, Vec2(sa * p)) / sb;
+    if (std::abs(sb * geometry::QueryPoint(outline, w).signed_distance) > tolerance) return false;
+  }
+  return true;
+}
+
+// A pose stream smoothed by the estimator's motion-only prior: pose measurements and the
+// white-noise-acceleration constant-velocity factor (factors.h), solved with Ceres.
+std::vector<push::PoseSample> Smoothed(const std::vector<push::PoseSample>& in, double sigma_t,
+                                                double sigma_r, double accel_t, double accel_r) {
+  const int n = static_cast<int>(in.size());
+  if (n < 3) return in;
+  std::vector<double> x(3 * n);
+  for (int i = 0; i < n; ++i) {
+    x[3 * i] = in[i].pose.x;
+    x[3 * i + 1] = in[i].pose.y;
+    // Continuous angles: the chart coordinate must not jump by 2 pi between samples.
+    x[3 * i + 2] = i == 0 ? in[0].pose.theta : x[3 * i - 1] + geometry::WrapAngle(in[i].pose.theta - x[3 * i - 1]);
+  }
+  ceres::Problem problem;
+  for (int i = 0; i < n; ++i) {
+    problem.AddResidualBlock(new PoseMeasurementFactor(in[i].pose, sigma_t, sigma_r), nullptr, &x[3 * i]);
+    if (i < 2) continue;
+    const double dt1 = in[i - 1].t - in[i - 2].t, dt2 = in[i].t - in[i - 1].t;
+    if (!(dt1 > 0.0 && dt2 > 0.0)) continue;
+    problem.AddResidualBlock(new ConstantVelocityFactor(dt1, dt2, ConstantVelocitySigma(accel_t, dt1, dt2),
+                                                        ConstantVelocitySigma(accel_r, dt1, dt2)),
+                             nullptr, &x[3 * i - 6], &x[3 * i - 3], &x[3 * i]);
+  }
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  options.max_num_iterations = 10;
+  options.function_tolerance = 1e-4;
+  options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  std::vector<push::PoseSample> out = in;
+  for (int i = 0; i < n; ++i) out[i].pose = {x[3 * i], x[3 * i + 1], x[3 * i + 2]};
+  return out;
+}
+
+// The white noise of a pose stream from its own samples: the second difference of three
+// consecutive samples is sqrt(6) sigma for white noise on a smooth motion; robust through the
+// median absolute value (x 1.4826). Triples with uneven steps (gaps) are skipped.
+void StreamNoise(const std::vector<push::PoseSample>& s, double* trans, double* rot) {
+  std::vector<double> dt, dx, da;
+  for (std::size_t i = 1; i < s.size(); ++i) dt.push_back(s[i].t - s[i - 1].t);
+  const double step = Median(dt);
+  for (std::size_t i = 1; i + 1 < s.size(); ++i) {
+    const double a = s[i].t - s[i - 1].t, b = s[i + 1].t - s[i].t;
+    if (!(a > 0.5 * step && a < 1.5 * step && b > 0.5 * step && b < 1.5 * step)) continue;
+    const Vec2 d = s[i + 1].pose.translation() - 2.0 * s[i].pose.translation() + s[i - 1].pose.translation();
+    dx.push_back(std::abs(d.x()));
+    dx.push_back(std::abs(d.y()));
+    da.push_back(std::abs(geometry::WrapAngle(s[i + 1].pose.theta - s[i].pose.theta) -
+                          geometry::WrapAngle(s[i].pose.theta - s[i - 1].pose.theta)));
+  }
+  *trans = dx.empty() ? 0.0 : 1.4826 * Median(dx) / std::sqrt(6.0);
+  *rot = da.empty() ? 0.0 : 1.4826 * Median(da) / std::sqrt(6.0);
+}
+
+// Every recording's contacts, pooled, with each recording's span (s).
+Contacts PoolContacts(const std::vector<const push::Trajectory*>& recordings, const RegistrationOptions& o,
+                      std::vector<double>* spans) {
+  if (recordings.empty() || recordings.front() == nullptr) throw GraphError("registration: no recording");
+  const push::Trajectory& first = *recordings.front();
+  if (first.object.shape.empty()) throw GraphError("registration: the object shape is empty");
+  Contacts pooled;
+  pooled.recordings = static_cast<int>(recordings.size());
+  spans->clear();
+  for (std::size_t k = 0; k < recordings.size(); ++k) {
+    const push::Trajectory& traj = *recordings[k];
+    if (traj.measured.object_pose.empty() || traj.measured.finger_pose.empty()) {
+      throw GraphError("registration: recording " + std::to_string(k) + " has no object or no finger pose measurements");
+    }
+    if (k > 0 && (traj.object.shape.num_vertices() != first.object.shape.num_vertices() ||
+                  traj.finger.shape.num_vertices() != first.finger.shape.num_vertices())) {
+      throw GraphError("registration: recording " + std::to_string(k) + " has another object or finger shape than the first");
+    }
+    const ContactPath path = MeasuredContactPath(traj, o);
+    pooled.q.insert(pooled.q.end(), path.q.begin(), path.q.end());
+    pooled.relative.insert(pooled.relative.end(), path.relative.begin(), path.relative.end());
+    pooled.recording.insert(pooled.recording.end(), path.q.size(), static_cast<int>(k));
+    spans->push_back(path.t.empty() ? 0.0 : path.t.back() - path.t.front());
+    pooled.noise = std::max(pooled.noise, path.noise);
+  }
+  if (pooled.q.size() < 8) {
+    throw GraphError("registration: only " + std::to_string(pooled.q.size()) +
+                     " finger samples in contact with an object pose near them (at least 8 needed)");
+  }
+  pooled.weight.assign(pooled.q.size(), 1.0);
+  return pooled;
+}
+
+// The shape as given against the contacts: median |gap| and the share penetrating beyond the
+// tolerance max(fit_tolerance, 2.5 noise of the smoothed path).
+ShapeFitCheck CheckContacts(const Shape& shape, const Shape& finger, const Contacts& c, const RegistrationOptions& o) {
+  ShapeFitCheck check;
+  check.tolerance = std::max(o.fit_tolerance, 2.5 * c.noise);
+  ContactFit fit(shape, c, finger, FingerAsDisk(finger), 1e-3, 1.0, 0.0);
+  fit.UseExactFinger();
+  const Placement identity = fit.Start();
+  std::vector<double> gaps;
+  int penetrating = 0;
+  for (std::size_t i = 0; i < fit.size(); ++i) {
+    const double g = fit.Gap(i, identity);
+    gaps.push_back(std::abs(g));
+    penetrating += g < -check.tolerance ? 1 : 0;
+  }
+  check.samples = static_cast<int>(gaps.size());
+  check.gap_median = Median(gaps);
+  check.penetration_share = static_cast<double>(penetrating) / std::max<std::size_t>(1, gaps.size());
+  check.fits = check.gap_median <= check.tolerance && check.penetration_share <= 0.1;
+  return check;
+}
+
+}  // namespace pushgraph::graph::internal::registration
