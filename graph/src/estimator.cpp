@@ -98,26 +98,9 @@ EstimationResult EstimateBatch(const push::Trajectory& traj, Model model, const 
   const auto start = std::chrono::steady_clock::now();
   ceres::Problem problem;
   for (int i = 0; i < n; ++i) builder.Initialize(i, INFINITY);
-  int stage_iterations = 0;
-  if (ModelHasForce(model)) {
-    // Staged start: the kinematic SDF graph first (interpolated measurements are far from
-    // satisfying D's per-step velocity directions), then the full graph from its solution.
-    internal::GraphBuilder kinematic(traj, Model::kSdf, cfg);
-    ceres::Problem pre;
-    for (int i = 0; i < n; ++i) kinematic.Initialize(i, INFINITY);
-    stage_iterations += kinematic.SmoothInitialMotion(10, 1e-3);
-    for (int i = 0; i < n; ++i) kinematic.AddFactors(pre, i);
-    stage_iterations += kinematic.Solve(pre, cfg.max_iterations, cfg.function_tolerance, "batch warm start (sdf)").iterations;
-    for (int i = 0; i < n; ++i) {
-      auto& dst = builder.vars()[i];
-      const auto& src = kinematic.vars()[i];
-      std::copy(src.x, src.x + 3, dst.x);
-      std::copy(src.e, src.e + 3, dst.e);
-      std::copy(src.p, src.p + 2, dst.p);
-    }
-  }
-  if (!ModelHasForce(model)) stage_iterations += builder.SmoothInitialMotion(10, 1e-3);
-  for (int i = 0; i < n; ++i) builder.AddFactors(problem, i);
+  // One builder, one shape querier, the staging the incremental mode uses too.
+  const int stage_iterations =
+      builder.StageSteps(problem, 0, n, cfg.max_iterations, cfg.function_tolerance, "batch solve");
   const internal::SolveOutcome summary = builder.Solve(problem, cfg.max_iterations, cfg.function_tolerance, "batch solve");
   EstimationResult r;
   r.model = model;

@@ -240,7 +240,7 @@ void GraphBuilder::EnableShapeFrame(const Vec2& centroid, double sigma_centroid,
 ceres::ResidualBlockId GraphBuilder::Add(ceres::Problem& problem, FactorType type, ceres::CostFunction* cost,
                                          ceres::LossFunction* loss, std::vector<double*> blocks,
                                          std::vector<int> object_pose_blocks) {
-  if (shape_frame_ && !object_pose_blocks.empty()) {
+  if (shape_frame_ && !warm_start_ && !object_pose_blocks.empty()) {
     blocks.push_back(frame_);
     cost = new ShapeFrameFactor(cost, std::move(object_pose_blocks));
     if (!frame_in_problem_) {
@@ -253,6 +253,7 @@ ceres::ResidualBlockId GraphBuilder::Add(ceres::Problem& problem, FactorType typ
     }
   }
   const ceres::ResidualBlockId id = problem.AddResidualBlock(cost, loss, blocks);
+  if (warm_start_) return id;
   if (tags_ != nullptr) tags_->push_back({type, id});
   origin_[id] = {type, type == FactorType::kPrior ? -1 : adding_step_};
   return id;
@@ -352,6 +353,26 @@ int GraphBuilder::SmoothInitialMotion(int max_iterations, double function_tolera
     }
   }
   return outcome.iterations;
+}
+
+int GraphBuilder::StageSteps(ceres::Problem& problem, int first, int last, int max_iterations,
+                             double function_tolerance, const std::string& what) {
+  int iterations = SmoothInitialMotion(10, 1e-3, first, last);
+  if (ModelHasForce(model_)) {
+    ceres::Problem warm;
+    warm_start_ = true;
+    for (int i = first; i < last; ++i) AddFactors(warm, i, kKinematic);
+    warm_start_ = false;
+    // The two steps before `first` enter the new steps' V factors as constants.
+    for (int i = std::max(0, first - 2); i < first; ++i) {
+      for (double* b : Blocks(i)) {
+        if (warm.HasParameterBlock(b)) warm.SetParameterBlockConstant(b);
+      }
+    }
+    iterations += Solve(warm, max_iterations, function_tolerance, (what + ", kinematics first").c_str()).iterations;
+  }
+  for (int i = first; i < last; ++i) AddFactors(problem, i, kAll);
+  return iterations;
 }
 
 ceres::LossFunction* GraphBuilder::MakeLoss(const LossConfig& loss) const {

@@ -140,6 +140,15 @@ class GraphBuilder {
   static constexpr int kKinematic = 1, kDynamic = 2, kAll = 3;
   /// Adds the factors whose newest step is i (steps i-2, i-1 must already be in the problem).
   void AddFactors(ceres::Problem& problem, int i, int parts = kAll);
+  /// The one staging path of the batch and incremental solvers: steps [first, last) start from
+  /// SmoothInitialMotion; with forces (QS, Yu) their kinematic factors (the model's own M, C, S,
+  /// V or random walk, touching) are then solved on their own, in a separate problem without the
+  /// shape frame, the two steps before `first` held fixed (incremental: only the new steps need
+  /// a start); then their full factors go into `problem`. Interpolated measurements are far from
+  /// satisfying D's per-step velocity directions: starting D from them costs the full solve tens
+  /// of iterations. Returns the iterations used.
+  int StageSteps(ceres::Problem& problem, int first, int last, int max_iterations, double function_tolerance,
+                 const std::string& what);
   /// Parameter blocks of step i present in the problem.
   std::vector<double*> Blocks(int i);
   /// Makes c a shared variable of every D factor (QS only; the batch solver calls this when
@@ -216,6 +225,9 @@ class GraphBuilder {
   double frame_[3] = {0.0, 0.0, 0.0};
   Vec2 frame_centroid_ = Vec2::Zero();
   std::vector<TaggedBlock>* tags_ = nullptr;
+  /// While StageSteps solves the kinematics first: no shape frame, factors not recorded for
+  /// Describe or the diagnostics (that problem is gone after it).
+  bool warm_start_ = false;
   int adding_step_ = -1;  ///< the step whose factors are being added (-1: shared)
   std::unordered_map<ceres::ResidualBlockId, std::pair<FactorType, int>> origin_;  ///< for Describe
   double frame_sigma_centroid_ = 0.01, frame_sigma_theta_ = 0.2;

@@ -12,6 +12,7 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <unordered_set>
 
 namespace pushgraph::graph {
 
@@ -124,15 +125,19 @@ struct FixedLagSmoother {
   // Schur-complements every factor touching step s onto the blocks they share with other steps.
   void Marginalize(int s) {
     std::vector<double*> removed = builder.Blocks(s);
-    // In a deterministic order (a set of pointers would make the sums, and so the result,
-    // depend on heap addresses).
-    std::vector<ceres::ResidualBlockId> rbs;
+    // In the problem's own order: with enable_fast_removal, GetResidualBlocksForParameterBlock
+    // walks a hash set of pointers, whose order (and so the sums below, and so the result)
+    // depends on heap addresses: two runs of one input gave different incremental estimates.
+    std::unordered_set<ceres::ResidualBlockId> touching;
     for (double* b : removed) {
       std::vector<ceres::ResidualBlockId> v;
       problem->GetResidualBlocksForParameterBlock(b, &v);
-      for (ceres::ResidualBlockId id : v) {
-        if (std::find(rbs.begin(), rbs.end(), id) == rbs.end()) rbs.push_back(id);
-      }
+      touching.insert(v.begin(), v.end());
+    }
+    std::vector<ceres::ResidualBlockId> all, rbs;
+    problem->GetResidualBlocks(&all);
+    for (ceres::ResidualBlockId id : all) {
+      if (touching.count(id)) rbs.push_back(id);
     }
     std::vector<double*> order(removed);
     std::map<double*, int> offset;
@@ -175,7 +180,10 @@ struct FixedLagSmoother {
       H.noalias() += Jf.transpose() * Jf;
       b.noalias() += Jf.transpose() * (scale * r);
     }
-    // Remove the step (its residual blocks go with its parameter blocks).
+    // Remove the step: its residual blocks in the order above first (RemoveParameterBlock would
+    // remove them in hash-set order, and fast removal moves the problem's last block into each
+    // freed place, so the problem's order, and Ceres' sums, would depend on heap addresses).
+    for (ceres::ResidualBlockId id : rbs) problem->RemoveResidualBlock(id);
     for (double* p : removed) problem->RemoveParameterBlock(p);
     const int sep_dim = dim - removed_dim;
     if (sep_dim == 0) return;
@@ -225,28 +233,9 @@ struct FixedLagSmoother {
       ++next_step;
     }
     if (next_step == first_new) return 0.0;
-    // The new steps start from a causal motion-only smoother (as the batch solver's start).
-    stats.iterations += builder.SmoothInitialMotion(10, 1e-3, first_new, next_step);
-    for (int i = first_new; i < next_step; ++i) builder.AddFactors(*problem, i, internal::GraphBuilder::kKinematic);
-    if (ModelHasForce(builder.model())) {
-      // Staged like the batch solver: the new steps' kinematics first (the window's older
-      // steps held fixed: only the new ones need a start), then everything with the dynamics.
-      std::vector<double*> held;
-      for (int i = lo; i < first_new; ++i) {
-        for (double* b : builder.Blocks(i)) {
-          if (problem->HasParameterBlock(b) && !problem->IsParameterBlockConstant(b)) {
-            problem->SetParameterBlockConstant(b);
-            held.push_back(b);
-          }
-        }
-      }
-      stats.iterations += builder
-                              .Solve(*problem, cfg.incremental_max_iterations, cfg.function_tolerance,
-                                     "incremental update, new steps' kinematics")
-                              .iterations;
-      for (double* b : held) problem->SetParameterBlockVariable(b);
-      for (int i = first_new; i < next_step; ++i) builder.AddFactors(*problem, i, internal::GraphBuilder::kDynamic);
-    }
+    // The new steps staged as in the batch solver (the window's older steps held fixed).
+    stats.iterations += builder.StageSteps(*problem, first_new, next_step, cfg.incremental_max_iterations,
+                                           cfg.function_tolerance, "incremental update, new steps");
     const internal::SolveOutcome summary =
         builder.Solve(*problem, cfg.incremental_max_iterations, cfg.function_tolerance, "incremental update, window");
     stats.iterations += summary.iterations;
