@@ -60,9 +60,10 @@ void CheckFrozen(const std::vector<Sample>& stream, const char* name, Value valu
 }  // namespace
 
 Diagnostics Diagnose(const push::Trajectory& traj, Model model, const EstimatorConfig& cfg,
-                     const EstimationResult& result, const FrameState* frame) {
+                     const EstimationResult& result, const FrameState* frame,
+                     std::shared_ptr<const geometry::ShapePairQuerier> querier) {
   Diagnostics d;
-  GraphBuilder builder(traj, model, cfg);
+  GraphBuilder builder(traj, model, cfg, std::move(querier));
   const int n = static_cast<int>(builder.steps().size());
   if (n != static_cast<int>(result.states.size())) {
     d.causes.push_back("diagnostics not computed: the estimate's steps do not match the trajectory's");

@@ -89,8 +89,9 @@ struct FrameSetup {
 };
 
 EstimationResult EstimateBatch(const push::Trajectory& traj, Model model, const EstimatorConfig& cfg,
-                               FrameSetup* frame = nullptr) {
-  internal::GraphBuilder builder(traj, model, cfg);
+                               FrameSetup* frame = nullptr,
+                               std::shared_ptr<const geometry::ShapePairQuerier> querier = nullptr) {
+  internal::GraphBuilder builder(traj, model, cfg, std::move(querier));
   if (frame) builder.EnableShapeFrame(frame->centroid, frame->sigma_centroid, frame->sigma_theta, frame->rotation);
   if (cfg.estimate_c) builder.EnableCEstimation();
   if (cfg.estimate_mu) builder.EnableMuEstimation();
@@ -334,6 +335,9 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
   }
   EstimationResult result;
   std::optional<internal::FrameState> frame_state;
+  // One querier for the estimate and its diagnostics (batch; the fixed-lag smoother keeps its own).
+  std::shared_ptr<const geometry::ShapePairQuerier> querier;
+  if (mode == Mode::kBatch) querier = internal::GraphBuilder::MakeQuerier(*working, config);
   if (mode == Mode::kBatch) {
     if (align) {
       // The frame refined as a static variable: the centroid prior of the registration.
@@ -342,7 +346,7 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
       frame.centroid = geometry::CoreCentroid(shape);
       frame.sigma_centroid = options.centroid_prior * geometry::RadiusAbout(shape, frame.centroid);
       frame.rotation = registration->rotation_observable;
-      result = EstimateBatch(*working, model, config, &frame);
+      result = EstimateBatch(*working, model, config, &frame, querier);
       frame_state = internal::FrameState{frame.centroid, frame.sigma_centroid, frame.sigma_theta, frame.rotation, frame.frame};
       // Final transform F * T, then its equivalent closest to angle 0 (F * T * C, C constant).
       Eigen::Matrix3d J_refined_frame, J_final_refined;
@@ -358,7 +362,7 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
         if (!frame.rotation) alignment.sigma.z() = 0.0;
       }
     } else {
-      result = EstimateBatch(*working, model, config);
+      result = EstimateBatch(*working, model, config, nullptr, querier);
     }
   } else {
     // Fixed-lag smoothing keeps the registered frame fixed (no static variable in the window).
@@ -400,7 +404,8 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
   }
   if (alignment.checked || !alignment.notes.empty()) result.shape_alignment = alignment;
   if (config.diagnostics) {
-    result.diagnostics = internal::Diagnose(*working, model, config, result, frame_state ? &*frame_state : nullptr);
+    result.diagnostics =
+        internal::Diagnose(*working, model, config, result, frame_state ? &*frame_state : nullptr, querier);
     for (const std::string& cause : result.diagnostics->causes) warnings.push_back("diagnostics: " + cause);
   }
   result.warnings.insert(result.warnings.begin(), warnings.begin(), warnings.end());

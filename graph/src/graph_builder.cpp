@@ -49,15 +49,15 @@ double NearestGap(const std::vector<Sample>& s, double t, int* index = nullptr) 
 
 }  // namespace
 
-GraphBuilder::GraphBuilder(const push::Trajectory& trajectory, Model model,
-                           const EstimatorConfig& config)
+GraphBuilder::GraphBuilder(const push::Trajectory& trajectory, Model model, const EstimatorConfig& config,
+                           std::shared_ptr<const geometry::ShapePairQuerier> querier)
     : traj_(trajectory), model_(model), cfg_(config) {
   ValidateConfig(cfg_);
   ValidateTrajectory(traj_);
   streams_.contact_point = !traj_.measured.contact_point.empty();
   streams_.force = !traj_.measured.force.empty();
   AppendSteps(INFINITY);
-  SetUpShapes();
+  SetUpShapes(std::move(querier));
 }
 
 GraphBuilder::GraphBuilder(const push::Trajectory& trajectory, Model model,
@@ -66,7 +66,7 @@ GraphBuilder::GraphBuilder(const push::Trajectory& trajectory, Model model,
   ValidateConfig(cfg_);
   if (traj_.object.shape.empty()) throw GraphError("trajectory: object.shape is missing or empty");
   if (traj_.finger.shape.empty()) throw GraphError("trajectory: finger.shape is missing or empty");
-  SetUpShapes();
+  SetUpShapes(nullptr);
 }
 
 int GraphBuilder::AppendSteps(double until) {
@@ -110,12 +110,17 @@ int GraphBuilder::AppendSteps(double until) {
   return static_cast<int>(steps_.size() - first_new);
 }
 
-void GraphBuilder::SetUpShapes() {
+std::shared_ptr<const geometry::ShapePairQuerier> GraphBuilder::MakeQuerier(const push::Trajectory& trajectory,
+                                                                          const EstimatorConfig& config) {
   geometry::ShapePairQuerier::Options pair_options;
-  pair_options.angle_cache_resolution = cfg_.finger_angle_resolution;
+  pair_options.angle_cache_resolution = config.finger_angle_resolution;
   pair_options.max_cached_angles = 4096;
   pair_options.check_rounded_depth = false;  // the factors never read depth_exact: no second query
-  querier_ = std::make_shared<geometry::ShapePairQuerier>(traj_.object.shape, traj_.finger.shape, pair_options);
+  return std::make_shared<geometry::ShapePairQuerier>(trajectory.object.shape, trajectory.finger.shape, pair_options);
+}
+
+void GraphBuilder::SetUpShapes(std::shared_ptr<const geometry::ShapePairQuerier> querier) {
+  querier_ = querier ? std::move(querier) : MakeQuerier(traj_, cfg_);
   if (ModelHasForce(model_)) qs_ = QuasiStaticGeometryFor(traj_, cfg_);
   if (traj_.object.mass > 0.0 && traj_.object.mu_surface > 0.0) {
     mu_surface_ = traj_.object.mu_surface;

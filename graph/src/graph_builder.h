@@ -105,7 +105,13 @@ class GraphBuilder {
                              std::vector<int> object_pose_blocks = {});
   /// Every block Add()s from now on is appended to `tags` (nullptr: stop).
   void RecordFactorTypes(std::vector<TaggedBlock>* tags) { tags_ = tags; }
-  GraphBuilder(const push::Trajectory& trajectory, Model model, const EstimatorConfig& config);
+  /// `querier`: the object-finger querier to share (MakeQuerier of the same trajectory and
+  /// config; the estimate and its diagnostics use one); null: a new one.
+  GraphBuilder(const push::Trajectory& trajectory, Model model, const EstimatorConfig& config,
+               std::shared_ptr<const geometry::ShapePairQuerier> querier = nullptr);
+  /// The exact object-finger querier the factors use (its Minkowski obstacles cached per angle).
+  static std::shared_ptr<const geometry::ShapePairQuerier> MakeQuerier(const push::Trajectory& trajectory,
+                                                                      const EstimatorConfig& config);
   /// Online use (OnlineEstimator): `trajectory` starts with empty streams and grows as the
   /// caller appends measurements; steps come from AppendSteps. `streams` says which streams will
   /// arrive (contact gating, and the load factor runs when no force stream will).
@@ -201,7 +207,8 @@ class GraphBuilder {
   void AddPoseMeasurementFactors(ceres::Problem& problem, int i);   ///< M of both poses
   void AddConstantVelocityFactors(ceres::Problem& problem, int i);  ///< V on steps i-2, i-1, i
   void AddDynamicFactors(ceres::Problem& problem, int i);
-  void SetUpShapes();  ///< querier, quasi-static geometry, friction (both constructors)
+  /// Querier (the given one, else a new one), quasi-static geometry, friction (both constructors).
+  void SetUpShapes(std::shared_ptr<const geometry::ShapePairQuerier> querier);
 
   const push::Trajectory& traj_;
   Model model_;
@@ -252,8 +259,10 @@ struct FrameState {
 };
 /// The self-diagnosis of `result` (diagnostics.h), estimated on `trajectory` (the shape used)
 /// with `model` and `config`; `frame` when the shape frame was a variable.
+/// `querier`: the estimate's (GraphBuilder::MakeQuerier), shared; null: a new one.
 Diagnostics Diagnose(const push::Trajectory& trajectory, Model model, const EstimatorConfig& config,
-                     const EstimationResult& result, const FrameState* frame);
+                     const EstimationResult& result, const FrameState* frame,
+                     std::shared_ptr<const geometry::ShapePairQuerier> querier = nullptr);
 
 /// Refuses a trajectory the estimator cannot use (trajectory_checks.cpp; GraphError naming the
 /// stream, sample and value): missing shapes or streams, NaN, unsupported magnitudes, unsorted
