@@ -14,6 +14,7 @@
 // the uniform set are printed (the tables in docs/benchmarks.md).
 #include <pushgraph/geometry/distance_field.h>
 #include <pushgraph/geometry/point_query.h>
+#include <pushgraph/geometry/shape_pair.h>
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_2_algorithms.h>
@@ -329,6 +330,63 @@ void BM_DistanceFieldLookup(benchmark::State& state, int n) {
   state.SetItemsProcessed(state.iterations());
 }
 
+// --- Penetration depth of rounded fingers (issue 15): the exact depth (the grown obstacle's
+// boundary, rounded_boundary.h) against the "core depth + radius" bound, side by side, on
+// overlapping queries against the star polygon (narrow notches everywhere). A disk of 0.2 * kSize
+// radius, and a rounded box at one relative angle (its Minkowski obstacle and boundary cached). ---
+struct PairSet {
+  std::unique_ptr<pg::ShapePairQuerier> exact, bound;
+  std::vector<pg::Pose2> fingers;
+  int deeper = 0;  // queries whose exact depth exceeds the bound
+};
+
+const PairSet& GetPairSet(bool disk, int n) {
+  static std::map<std::pair<bool, int>, std::unique_ptr<PairSet>> sets;
+  auto& slot = sets[{disk, n}];
+  if (slot) return *slot;
+  slot = std::make_unique<PairSet>();
+  PairSet& p = *slot;
+  const pg::Shape& object = GetShape(Kind::kStar, n).shape;
+  const pg::Shape finger = disk ? pg::Shape::Disk(0.2 * kSize) : pg::Shape::Box(0.2 * kSize, 0.1 * kSize, 0.1 * kSize);
+  pg::ShapePairQuerier::Options bound_options;
+  bound_options.exact_rounded_depth = false;
+  p.exact = std::make_unique<pg::ShapePairQuerier>(object, finger);
+  p.bound = std::make_unique<pg::ShapePairQuerier>(object, finger, bound_options);
+  std::mt19937_64 rng(1515 + n);
+  const pg::Box2 box = object.bounds();
+  std::uniform_real_distribution<double> ux(box.min.x(), box.max.x()), uy(box.min.y(), box.max.y());
+  while (static_cast<int>(p.fingers.size()) < kNumQueries) {
+    const pg::Pose2 f{ux(rng), uy(rng), 0.4};
+    const pg::ShapePairResult e = p.exact->Query(pg::Pose2{}, f);  // builds the boundary once
+    if (!e.intersecting) continue;
+    p.deeper += e.depth > p.bound->Query(pg::Pose2{}, f).depth;
+    p.fingers.push_back(f);
+  }
+  return p;
+}
+
+void BM_PairDepth(benchmark::State& state, bool disk, bool exact, int n) {
+  const PairSet& p = GetPairSet(disk, n);
+  const pg::ShapePairQuerier& q = exact ? *p.exact : *p.bound;
+  size_t i = 0;
+  for (auto _ : state) benchmark::DoNotOptimize(q.Query(pg::Pose2{}, p.fingers[i++ & (kNumQueries - 1)]).depth);
+  state.SetItemsProcessed(state.iterations());
+  state.counters["deeper_than_bound"] = static_cast<double>(p.deeper) / kNumQueries;
+}
+
+// The one-off cost of the boundary: a new querier's first overlapping query (disk: the boundary of
+// the grown object; box: the Minkowski obstacle and, for the exact depth, its boundary).
+void BM_PairFirstQuery(benchmark::State& state, bool disk, bool exact, int n) {
+  const pg::Shape& object = GetShape(Kind::kStar, n).shape;
+  const pg::Shape finger = disk ? pg::Shape::Disk(0.2 * kSize) : pg::Shape::Box(0.2 * kSize, 0.1 * kSize, 0.1 * kSize);
+  pg::ShapePairQuerier::Options o;
+  o.exact_rounded_depth = exact;
+  for (auto _ : state) {
+    const pg::ShapePairQuerier q(object, finger, o);
+    benchmark::DoNotOptimize(q.Query(pg::Pose2{}, pg::Pose2{0.0, 0.0, 0.4}).depth);
+  }
+}
+
 void RegisterAll() {
   for (const int n : kSizes) {
     for (const char* set : kSets) {
@@ -344,6 +402,17 @@ void RegisterAll() {
     benchmark::RegisterBenchmark(("field_build_256" + tail).c_str(), BM_DistanceFieldBuild, n)
         ->Unit(benchmark::kMillisecond)
         ->Iterations(1);
+  }
+  for (const int n : {64, 1000, 10000}) {
+    for (const bool disk : {true, false}) {
+      const std::string tail = std::string(disk ? "/disk-overlap/" : "/rounded-box-overlap/") + std::to_string(n);
+      benchmark::RegisterBenchmark(("pair_exact_depth" + tail).c_str(), BM_PairDepth, disk, true, n);
+      benchmark::RegisterBenchmark(("pair_bound_depth" + tail).c_str(), BM_PairDepth, disk, false, n);
+      benchmark::RegisterBenchmark(("pair_first_query_exact" + tail).c_str(), BM_PairFirstQuery, disk, true, n)
+          ->Unit(benchmark::kMillisecond);
+      benchmark::RegisterBenchmark(("pair_first_query_bound" + tail).c_str(), BM_PairFirstQuery, disk, false, n)
+          ->Unit(benchmark::kMillisecond);
+    }
   }
 }
 
@@ -400,6 +469,15 @@ class TableReporter : public benchmark::ConsoleReporter {
                   Ns("field_lookup", "uniform", n), build * 1e-6, build / 65536.0,
                   build / 65536.0 / Ns("pushgraph", "uniform", n));
     }
+    std::printf("\n| vertices | finger | exact depth | core depth + radius | exact / bound | first query, exact | "
+                "first query, bound |\n|---:|---|---:|---:|---:|---:|---:|\n");
+    for (const int n : {64, 1000, 10000})
+      for (const char* set : {"disk-overlap", "rounded-box-overlap"}) {
+        const double e = Ns("pair_exact_depth", set, n), b = Ns("pair_bound_depth", set, n);
+        if (std::isnan(e)) continue;
+        std::printf("| %d | %s | %.0f ns | %.0f ns | %.2f | %.2f ms | %.2f ms |\n", n, set, e, b, e / b,
+                    Ns("pair_first_query_exact", set, n) * 1e-6, Ns("pair_first_query_bound", set, n) * 1e-6);
+      }
   }
 
  private:

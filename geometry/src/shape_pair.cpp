@@ -12,10 +12,12 @@
 #include <pushgraph/geometry/point_query.h>
 
 #include "minkowski_obstacle.h"
+#include "rounded_boundary.h"
 #include "shape_impl.h"
 
 #include <Eigen/LU>
 
+#include <algorithm>
 #include <cmath>
 #include <deque>
 #include <limits>
@@ -45,14 +47,16 @@ struct WitnessInputs {
   Mat23 J_m_obj = Mat23::Zero(), J_m_fin = Mat23::Zero();
   Mat23 J_n_obj = Mat23::Zero(), J_n_fin = Mat23::Zero();
   Row3 J_sd_obj = Row3::Zero(), J_sd_fin = Row3::Zero();
+  // The contact normal k at the touching point after the separating move, where it differs from
+  // the separating direction n (a concave corner of a rounded obstacle); otherwise k = n.
+  bool separate_contact_normal = false;
+  Vec2 k_w{0, 0};
+  Mat23 J_k_obj = Mat23::Zero(), J_k_fin = Mat23::Zero();
 };
 
 // Finger material point f: finger_point = f - rf n, object_point = f - (sd + rf) n.
 // Object material point o: object_point = o + ro n, finger_point = o + (sd + ro) n.
-void FillWitnesses(const WitnessInputs& in, double ro, double rf, ShapePairResult* r, ShapePairJacobians* J) {
-  r->signed_distance = in.sd;
-  r->normal = in.n_w;
-  r->depth = std::max(0.0, -in.sd);
+void FillWitnessesAlongNormal(const WitnessInputs& in, double ro, double rf, ShapePairResult* r, ShapePairJacobians* J) {
   if (in.on_finger) {
     r->finger_point = in.m_w - rf * in.n_w;
     r->object_point = in.m_w - (in.sd + rf) * in.n_w;
@@ -61,8 +65,6 @@ void FillWitnesses(const WitnessInputs& in, double ro, double rf, ShapePairResul
     r->finger_point = in.m_w + (in.sd + ro) * in.n_w;
   }
   if (!J) return;
-  J->J_sd_object_pose = in.J_sd_obj;
-  J->J_sd_finger_pose = in.J_sd_fin;
   if (in.on_finger) {
     J->J_finger_point_object_pose = in.J_m_obj - rf * in.J_n_obj;
     J->J_finger_point_finger_pose = in.J_m_fin - rf * in.J_n_fin;
@@ -74,6 +76,43 @@ void FillWitnesses(const WitnessInputs& in, double ro, double rf, ShapePairResul
     J->J_finger_point_object_pose = in.J_m_obj + in.n_w * in.J_sd_obj + (in.sd + ro) * in.J_n_obj;
     J->J_finger_point_finger_pose = in.J_m_fin + in.n_w * in.J_sd_fin + (in.sd + ro) * in.J_n_fin;
   }
+}
+
+// At a concave corner of a rounded obstacle the touching point's normal k is not n:
+// finger material: finger_point = f - rf k, object_point = finger_point - sd n;
+// object material: object_point = o + ro k, finger_point = object_point + sd n.
+void FillWitnessesAtCorner(const WitnessInputs& in, double ro, double rf, ShapePairResult* r, ShapePairJacobians* J) {
+  if (in.on_finger) {
+    r->finger_point = in.m_w - rf * in.k_w;
+    r->object_point = r->finger_point - in.sd * in.n_w;
+  } else {
+    r->object_point = in.m_w + ro * in.k_w;
+    r->finger_point = r->object_point + in.sd * in.n_w;
+  }
+  if (!J) return;
+  if (in.on_finger) {
+    J->J_finger_point_object_pose = in.J_m_obj - rf * in.J_k_obj;
+    J->J_finger_point_finger_pose = in.J_m_fin - rf * in.J_k_fin;
+    J->J_object_point_object_pose = J->J_finger_point_object_pose - in.n_w * in.J_sd_obj - in.sd * in.J_n_obj;
+    J->J_object_point_finger_pose = J->J_finger_point_finger_pose - in.n_w * in.J_sd_fin - in.sd * in.J_n_fin;
+  } else {
+    J->J_object_point_object_pose = in.J_m_obj + ro * in.J_k_obj;
+    J->J_object_point_finger_pose = in.J_m_fin + ro * in.J_k_fin;
+    J->J_finger_point_object_pose = J->J_object_point_object_pose + in.n_w * in.J_sd_obj + in.sd * in.J_n_obj;
+    J->J_finger_point_finger_pose = J->J_object_point_finger_pose + in.n_w * in.J_sd_fin + in.sd * in.J_n_fin;
+  }
+}
+
+void FillWitnesses(const WitnessInputs& in, double ro, double rf, ShapePairResult* r, ShapePairJacobians* J) {
+  r->signed_distance = in.sd;
+  r->normal = in.n_w;
+  r->depth = std::max(0.0, -in.sd);
+  if (J) {
+    J->J_sd_object_pose = in.J_sd_obj;
+    J->J_sd_finger_pose = in.J_sd_fin;
+  }
+  if (in.separate_contact_normal) FillWitnessesAtCorner(in, ro, rf, r, J);
+  else FillWitnessesAlongNormal(in, ro, rf, r, J);
 }
 
 // Finger vertex f (finger frame) against the object: a posed point query on the object.
@@ -117,6 +156,31 @@ void CheckPose(const Pose2& p, const char* which) {
     throw GeometryError(std::string(which) + " pose is not finite");
 }
 
+
+// How a feature of the obstacle's core moves with the relative angle phi, and which material
+// point generates it (Lozano-Perez's contact types; see QueryExact).
+struct FeatureMotion {
+  Vec2 n{0, 0}, dn{0, 0};  // a line n . x = h of C: normal, d n / d phi, d h / d phi
+  double dh = 0.0;
+  Vec2 dv{0, 0};           // a vertex of C: d v / d phi
+  bool finger_material = true;
+  Vec2 f{0, 0}, o{0, 0};   // finger vertex (finger frame) / object vertex (object frame)
+};
+
+// Rounding of a distance computed at the scale of the obstacle and the query point.
+double RoundingSlack(const Shape& C, const Vec2& c) {
+  const Box2 b = C.bounds();
+  const double scale = std::max({b.min.cwiseAbs().maxCoeff(), b.max.cwiseAbs().maxCoeff(), c.cwiseAbs().maxCoeff()});
+  return 64.0 * std::numeric_limits<double>::epsilon() * scale;
+}
+
+// "Core depth + radius" is the depth of a rounded obstacle except where the obstacle fills a
+// concave region: only rounded non-convex polygonal cores need the exact boundary.
+bool NeedsRoundedBoundary(const Shape& C) {
+  const Shape::Impl& k = C.impl();
+  return k.radius > 0.0 && !k.degenerate_core && !k.convex;
+}
+
 }  // namespace
 
 struct ShapePairQuerier::Impl {
@@ -126,10 +190,16 @@ struct ShapePairQuerier::Impl {
   Vec2 finger_centre{0, 0};
   Shape inflated_object;  // point fingers: the object with radius ro + rf
 
+  struct CachedObstacle {
+    Shape shape;
+    std::shared_ptr<const RoundedBoundary> boundary;  // built by the first overlapping query
+  };
   mutable std::mutex mutex;
-  mutable std::map<double, Shape> obstacles;  // relative angle -> C (object frame)
+  mutable std::map<double, CachedObstacle> obstacles;  // relative angle -> C (object frame)
   mutable std::deque<double> order;
   mutable int built = 0;
+  mutable std::once_flag inflated_boundary_once;
+  mutable std::unique_ptr<const RoundedBoundary> inflated_boundary;  // point fingers
 
   // The obstacle at relative angle phi, or at phi rounded to angle_cache_resolution: *used is
   // the angle it was built for (the touching pairs must be searched at that angle).
@@ -140,10 +210,10 @@ struct ShapePairQuerier::Impl {
     *used = key;
     std::lock_guard<std::mutex> lock(mutex);
     auto it = obstacles.find(key);
-    if (it != obstacles.end()) return it->second;
+    if (it != obstacles.end()) return it->second.shape;
     Shape c = MinkowskiSumOfCores(object, RotatedReflectedCore(finger, key), object.radius() + finger.radius());
     ++built;
-    obstacles.emplace(key, c);
+    obstacles.emplace(key, CachedObstacle{c, nullptr});
     order.push_back(key);
     while (static_cast<int>(order.size()) > std::max(1, options.max_cached_angles)) {
       obstacles.erase(order.front());
@@ -152,9 +222,35 @@ struct ShapePairQuerier::Impl {
     return c;
   }
 
+  // The rounded boundary of the obstacle cached under `key` (built once per angle, like C).
+  std::shared_ptr<const RoundedBoundary> BoundaryOf(double key, const Shape& C) const {
+    std::lock_guard<std::mutex> lock(mutex);
+    auto it = obstacles.find(key);
+    if (it == obstacles.end()) return std::make_shared<const RoundedBoundary>(C);  // evicted meanwhile
+    if (!it->second.boundary) it->second.boundary = std::make_shared<const RoundedBoundary>(C);
+    return it->second.boundary;
+  }
+
+  const RoundedBoundary& InflatedBoundary() const {
+    std::call_once(inflated_boundary_once, [this] { inflated_boundary = std::make_unique<const RoundedBoundary>(inflated_object); });
+    return *inflated_boundary;
+  }
+
   ShapePairResult QueryPointFinger(const Pose2& object_pose, const Pose2& finger_pose, ShapePairJacobians* J) const {
     bool inside = false;
     const WitnessInputs w = FingerVertexAgainstObject(inflated_object, object_pose, finger_pose, finger_centre, 0.0, &inside);
+    if (inside && options.exact_rounded_depth && NeedsRoundedBoundary(inflated_object)) {
+      // The centre in the object frame, c = Ro^T (m - t), with d c / d theta = (c_y, -c_x).
+      const Eigen::Matrix2d Ro = object_pose.rotation();
+      const Vec2 c = Ro.transpose() * (w.m_w - object_pose.translation());
+      const RoundedBoundaryPoint bp = InflatedBoundary().Nearest(c, -w.sd);
+      if (bp.distance > -w.sd + RoundingSlack(inflated_object, c)) {
+        Mat23 J_c_obj;
+        J_c_obj << -Ro.transpose(), Vec2(c.y(), -c.x());
+        const Mat23 J_c_fin = Ro.transpose() * w.J_m_fin;
+        return QueryRounded(inflated_object, bp, c, J_c_obj, J_c_fin, 0.0, Ro, object_pose, finger_pose, &w, J);
+      }
+    }
     // The inflated object already carries rf: its signed distance is the separation, and the
     // finger point lies rf behind the centre.
     ShapePairResult r;
@@ -163,27 +259,23 @@ struct ShapePairQuerier::Impl {
     return r;
   }
 
+  FeatureMotion MotionAt(const Vec2& c_contact, double phi, bool vertex, const Vec2& n_hint) const;
+  // `centre`: a point finger's centre (world) with its Jacobian, already at hand.
+  ShapePairResult QueryRounded(const Shape& C, const RoundedBoundaryPoint& bp, const Vec2& c, const Mat23& J_c_obj,
+                               const Mat23& J_c_fin, double phi, const Eigen::Matrix2d& Ro, const Pose2& object_pose,
+                               const Pose2& finger_pose, const WitnessInputs* centre, ShapePairJacobians* J) const;
   ShapePairResult QueryExact(const Pose2& object_pose, const Pose2& finger_pose, ShapePairJacobians* J) const;
   ShapePairResult QuerySampled(const Pose2& object_pose, const Pose2& finger_pose, ShapePairJacobians* J) const;
 };
 
-ShapePairResult ShapePairQuerier::Impl::QueryExact(const Pose2& object_pose, const Pose2& finger_pose,
-                                                   ShapePairJacobians* J) const {
+// The touching pairs at the contact configuration c_contact (finger origin, object frame, at
+// relative angle phi) generate a feature of C's core. Each is a line of C's boundary, n . x = h,
+// moving with phi (Lozano-Perez's type A: finger vertex on object edge, n fixed; type B: object
+// vertex on finger edge, n turns with phi), or a vertex-vertex pair, a C vertex o - R f.
+FeatureMotion ShapePairQuerier::Impl::MotionAt(const Vec2& c_contact, double phi, bool vertex,
+                                               const Vec2& n_hint) const {
   const double ro = object.radius(), rf = finger.radius();
-  Mat23 J_c_obj;
-  const Vec2 c = InverseAct(object_pose, finger_pose.translation(), &J_c_obj);
-  double phi = 0.0;  // the relative angle the obstacle was built for (rounded when cached)
-  const Shape C = Obstacle(finger_pose.theta - object_pose.theta, &phi);
-  const PointQuery qc = QueryPoint(C, c);
-  const Vec2 n_o = qc.normal;
-  const double sd = qc.signed_distance;
-  const Vec2 c_contact = qc.closest_point - C.radius() * n_o;  // finger origin at first contact (cores)
   const Eigen::Matrix2d R = Pose2{0.0, 0.0, phi}.rotation();
-
-  // The touching pairs at the contact configuration c_contact generate C's closest feature.
-  // Each is a line of C's boundary, n . x = h, moving with phi (Lozano-Perez's type A: finger
-  // vertex on object edge, n fixed; type B: object vertex on finger edge, n turns with phi),
-  // or a vertex-vertex pair, a C vertex o - R f.
   struct Pair {
     bool vertex_vertex = false, finger_material = true;
     Vec2 f{0, 0}, o{0, 0};  // finger vertex (finger frame) / object vertex (object frame)
@@ -226,27 +318,24 @@ ShapePairResult ShapePairQuerier::Impl::QueryExact(const Pose2& object_pose, con
   }
   if (pairs.empty()) throw GeometryError("internal: no touching pair found at the contact configuration");
 
-  // d sd / d c = n; d sd / d phi and the normal's derivatives from the generating pair(s).
-  double sd_phi = 0.0;
-  Eigen::Matrix2d Nc = Eigen::Matrix2d::Zero();
-  Vec2 Nphi = Vec2::Zero();
+  FeatureMotion m;
   const Pair* material = &pairs[0];
-  if (qc.feature.kind == BoundaryFeature::Kind::kEdge) {
+  if (!vertex) {
     const Pair* best = nullptr;
     for (const Pair& p : pairs)
-      if (!p.vertex_vertex && (!best || p.n.dot(n_o) > best->n.dot(n_o))) best = &p;
+      if (!p.vertex_vertex && (!best || p.n.dot(n_hint) > best->n.dot(n_hint))) best = &p;
     if (!best) best = &pairs[0];
     material = best;
-    sd_phi = best->dn.dot(c) - best->dh;
-    Nphi = best->dn;
+    m.n = best->n;
+    m.dn = best->dn;
+    m.dh = best->dh;
   } else {
     // A C vertex: either o - R f, or the crossing of two contact lines (two simultaneous contacts).
-    Vec2 dv = Vec2::Zero();
     const Pair* vv = nullptr;
     for (const Pair& p : pairs)
       if (p.vertex_vertex) vv = &p;
     if (vv) {
-      dv = -(dR * vv->f);
+      m.dv = -(dR * vv->f);
       material = vv;
     } else {
       const Pair* first = nullptr;
@@ -259,22 +348,57 @@ ShapePairResult ShapePairQuerier::Impl::QueryExact(const Pose2& object_pose, con
       Nm << first->n.transpose(), (second ? second->n : first->n).transpose();
       if (second && std::abs(Nm.determinant()) > 1e-12) {
         const Vec2 rhs(first->dh - first->dn.dot(c_contact), second->dh - second->dn.dot(c_contact));
-        dv = Nm.inverse() * rhs;
+        m.dv = Nm.inverse() * rhs;
       }
       material = first;
     }
+  }
+  m.finger_material = material->finger_material;
+  m.f = material->f;
+  m.o = material->o;
+  return m;
+}
+
+ShapePairResult ShapePairQuerier::Impl::QueryExact(const Pose2& object_pose, const Pose2& finger_pose,
+                                                   ShapePairJacobians* J) const {
+  const double ro = object.radius(), rf = finger.radius();
+  Mat23 J_c_obj;
+  const Vec2 c = InverseAct(object_pose, finger_pose.translation(), &J_c_obj);
+  double phi = 0.0;  // the relative angle the obstacle was built for (rounded when cached)
+  const Shape C = Obstacle(finger_pose.theta - object_pose.theta, &phi);
+  const PointQuery qc = QueryPoint(C, c);
+  const Eigen::Matrix2d Ro = object_pose.rotation();
+  if (qc.containment == Containment::kInside && options.exact_rounded_depth && NeedsRoundedBoundary(C)) {
+    const RoundedBoundaryPoint bp = BoundaryOf(phi, C)->Nearest(c, -qc.signed_distance);
+    if (bp.distance > -qc.signed_distance + RoundingSlack(C, c)) {
+      Mat23 J_c_fin = Mat23::Zero();
+      J_c_fin.block<2, 2>(0, 0) = Ro.transpose();
+      return QueryRounded(C, bp, c, J_c_obj, J_c_fin, phi, Ro, object_pose, finger_pose, nullptr, J);
+    }
+  }
+  const Vec2 n_o = qc.normal;
+  const double sd = qc.signed_distance;
+  const Vec2 c_contact = qc.closest_point - C.radius() * n_o;  // finger origin at first contact (cores)
+
+  // d sd / d c = n; d sd / d phi and the normal's derivatives from the generating pair(s).
+  const bool vertex = qc.feature.kind != BoundaryFeature::Kind::kEdge;
+  const FeatureMotion mo = MotionAt(c_contact, phi, vertex, n_o);
+  double sd_phi = 0.0;
+  Eigen::Matrix2d Nc = Eigen::Matrix2d::Zero();
+  Vec2 Nphi = Vec2::Zero();
+  if (!vertex) {
+    sd_phi = mo.dn.dot(c) - mo.dh;
+    Nphi = mo.dn;
+  } else {
     const double d = (c - c_contact).norm();
-    sd_phi = -n_o.dot(dv);
+    sd_phi = -n_o.dot(mo.dv);
     if (d > 0.0) {
       const double s = qc.signed_distance + C.radius() > 0.0 ? 1.0 : -1.0;
       const Eigen::Matrix2d P = Eigen::Matrix2d::Identity() - n_o * n_o.transpose();
       Nc = s * P / d;
-      Nphi = -s * P * dv / d;
+      Nphi = -s * P * mo.dv / d;
     }
   }
-  const bool finger_material = material->finger_material;
-  const Vec2 f_l = material->f, o_l = material->o;
-  const Eigen::Matrix2d Ro = object_pose.rotation();
   WitnessInputs w;
   w.sd = sd;
   w.n_w = Ro * n_o;
@@ -285,15 +409,153 @@ ShapePairResult ShapePairQuerier::Impl::QueryExact(const Pose2& object_pose, con
   w.J_n_obj.col(2) += -Ro * Nphi + RotationDerivative(object_pose.theta) * n_o;
   w.J_n_fin.block<2, 2>(0, 0) = Ro * Nc * Ro.transpose();
   w.J_n_fin.col(2) = Ro * Nphi;
-  w.on_finger = finger_material;
-  if (finger_material) {
-    w.m_w = Act(finger_pose, f_l, &w.J_m_fin);
+  w.on_finger = mo.finger_material;
+  if (mo.finger_material) {
+    w.m_w = Act(finger_pose, mo.f, &w.J_m_fin);
   } else {
-    w.m_w = Act(object_pose, o_l, &w.J_m_obj);
+    w.m_w = Act(object_pose, mo.o, &w.J_m_obj);
   }
   ShapePairResult r;
   FillWitnesses(w, ro, rf, &r, J);
   r.intersecting = qc.containment == Containment::kInside;
+  return r;
+}
+
+// The exact depth of a rounded obstacle, from the nearest point p of its boundary (rounded_boundary.h):
+// on the offset of one core feature (an edge's segment: sd = n . c - h - R; a vertex's arc:
+// sd = |c - v| - R), or at a concave corner where the offsets of two features cross. There
+// sd = -|p - c| and n = (p - c) / |p - c|, with p(phi) moving as both features do: differentiating
+// their equations (line: n_i . p = h_i + R; arc: |p - v_j|^2 = R^2) gives a 2x2 system for
+// d p / d phi. The contact normal k (the touching point's normal after the move) is the first
+// feature's. For a point finger nothing moves with phi (C is the object).
+ShapePairResult ShapePairQuerier::Impl::QueryRounded(const Shape& C, const RoundedBoundaryPoint& bp, const Vec2& c,
+                                                     const Mat23& J_c_obj, const Mat23& J_c_fin, double phi,
+                                                     const Eigen::Matrix2d& Ro, const Pose2& object_pose,
+                                                     const Pose2& finger_pose, const WitnessInputs* centre,
+                                                     ShapePairJacobians* J) const {
+  const Shape::Impl& K = C.impl();
+  const double R = K.radius;
+  struct Feature {
+    bool vertex = false;
+    Vec2 v{0, 0}, n{0, 0};
+    FeatureMotion motion;
+  };
+  auto feature_of = [&](const CoreFeatureRef& ref) {
+    Feature f;
+    f.vertex = ref.is_vertex;
+    Vec2 contact, hint;
+    if (ref.is_vertex) {
+      f.v = K.vertices[ref.index];
+      contact = f.v;
+      hint = (bp.point - f.v) / R;
+    } else {
+      const Vec2 d = K.vertices[K.next[ref.index]] - K.vertices[ref.index];
+      f.n = Vec2(d.y(), -d.x()).normalized();
+      contact = bp.point - R * f.n;
+      hint = f.n;
+    }
+    if (point_finger) {
+      f.motion.f = finger_centre;  // the disk's centre touches; nothing turns with phi
+    } else {
+      f.motion = MotionAt(contact, phi, f.vertex, hint);
+    }
+    return f;
+  };
+  Feature a = feature_of(bp.feature);
+  const double L = bp.distance;
+  const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
+  Vec2 n = Vec2::Zero(), Nphi = Vec2::Zero(), k = Vec2::Zero(), Kphi = Vec2::Zero();
+  Eigen::Matrix2d Nc = Eigen::Matrix2d::Zero();
+  double sd_phi = 0.0;
+  bool corner = false;
+  if (bp.corner) {
+    Feature b = feature_of(bp.other);
+    const Vec2& p = bp.point;
+    // The witnesses follow one of the corner's two contacts, chosen by the features' numbers so
+    // that the choice depends neither on which piece the search met first nor on the side of the
+    // bisector c is on (a finger wedged in a symmetric V sits on it: any rule by direction
+    // would flip the witnesses from wall to wall with every tiny motion).
+    if (std::make_pair(bp.other.index, bp.other.is_vertex) < std::make_pair(bp.feature.index, bp.feature.is_vertex))
+      std::swap(a, b);
+    Eigen::Matrix2d A;
+    Vec2 rhs;
+    auto equation = [&](const Feature& f, int row) {
+      if (f.vertex) {
+        A.row(row) = (p - f.v).transpose();
+        rhs(row) = (p - f.v).dot(f.motion.dv);
+      } else {
+        A.row(row) = f.n.transpose();
+        rhs(row) = f.motion.dh - f.motion.dn.dot(p);
+      }
+    };
+    equation(a, 0);
+    equation(b, 1);
+    // A corner whose two curves are nearly tangent is smooth to first order: treat it as one piece.
+    if (std::abs(A.determinant()) > 1e-6 * A.row(0).norm() * A.row(1).norm()) {
+      corner = true;
+      const Vec2 dp = A.partialPivLu().solve(rhs);
+      n = (p - c) / L;
+      const Eigen::Matrix2d P = I - n * n.transpose();
+      sd_phi = -n.dot(dp);
+      Nc = -P / L;
+      Nphi = P * dp / L;
+      if (a.vertex) {
+        k = (p - a.v) / R;
+        Kphi = (dp - a.motion.dv) / R;
+      } else {
+        k = a.n;
+        Kphi = a.motion.dn;
+      }
+    }
+  }
+  if (!corner) {
+    if (!a.vertex) {
+      n = a.n;
+      sd_phi = a.motion.dn.dot(c) - a.motion.dh;
+      Nphi = a.motion.dn;
+    } else {
+      const Vec2 w = c - a.v;
+      const double d = w.norm();
+      n = d > 0.0 ? Vec2(w / d) : Vec2((bp.point - a.v) / R);
+      sd_phi = -n.dot(a.motion.dv);
+      if (d > 0.0) {
+        const Eigen::Matrix2d P = I - n * n.transpose();
+        Nc = P / d;
+        Nphi = -P * a.motion.dv / d;
+      }
+    }
+  }
+  Eigen::Matrix2d dRo;  // d Ro / d theta from Ro's entries (no second sincos)
+  dRo << -Ro(1, 0), -Ro(0, 0), Ro(0, 0), -Ro(1, 0);
+  WitnessInputs w;
+  w.sd = -L;
+  w.n_w = Ro * n;
+  w.J_sd_obj = n.transpose() * J_c_obj;
+  w.J_sd_obj(2) -= sd_phi;
+  w.J_sd_fin = n.transpose() * J_c_fin;
+  w.J_sd_fin(2) += sd_phi;
+  w.J_n_obj = Ro * Nc * J_c_obj;
+  w.J_n_obj.col(2) += -Ro * Nphi + dRo * n;
+  w.J_n_fin = Ro * Nc * J_c_fin;
+  w.J_n_fin.col(2) += Ro * Nphi;
+  if (corner) {
+    w.separate_contact_normal = true;
+    w.k_w = Ro * k;
+    w.J_k_obj.col(2) = -Ro * Kphi + dRo * k;
+    w.J_k_fin.col(2) = Ro * Kphi;
+  }
+  w.on_finger = a.motion.finger_material;
+  if (centre) {
+    w.m_w = centre->m_w;
+    w.J_m_fin = centre->J_m_fin;
+  } else if (a.motion.finger_material) {
+    w.m_w = Act(finger_pose, a.motion.f, &w.J_m_fin);
+  } else {
+    w.m_w = Act(object_pose, a.motion.o, &w.J_m_obj);
+  }
+  ShapePairResult r;
+  FillWitnesses(w, object.radius(), finger.radius(), &r, J);
+  r.intersecting = true;
   return r;
 }
 

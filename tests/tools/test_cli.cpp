@@ -109,14 +109,15 @@ TEST_F(CliTest, PenetrationJsonContractAndNegativeNumberOptions) {
     EXPECT_NEAR(j["object_point"][0].get<double>(), 0.0, 1e-15);    // its projection
     EXPECT_TRUE(j["depth_exact"].get<bool>());                       // it leaves along -x
   }
-  // Centred 0.05 below the 0.2-wide hole, the 0.2-radius disk cannot leave into it: the
-  // reported depth (0.25) is a lower bound, and the output says so.
+  // Centred 0.05 below the 0.2-wide hole, the 0.2-radius disk cannot leave into it ("core depth +
+  // radius" would say 0.25, towards the hole): it leaves through the bottom edge, 0.55 down.
   const std::string big = Write("big.json", R"({"polygons":[{"outer":[[0,0]]}],"radius":0.2})");
   const ToolRun hole = Exec("penetration " + object + " " + big + " --finger-pose 0.5,0.35,0");
   ASSERT_EQ(hole.status, 0) << hole.err;
   const auto h = nlohmann::json::parse(hole.out);
-  EXPECT_NEAR(h["depth"].get<double>(), 0.25, 1e-15);
-  EXPECT_FALSE(h["depth_exact"].get<bool>());
+  EXPECT_NEAR(h["depth"].get<double>(), 0.55, 1e-15);
+  EXPECT_EQ(h["direction"][1].get<double>(), -1.0);
+  EXPECT_TRUE(h["depth_exact"].get<bool>());
   const ToolRun apart = Exec("penetration " + object + " " + finger + " --object-pose 0,0,0 --finger-pose -0.3,0.5,0");
   ASSERT_EQ(apart.status, 0) << apart.err;
   const auto j = nlohmann::json::parse(apart.out);

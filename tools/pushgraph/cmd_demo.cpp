@@ -70,6 +70,9 @@ void RunGeometryDemo(const std::string& data_dir, const std::string& svg_path) {
   const geometry::Shape square = geometry::LoadShapeJson(data_dir + "/shapes/rounded_square_finger.json");
   const geometry::Pose2 object_pose{0.0, 0.0, 0.0};
   const geometry::ShapePairQuerier disk_pair(object, disk), square_pair(object, square);
+  geometry::ShapePairQuerier::Options core_depth;  // "core depth + radii", for the `*` marks
+  core_depth.exact_rounded_depth = false;
+  const geometry::ShapePairQuerier disk_bound(object, disk, core_depth), square_bound(object, square, core_depth);
 
   std::printf("pushgraph demo: fingers sweeping down through the V-notch of a block with two holes\n");
   std::printf("object: %d vertices, area %.6g m^2 (data/shapes/notched_block.json)\n\n", object.num_vertices(),
@@ -85,6 +88,8 @@ void RunGeometryDemo(const std::string& data_dir, const std::string& svg_path) {
     const geometry::Pose2 finger_pose{0.0, y, 0.3};
     const geometry::ShapePairResult a = disk_pair.Query(object_pose, finger_pose);
     const geometry::ShapePairResult b = square_pair.Query(object_pose, finger_pose);
+    const bool a_deeper = a.depth > disk_bound.Query(object_pose, finger_pose).depth + 1e-12;
+    const bool b_deeper = b.depth > square_bound.Query(object_pose, finger_pose).depth + 1e-12;
     auto dir = [](const geometry::ShapePairResult& r) {
       char buf[32];
       if (r.intersecting) std::snprintf(buf, sizeof buf, "(%+.2f,%+.2f)", r.normal.x(), r.normal.y());
@@ -92,7 +97,7 @@ void RunGeometryDemo(const std::string& data_dir, const std::string& svg_path) {
       return std::string(buf);
     };
     std::printf("%9.1f | %+12.6f %8.5f%s %10s | %+12.6f %8.5f%s %10s\n", y * 1e3, a.signed_distance, a.depth,
-                a.depth_exact ? " " : "*", dir(a).c_str(), b.signed_distance, b.depth, b.depth_exact ? " " : "*",
+                a_deeper ? "*" : " ", dir(a).c_str(), b.signed_distance, b.depth, b_deeper ? "*" : " ",
                 dir(b).c_str());
     char buf[256];
     std::snprintf(buf, sizeof buf,
@@ -104,8 +109,8 @@ void RunGeometryDemo(const std::string& data_dir, const std::string& svg_path) {
                   (origin.y() - a.object_point.y()) * scale);
     markers += buf;
   }
-  std::printf("* depth is a lower bound: the rounded finger's obstacle fills the V there, and moving by it\n"
-              "  still overlaps (ShapePairResult::depth_exact; docs/geometry.md)\n");
+  std::printf("* deeper than core depth + radius: the rounded finger's obstacle fills the V there, and the exact\n"
+              "  depth leaves through the corner where the two walls' offsets cross (docs/geometry.md)\n");
 
   // Accelerated queries agree bit for bit with the brute-force edge loop.
   std::mt19937 rng(7);

@@ -23,9 +23,9 @@ void RegisterPenetration(CLI::App& app) {
   cmd->footer(
       "Prints JSON: signed_distance (> 0 apart, -depth when overlapping), intersecting, object_point and\n"
       "finger_point (world frame; when overlapping, the projection G_delta and the deepest finger point delta),\n"
-      "depth (>= 0), depth_exact when overlapping (false: depth is a lower bound, for rounded shapes in a\n"
-      "concave corner, notch or hole, or --fast) and direction (unit vector the finger moves along to\n"
-      "separate; null when apart).");
+      "depth (>= 0; exact, rounded fingers in concave corners, notches and holes included), depth_exact\n"
+      "when overlapping (false only with --fast, an estimate) and direction (unit vector the finger moves\n"
+      "along to separate; null when apart).");
   cmd->callback([args] {
     const geometry::Shape object = geometry::LoadShapeJson(args->object_path);
     const geometry::Shape finger = geometry::LoadShapeJson(args->finger_path);
@@ -41,7 +41,7 @@ void RegisterPenetration(CLI::App& app) {
     out["object_point"] = {r.object_point.x(), r.object_point.y()};
     out["finger_point"] = {r.finger_point.x(), r.finger_point.y()};
     out["depth"] = r.depth;
-    // false: a lower bound (rounded shapes in a concave corner, notch or hole; --fast estimates).
+    // false only for --fast (an estimate); rounded fingers' depths are exact (docs/geometry.md).
     if (r.intersecting) out["depth_exact"] = r.depth_exact;
     out["direction"] = r.intersecting ? nlohmann::json{r.normal.x(), r.normal.y()} : nlohmann::json(nullptr);
     std::cout << DumpJson(out) << "\n";

@@ -12,13 +12,15 @@
 // C = object_core (+) (-finger_core) at the current relative angle, built exactly with CGAL
 // (Epeck Minkowski sums, reduced convolution; cached per relative angle) and queried with the
 // exact point query. For a finger whose core is a point (a disk) C is the object itself and no
-// Minkowski sum is needed. Rounding radii (a disk finger's, a rounded object's) add to the core
-// depth (the rounded-shape convention of point_query.h). That sum is the true depth when the
-// finger can leave along the core's normal, but only a lower bound where the rounded obstacle
-// fills a concave corner, a notch or a hole narrower than the finger (moving by it still
-// overlaps): each overlapping rounded query checks its own answer by moving the finger and
-// reports the outcome in depth_exact (Options::check_rounded_depth). Separations of apart
-// shapes are always exact.
+// Minkowski sum is needed. With rounding radii (a disk finger's, a rounded object's) the obstacle
+// is C grown by a disk of their sum, and the depth is the distance to that grown obstacle's
+// boundary: its offset segments and arcs, split where they cross in concave corners, notches and
+// holes narrower than the finger (rounded_boundary.h; built once per relative angle, or once for
+// a disk finger, on the first overlapping query). Where the finger can leave along the core's
+// normal this equals "core depth + radii"; where the grown obstacle fills a concave region the
+// depth is larger and the witness points sit at the corner where two offsets cross. Depths are
+// within a few ulps of the coordinates' scale of an independent extended-precision oracle
+// (tests/geometry/test_rounded_depth.cpp); separations of apart shapes are exact.
 //
 // The fast path (Method::kVertexSampling) takes the deepest vertex of either shape inside the
 // other; it is exact when apart and for point/disk fingers, and an estimate for polygonal
@@ -42,10 +44,10 @@ struct ShapePairResult {
   Vec2 object_point{0.0, 0.0};   ///< world frame: closest object point / projection G_delta
   Vec2 finger_point{0.0, 0.0};   ///< world frame: closest finger point / deepest point delta
   double depth = 0.0;            ///< max(0, -signed_distance)
-  /// False when `depth` is only a lower bound of the penetration depth: rounded shapes whose
-  /// obstacle fills a concave corner, notch or hole (moving the finger by depth along normal
-  /// leaves it overlapping; checked only with Options::check_rounded_depth), or the
-  /// vertex-sampling estimate of a polygonal finger.
+  /// False when `depth` is not the penetration depth: the vertex-sampling estimate of a
+  /// polygonal finger, or (with Options::exact_rounded_depth off) the "core depth + radii" lower
+  /// bound of a rounded pair where moving the finger by it leaves the shapes overlapping (checked
+  /// with Options::check_rounded_depth).
   bool depth_exact = true;
   /// Unit vector, world frame, in which the finger moves to increase the separation fastest
   /// (to separate, when intersecting); object_point - finger_point = -signed_distance * normal.
@@ -74,9 +76,14 @@ class ShapePairQuerier {
     /// fingers; 0 caches exact angles only (bit-identical angles share an obstacle).
     double angle_cache_resolution = 0.0;
     int max_cached_angles = 256;
-    /// Check an overlapping rounded query's depth by a second query (ShapePairResult::
-    /// depth_exact); off, depth_exact is left true and the query costs one point query less.
-    bool check_rounded_depth = true;
+    /// Rounded shapes: the exact depth from the grown obstacle's boundary (header). Off: "core
+    /// depth + radii", a lower bound where the grown obstacle fills a concave region (kept for
+    /// comparison and benchmarks).
+    bool exact_rounded_depth = true;
+    /// Check every overlapping rounded query by moving the finger by its depth and querying
+    /// again (ShapePairResult::depth_exact); a self-test for the exact depth, which never fails
+    /// it, and the way to see where the bound falls short with exact_rounded_depth off.
+    bool check_rounded_depth = false;
   };
 
   ShapePairQuerier(Shape object, Shape finger);
