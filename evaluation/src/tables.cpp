@@ -156,10 +156,11 @@ std::vector<Table> MakeTables(std::vector<EvaluationRow> rows, const std::string
     t.columns = {"object", "trajectories", "method", "mode", "position (mm)", "rotation (rad)", "samples"};
     for (const auto& [g, s] : groups) {
       const Agg a{&s};
+      const std::string& group = g;  // a lambda may not capture a structured binding before C++20
       auto add = [&](const std::string& prefix, const std::string& method, const std::string& mode) {
         const std::string p = prefix + "/object_position", r = prefix + "/object_rotation";
         if (!a.Has(p)) return;
-        t.rows.push_back({g, count(g), method, mode, Fmt(1e3 * a.Mean(p)) + " +- " + Fmt(1e3 * a.Std(p)),
+        t.rows.push_back({group, count(group), method, mode, Fmt(1e3 * a.Mean(p)) + " +- " + Fmt(1e3 * a.Std(p)),
                           Fmt(a.Mean(r)) + " +- " + Fmt(a.Std(r)), Fmt(a.N(p), 10)});
       };
       add("gauss.raw", "raw", "-");

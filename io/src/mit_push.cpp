@@ -75,6 +75,30 @@ Raw ReadH5(const std::string& path) {
                       std::to_string(dims[1]));
       if (ds.getTypeClass() != H5T_FLOAT && ds.getTypeClass() != H5T_INTEGER)
         throw IoError(path + ": dataset '" + kDatasets[k] + "' is not numeric");
+      // A header that claims more rows than the file can hold (corrupt, or a fuzzer's) must not
+      // become a huge allocation: even compressed, 8-byte values rarely shrink 64-fold.
+      std::error_code size_ec;
+      const double file_bytes = static_cast<double>(std::filesystem::file_size(path, size_ec));
+      const double claimed_bytes = static_cast<double>(dims[0]) * 4.0 * sizeof(double);
+      if (!size_ec && claimed_bytes > 64.0 * file_bytes + 4096.0)
+        throw IoError(path + ": dataset '" + kDatasets[k] + "' claims " + std::to_string(dims[0]) +
+                      " rows, more than the file's " + std::to_string(static_cast<long long>(file_bytes)) +
+                      " bytes can hold (corrupt HDF5)");
+      // The same for what the read itself allocates: the element size, and a chunk's size for
+      // chunked storage (a 28 KB file claiming a huge chunk made the HDF5 read take 4 GB).
+      const size_t element_bytes = ds.getDataType().getSize();
+      if (element_bytes == 0 || element_bytes > 16)
+        throw IoError(path + ": dataset '" + kDatasets[k] + "' has " + std::to_string(element_bytes) +
+                      "-byte elements (corrupt HDF5; expected numbers of at most 16 bytes)");
+      const H5::DSetCreatPropList layout = ds.getCreatePlist();
+      if (layout.getLayout() == H5D_CHUNKED) {
+        hsize_t chunk[2] = {0, 0};
+        if (layout.getChunk(2, chunk) != 2 || static_cast<double>(chunk[0]) * static_cast<double>(chunk[1]) *
+                                                      static_cast<double>(element_bytes) > 64.0 * file_bytes + 4096.0)
+          throw IoError(path + ": dataset '" + kDatasets[k] + "' has chunks of " + std::to_string(chunk[0]) + " x " +
+                        std::to_string(chunk[1]) + ", more than the file's " +
+                        std::to_string(static_cast<long long>(file_bytes)) + " bytes can hold (corrupt HDF5)");
+      }
       std::vector<Row>& rows = Slot(raw, k);
       rows.resize(dims[0]);
       if (dims[0] > 0) ds.read(rows.data(), H5::PredType::NATIVE_DOUBLE);

@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -188,6 +189,39 @@ TEST_F(MitPush, BrokenFilesGetClearErrors) {
     std::ofstream(cut, std::ios::binary) << bytes.substr(0, bytes.size() / 2);
   }
   expect_error(cut, "truncated: the file has");
+  // Found by fuzz_mit_hdf5: a header whose dataspace claims 2^40 rows made the reader allocate
+  // 35 TB (it now compares the claim with the file's size first).
+  const std::string huge = (dir_ / "huge_claim.h5").string();
+  {
+    std::ifstream in(whole, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const uint64_t rows = sets[1].second.size(), columns = 4, claim = uint64_t{1} << 40;
+    std::string pattern(16, '\0');
+    std::memcpy(&pattern[0], &rows, 8);  // the dataspace's dimensions, little-endian (x86-64)
+    std::memcpy(&pattern[8], &columns, 8);
+    int patched = 0;
+    for (std::size_t at = bytes.find(pattern); at != std::string::npos; at = bytes.find(pattern, at + 16), ++patched)
+      std::memcpy(&bytes[at], &claim, 8);
+    ASSERT_GT(patched, 0);
+    std::ofstream(huge, std::ios::binary) << bytes;
+  }
+  expect_error(huge, "claims 1099511627776 rows, more than the file's");
+  // Found by fuzz_mit_hdf5: a datatype claiming 4294967287-byte elements made the HDF5 read take
+  // 4.2 GB and 19 s before failing. The element size is checked first.
+  const std::string wide = (dir_ / "wide_elements.h5").string();
+  {
+    std::ifstream in(whole, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    // An IEEE little-endian double's datatype message after its class and bit fields: size 8,
+    // bit offset 0, precision 64, exponent at 52 (11 bits), mantissa at 0 (52 bits), bias 1023.
+    const std::string f64("\x08\x00\x00\x00\x00\x00\x40\x00\x34\x0b\x00\x34\xff\x03\x00\x00", 16);
+    int patched = 0;
+    for (std::size_t at = bytes.find(f64); at != std::string::npos; at = bytes.find(f64, at + 16), ++patched)
+      bytes.replace(at, 4, std::string("\xf7\xff\xff\xff", 4));
+    ASSERT_GT(patched, 0);
+    std::ofstream(wide, std::ios::binary) << bytes;
+  }
+  expect_error(wide, "4294967287-byte elements (corrupt HDF5");
 }
 
 }  // namespace

@@ -1,5 +1,7 @@
 #include "cli_common.h"
 
+#include <pushgraph/io/errors.h>
+#include <pushgraph/io/points_csv.h>
 #include <pushgraph/limit_surface/support.h>
 
 #include <algorithm>
@@ -29,55 +31,12 @@ std::string DefaultDataDir() {
 #endif
 }
 
-namespace {
-
-// std::from_chars (correctly rounded, no locale, no allocation) after the leading blanks and
-// '+' that std::stod accepts; false where it does not parse the whole item (std::stod then
-// decides, so hexadecimal input keeps working).
-bool ParseFast(const std::string& item, double* value) {
-  const char* begin = item.data();
-  const char* end = begin + item.size();
-  while (begin < end && std::isspace(static_cast<unsigned char>(*begin))) ++begin;
-  if (begin < end && *begin == '+') {
-    ++begin;
-    if (begin < end && (*begin == '-' || *begin == '+')) return false;  // "+-1" is not a number
-  }
-  if (begin == end || std::isspace(static_cast<unsigned char>(*begin))) return false;
-  const auto [ptr, ec] = std::from_chars(begin, end, *value);
-  return ec == std::errc() && ptr == end;
-}
-
-}  // namespace
-
 std::vector<double> ParseNumbers(const std::string& text, std::size_t count, const std::string& what) {
-  std::vector<double> values;
-  // Split on commas as std::getline would (no item after a trailing comma; none for "").
-  for (std::size_t start = 0; start < text.size();) {
-    const std::size_t comma = std::min(text.find(',', start), text.size());
-    const std::string item = text.substr(start, comma - start);
-    start = comma + 1;
-    std::size_t used = item.size();
-    double value = 0.0;
-    if (!ParseFast(item, &value)) {
-      try {
-        value = std::stod(item, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-    }
-    if (used == 0 || used != item.size()) {
-      throw CliError(what + ": '" + item + "' is not a number (expected " + std::to_string(count) +
-                     " comma-separated numbers, got '" + text + "')");
-    }
-    if (!std::isfinite(value)) throw CliError(what + ": '" + item + "' is not finite");
-    values.push_back(value);
+  try {
+    return io::ParseNumberList(text, count, what);
+  } catch (const io::IoError& e) {
+    throw CliError(e.what());  // a flag's value: exit status 2, like every usage error
   }
-  if (!text.empty() && text.back() == ',') values.push_back(NAN);  // forces the count error below
-  if (values.size() != count) {
-    throw CliError(what + ": expected " + std::to_string(count) + " comma-separated numbers, got '" +
-                   text + "'");
-  }
-  return values;
 }
 
 geometry::Pose2 ParsePose(const std::string& text, const std::string& what) {
