@@ -14,6 +14,17 @@ SHARED_DIR=${SHARED_DIR:-../shared}
 BUILD=${FUZZ_BUILD_DIR:-build-fuzz}
 OUT=${FUZZ_OUT:-out/fuzz}
 bash scripts/install-deps.sh > /dev/null
+# clang with its libFuzzer and sanitizer runtimes (Debian 12: clang 14), when missing.
+missing=()
+for p in clang libclang-rt-14-dev llvm-14; do
+  dpkg-query -W -f='${Status}' "$p" 2> /dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  sudo_cmd=()
+  [ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
+  "${sudo_cmd[@]}" apt-get update -qq
+  "${sudo_cmd[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" > /dev/null
+fi
 targets=("$@")
 [ ${#targets[@]} -gt 0 ] || targets=(fuzz_shape_json fuzz_trajectory_json fuzz_points_csv fuzz_obj_footprint
                                      fuzz_mit_hdf5 fuzz_mit_json fuzz_estimator_config fuzz_evaluation_config)
