@@ -13,6 +13,7 @@
 
 #include "minkowski_obstacle.h"
 #include "rounded_boundary.h"
+#include "shape_pair_witness.h"
 #include "shape_impl.h"
 
 #include <Eigen/LU>
@@ -27,93 +28,7 @@
 namespace pushgraph::geometry {
 namespace {
 
-using Mat23 = Eigen::Matrix<double, 2, 3>;
-using Row3 = Eigen::Matrix<double, 1, 3>;
-
-Eigen::Matrix2d RotationDerivative(double theta) {
-  Eigen::Matrix2d dR;
-  dR << -std::sin(theta), -std::cos(theta), std::cos(theta), -std::sin(theta);
-  return dR;
-}
-
-Vec2 Perp(const Vec2& v) { return {-v.y(), v.x()}; }
-
-// Witness points from a material point `m_w` (world) on the finger (finger_side) or on the
-// object, the separating normal and the separation; with the Jacobians of each input.
-struct WitnessInputs {
-  bool on_finger = true;
-  Vec2 m_w, n_w;
-  double sd = 0.0;
-  Mat23 J_m_obj = Mat23::Zero(), J_m_fin = Mat23::Zero();
-  Mat23 J_n_obj = Mat23::Zero(), J_n_fin = Mat23::Zero();
-  Row3 J_sd_obj = Row3::Zero(), J_sd_fin = Row3::Zero();
-  // The contact normal k at the touching point after the separating move, where it differs from
-  // the separating direction n (a concave corner of a rounded obstacle); otherwise k = n.
-  bool separate_contact_normal = false;
-  Vec2 k_w{0, 0};
-  Mat23 J_k_obj = Mat23::Zero(), J_k_fin = Mat23::Zero();
-};
-
-// Finger material point f: finger_point = f - rf n, object_point = f - (sd + rf) n.
-// Object material point o: object_point = o + ro n, finger_point = o + (sd + ro) n.
-void FillWitnessesAlongNormal(const WitnessInputs& in, double ro, double rf, ShapePairResult* r, ShapePairJacobians* J) {
-  if (in.on_finger) {
-    r->finger_point = in.m_w - rf * in.n_w;
-    r->object_point = in.m_w - (in.sd + rf) * in.n_w;
-  } else {
-    r->object_point = in.m_w + ro * in.n_w;
-    r->finger_point = in.m_w + (in.sd + ro) * in.n_w;
-  }
-  if (!J) return;
-  if (in.on_finger) {
-    J->J_finger_point_object_pose = in.J_m_obj - rf * in.J_n_obj;
-    J->J_finger_point_finger_pose = in.J_m_fin - rf * in.J_n_fin;
-    J->J_object_point_object_pose = in.J_m_obj - in.n_w * in.J_sd_obj - (in.sd + rf) * in.J_n_obj;
-    J->J_object_point_finger_pose = in.J_m_fin - in.n_w * in.J_sd_fin - (in.sd + rf) * in.J_n_fin;
-  } else {
-    J->J_object_point_object_pose = in.J_m_obj + ro * in.J_n_obj;
-    J->J_object_point_finger_pose = in.J_m_fin + ro * in.J_n_fin;
-    J->J_finger_point_object_pose = in.J_m_obj + in.n_w * in.J_sd_obj + (in.sd + ro) * in.J_n_obj;
-    J->J_finger_point_finger_pose = in.J_m_fin + in.n_w * in.J_sd_fin + (in.sd + ro) * in.J_n_fin;
-  }
-}
-
-// At a concave corner of a rounded obstacle the touching point's normal k is not n:
-// finger material: finger_point = f - rf k, object_point = finger_point - sd n;
-// object material: object_point = o + ro k, finger_point = object_point + sd n.
-void FillWitnessesAtCorner(const WitnessInputs& in, double ro, double rf, ShapePairResult* r, ShapePairJacobians* J) {
-  if (in.on_finger) {
-    r->finger_point = in.m_w - rf * in.k_w;
-    r->object_point = r->finger_point - in.sd * in.n_w;
-  } else {
-    r->object_point = in.m_w + ro * in.k_w;
-    r->finger_point = r->object_point + in.sd * in.n_w;
-  }
-  if (!J) return;
-  if (in.on_finger) {
-    J->J_finger_point_object_pose = in.J_m_obj - rf * in.J_k_obj;
-    J->J_finger_point_finger_pose = in.J_m_fin - rf * in.J_k_fin;
-    J->J_object_point_object_pose = J->J_finger_point_object_pose - in.n_w * in.J_sd_obj - in.sd * in.J_n_obj;
-    J->J_object_point_finger_pose = J->J_finger_point_finger_pose - in.n_w * in.J_sd_fin - in.sd * in.J_n_fin;
-  } else {
-    J->J_object_point_object_pose = in.J_m_obj + ro * in.J_k_obj;
-    J->J_object_point_finger_pose = in.J_m_fin + ro * in.J_k_fin;
-    J->J_finger_point_object_pose = J->J_object_point_object_pose + in.n_w * in.J_sd_obj + in.sd * in.J_n_obj;
-    J->J_finger_point_finger_pose = J->J_object_point_finger_pose + in.n_w * in.J_sd_fin + in.sd * in.J_n_fin;
-  }
-}
-
-void FillWitnesses(const WitnessInputs& in, double ro, double rf, ShapePairResult* r, ShapePairJacobians* J) {
-  r->signed_distance = in.sd;
-  r->normal = in.n_w;
-  r->depth = std::max(0.0, -in.sd);
-  if (J) {
-    J->J_sd_object_pose = in.J_sd_obj;
-    J->J_sd_finger_pose = in.J_sd_fin;
-  }
-  if (in.separate_contact_normal) FillWitnessesAtCorner(in, ro, rf, r, J);
-  else FillWitnessesAlongNormal(in, ro, rf, r, J);
-}
+using namespace internal;  // NOLINT: the query's own helpers (shape_pair_witness.h)
 
 // Finger vertex f (finger frame) against the object: a posed point query on the object.
 WitnessInputs FingerVertexAgainstObject(const Shape& object, const Pose2& object_pose, const Pose2& finger_pose,
@@ -155,17 +70,6 @@ void CheckPose(const Pose2& p, const char* which) {
   if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.theta))
     throw GeometryError(std::string(which) + " pose is not finite");
 }
-
-
-// How a feature of the obstacle's core moves with the relative angle phi, and which material
-// point generates it (Lozano-Perez's contact types; see QueryExact).
-struct FeatureMotion {
-  Vec2 n{0, 0}, dn{0, 0};  // a line n . x = h of C: normal, d n / d phi, d h / d phi
-  double dh = 0.0;
-  Vec2 dv{0, 0};           // a vertex of C: d v / d phi
-  bool finger_material = true;
-  Vec2 f{0, 0}, o{0, 0};   // finger vertex (finger frame) / object vertex (object frame)
-};
 
 // Rounding of a distance computed at the scale of the obstacle and the query point.
 double RoundingSlack(const Shape& C, const Vec2& c) {
@@ -376,45 +280,16 @@ ShapePairResult ShapePairQuerier::Impl::QueryExact(const Pose2& object_pose, con
       return QueryRounded(C, bp, c, J_c_obj, J_c_fin, phi, Ro, object_pose, finger_pose, nullptr, J);
     }
   }
-  const Vec2 n_o = qc.normal;
-  const double sd = qc.signed_distance;
-  const Vec2 c_contact = qc.closest_point - C.radius() * n_o;  // finger origin at first contact (cores)
-
-  // d sd / d c = n; d sd / d phi and the normal's derivatives from the generating pair(s).
+  const Vec2 c_contact = qc.closest_point - C.radius() * qc.normal;  // finger origin at first contact (cores)
   const bool vertex = qc.feature.kind != BoundaryFeature::Kind::kEdge;
-  const FeatureMotion mo = MotionAt(c_contact, phi, vertex, n_o);
-  double sd_phi = 0.0;
-  Eigen::Matrix2d Nc = Eigen::Matrix2d::Zero();
-  Vec2 Nphi = Vec2::Zero();
-  if (!vertex) {
-    sd_phi = mo.dn.dot(c) - mo.dh;
-    Nphi = mo.dn;
-  } else {
-    const double d = (c - c_contact).norm();
-    sd_phi = -n_o.dot(mo.dv);
-    if (d > 0.0) {
-      const double s = qc.signed_distance + C.radius() > 0.0 ? 1.0 : -1.0;
-      const Eigen::Matrix2d P = Eigen::Matrix2d::Identity() - n_o * n_o.transpose();
-      Nc = s * P / d;
-      Nphi = -s * P * mo.dv / d;
-    }
-  }
-  WitnessInputs w;
-  w.sd = sd;
-  w.n_w = Ro * n_o;
-  w.J_sd_obj = n_o.transpose() * J_c_obj;
-  w.J_sd_obj(2) -= sd_phi;
-  w.J_sd_fin << (n_o.transpose() * Ro.transpose()), sd_phi;
-  w.J_n_obj = Ro * Nc * J_c_obj;
-  w.J_n_obj.col(2) += -Ro * Nphi + RotationDerivative(object_pose.theta) * n_o;
-  w.J_n_fin.block<2, 2>(0, 0) = Ro * Nc * Ro.transpose();
-  w.J_n_fin.col(2) = Ro * Nphi;
-  w.on_finger = mo.finger_material;
-  if (mo.finger_material) {
-    w.m_w = Act(finger_pose, mo.f, &w.J_m_fin);
-  } else {
-    w.m_w = Act(object_pose, mo.o, &w.J_m_obj);
-  }
+  const FeatureMotion mo = MotionAt(c_contact, phi, vertex, qc.normal);
+  Separation sep;
+  sep.sd = qc.signed_distance;
+  sep.n = qc.normal;
+  OneFeatureDerivatives(vertex, c, c_contact, qc.signed_distance + C.radius() > 0.0 ? 1.0 : -1.0, mo, &sep);
+  Mat23 J_c_fin = Mat23::Zero();
+  J_c_fin.block<2, 2>(0, 0) = Ro.transpose();
+  const WitnessInputs w = ObstacleWitness(sep, J_c_obj, J_c_fin, Ro, object_pose, finger_pose, mo);
   ShapePairResult r;
   FillWitnesses(w, ro, rf, &r, J);
   r.intersecting = qc.containment == Containment::kInside;
@@ -463,10 +338,9 @@ ShapePairResult ShapePairQuerier::Impl::QueryRounded(const Shape& C, const Round
   };
   Feature a = feature_of(bp.feature);
   const double L = bp.distance;
-  const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
-  Vec2 n = Vec2::Zero(), Nphi = Vec2::Zero(), k = Vec2::Zero(), Kphi = Vec2::Zero();
-  Eigen::Matrix2d Nc = Eigen::Matrix2d::Zero();
-  double sd_phi = 0.0;
+  Separation sep;
+  sep.sd = -L;
+  Vec2 k = Vec2::Zero(), Kphi = Vec2::Zero();
   bool corner = false;
   if (bp.corner) {
     Feature b = feature_of(bp.other);
@@ -494,11 +368,11 @@ ShapePairResult ShapePairQuerier::Impl::QueryRounded(const Shape& C, const Round
     if (std::abs(A.determinant()) > 1e-6 * A.row(0).norm() * A.row(1).norm()) {
       corner = true;
       const Vec2 dp = A.partialPivLu().solve(rhs);
-      n = (p - c) / L;
-      const Eigen::Matrix2d P = I - n * n.transpose();
-      sd_phi = -n.dot(dp);
-      Nc = -P / L;
-      Nphi = P * dp / L;
+      sep.n = (p - c) / L;
+      const Eigen::Matrix2d P = Eigen::Matrix2d::Identity() - sep.n * sep.n.transpose();
+      sep.sd_phi = -sep.n.dot(dp);
+      sep.Nc = -P / L;
+      sep.Nphi = P * dp / L;
       if (a.vertex) {
         k = (p - a.v) / R;
         Kphi = (dp - a.motion.dv) / R;
@@ -509,49 +383,18 @@ ShapePairResult ShapePairQuerier::Impl::QueryRounded(const Shape& C, const Round
     }
   }
   if (!corner) {
-    if (!a.vertex) {
-      n = a.n;
-      sd_phi = a.motion.dn.dot(c) - a.motion.dh;
-      Nphi = a.motion.dn;
-    } else {
-      const Vec2 w = c - a.v;
-      const double d = w.norm();
-      n = d > 0.0 ? Vec2(w / d) : Vec2((bp.point - a.v) / R);
-      sd_phi = -n.dot(a.motion.dv);
-      if (d > 0.0) {
-        const Eigen::Matrix2d P = I - n * n.transpose();
-        Nc = P / d;
-        Nphi = -P * a.motion.dv / d;
-      }
-    }
+    // On one feature's offset c lies on the feature's outer side (s = +1).
+    const Vec2 from_v = c - a.v;
+    const double d = from_v.norm();
+    sep.n = !a.vertex ? a.n : d > 0.0 ? Vec2(from_v / d) : Vec2((bp.point - a.v) / R);
+    OneFeatureDerivatives(a.vertex, c, a.v, 1.0, a.motion, &sep);
   }
-  Eigen::Matrix2d dRo;  // d Ro / d theta from Ro's entries (no second sincos)
-  dRo << -Ro(1, 0), -Ro(0, 0), Ro(0, 0), -Ro(1, 0);
-  WitnessInputs w;
-  w.sd = -L;
-  w.n_w = Ro * n;
-  w.J_sd_obj = n.transpose() * J_c_obj;
-  w.J_sd_obj(2) -= sd_phi;
-  w.J_sd_fin = n.transpose() * J_c_fin;
-  w.J_sd_fin(2) += sd_phi;
-  w.J_n_obj = Ro * Nc * J_c_obj;
-  w.J_n_obj.col(2) += -Ro * Nphi + dRo * n;
-  w.J_n_fin = Ro * Nc * J_c_fin;
-  w.J_n_fin.col(2) += Ro * Nphi;
+  WitnessInputs w = ObstacleWitness(sep, J_c_obj, J_c_fin, Ro, object_pose, finger_pose, a.motion, centre);
   if (corner) {
     w.separate_contact_normal = true;
     w.k_w = Ro * k;
-    w.J_k_obj.col(2) = -Ro * Kphi + dRo * k;
+    w.J_k_obj.col(2) = -Ro * Kphi + RotationDerivativeOf(Ro) * k;
     w.J_k_fin.col(2) = Ro * Kphi;
-  }
-  w.on_finger = a.motion.finger_material;
-  if (centre) {
-    w.m_w = centre->m_w;
-    w.J_m_fin = centre->J_m_fin;
-  } else if (a.motion.finger_material) {
-    w.m_w = Act(finger_pose, a.motion.f, &w.J_m_fin);
-  } else {
-    w.m_w = Act(object_pose, a.motion.o, &w.J_m_obj);
   }
   ShapePairResult r;
   FillWitnesses(w, object.radius(), finger.radius(), &r, J);
