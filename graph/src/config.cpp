@@ -165,6 +165,10 @@ EstimatorConfig ParseEstimatorConfig(const std::string& json_text, const std::st
       if (!it->is_number_integer()) Fail(source, key, "expected an integer");
       cfg.incremental_update_every_steps = it->get<int>();
       if (cfg.incremental_update_every_steps < 1) Fail(source, key, "must be >= 1");
+    } else if (key == "incremental_window_steps") {
+      if (!it->is_number_integer()) Fail(source, key, "expected an integer");
+      cfg.incremental_window_steps = it->get<int>();
+      if (cfg.incremental_window_steps < 3) Fail(source, key, "must be >= 3 (the V factors span three steps)");
     } else if (key == "covariance_method") {
       cfg.covariance_method = ParseChoice<EstimatorConfig::CovarianceMethod>(
           *it, source, key, {{"selected_inversion", EstimatorConfig::CovarianceMethod::kSelectedInversion},
@@ -175,12 +179,13 @@ EstimatorConfig ParseEstimatorConfig(const std::string& json_text, const std::st
                              {"on", EstimatorConfig::AlignShape::kOn},
                              {"off", EstimatorConfig::AlignShape::kOff}});
     } else if (key == "covariance" || key == "estimate_c" || key == "estimate_mu" || key == "align_scale" ||
-               key == "diagnostics") {
+               key == "diagnostics" || key == "incremental_smoothing") {
       if (!it->is_boolean()) Fail(source, key, "expected true or false");
       (key == "covariance"    ? cfg.covariance
        : key == "estimate_c"  ? cfg.estimate_c
        : key == "estimate_mu" ? cfg.estimate_mu
        : key == "diagnostics" ? cfg.diagnostics
+       : key == "incremental_smoothing" ? cfg.incremental_smoothing
                               : cfg.align_scale) = it->get<bool>();
     } else if (key == "losses") {
       if (!it->is_object()) Fail(source, key, "expected an object");
@@ -246,6 +251,9 @@ void ValidateConfig(const EstimatorConfig& cfg) {
   }
   if (cfg.incremental_update_every_steps < 0) {
     throw GraphError("config key 'incremental_update_every_steps' must be >= 1 (0: unset)");
+  }
+  if (cfg.incremental_window_steps != 0 && cfg.incremental_window_steps < 3) {
+    throw GraphError("config key 'incremental_window_steps' must be >= 3 (0: unset)");
   }
   if (cfg.incremental_window < cfg.incremental_update_every) {
     throw GraphError("config: incremental_window must be >= incremental_update_every");

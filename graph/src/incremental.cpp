@@ -75,6 +75,34 @@ std::string Precise(double t) {
   return o.str();
 }
 
+// The blocks' values, concatenated.
+Eigen::VectorXd Values(const std::vector<double*>& blocks, const std::vector<int>& sizes) {
+  int total = 0;
+  for (int n : sizes) total += n;
+  Eigen::VectorXd v(total);
+  int off = 0;
+  for (std::size_t k = 0; k < blocks.size(); ++k) {
+    for (int j = 0; j < sizes[k]; ++j) v[off + j] = blocks[k][j];
+    off += sizes[k];
+  }
+  return v;
+}
+
+// What marginalizing one step leaves behind: the Gaussian conditional of its blocks given the
+// blocks it was connected to (its separator), linearized where the step left the window:
+// x_r = x_r_lin + G (x_s - x_s_lin), covariance Hrr^-1 (H the information of the factors that
+// touched the step). Kept for the backward smoothing pass.
+struct StepConditional {
+  int step = 0;
+  std::vector<double*> removed, separator;
+  std::vector<int> removed_sizes, separator_sizes;
+  Eigen::VectorXd removed_lin, separator_lin;
+  Eigen::MatrixXd G;       // removed_dim x separator_dim
+  // The conditional's square-root information: rows sqrt(lambda_i) u_i^T of H_rr's eigenpairs
+  // (only when covariances are wanted; rank-revealing like the marginal prior).
+  Eigen::MatrixXd S;
+};
+
 // The fixed-lag smoother both front ends drive: steps join at updates, the window is re-solved,
 // steps older than the window are marginalized.
 struct FixedLagSmoother {
@@ -90,6 +118,7 @@ struct FixedLagSmoother {
   SolverStats stats;
   double total_update_time = 0.0;
   double last_cost = 0.0;
+  std::vector<StepConditional> conditionals;  // in the order the steps were marginalized
 
   // online == nullptr: every step of the recorded `t` exists from the start.
   FixedLagSmoother(const push::Trajectory& t, Model model, const EstimatorConfig& c,
@@ -111,7 +140,7 @@ struct FixedLagSmoother {
   void Record(const std::vector<int>& idx, ChainSolver* chain = nullptr) {
     std::vector<StateEstimate> out;
     for (int i : idx) out.push_back(builder.State(i));
-    if (cfg.covariance && !idx.empty()) {
+    if (cfg.covariance && !cfg.incremental_smoothing && !idx.empty()) {
       const std::string status = internal::ComputeCovariances(*problem, builder, idx, out, cfg.covariance_method, nullptr, nullptr, chain);
       if (status != "ok") stats.covariance_status = status;
       else if (stats.covariance_status == "not computed") stats.covariance_status = "ok";
@@ -142,14 +171,20 @@ struct FixedLagSmoother {
     std::vector<double*> order(removed);
     std::map<double*, int> offset;
     int dim = 0;
-    for (double* b : removed) { offset[b] = dim; dim += problem->ParameterBlockSize(b); }
+    std::vector<int> order_sizes;  // of `order`
+    for (double* b : removed) { offset[b] = dim; order_sizes.push_back(problem->ParameterBlockSize(b)); dim += order_sizes.back(); }
     const int removed_dim = dim;
     std::vector<std::vector<double*>> rb_params;
     for (ceres::ResidualBlockId id : rbs) {
       std::vector<double*> ps;
       problem->GetParameterBlocksForResidualBlock(id, &ps);
       for (double* p : ps) {
-        if (!offset.count(p)) { offset[p] = dim; order.push_back(p); dim += problem->ParameterBlockSize(p); }
+        if (!offset.count(p)) {
+          offset[p] = dim;
+          order.push_back(p);
+          order_sizes.push_back(problem->ParameterBlockSize(p));
+          dim += order_sizes.back();
+        }
       }
       rb_params.push_back(ps);
     }
@@ -186,13 +221,34 @@ struct FixedLagSmoother {
     for (ceres::ResidualBlockId id : rbs) problem->RemoveResidualBlock(id);
     for (double* p : removed) problem->RemoveParameterBlock(p);
     const int sep_dim = dim - removed_dim;
-    if (sep_dim == 0) return;
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> er(H.topLeftCorner(removed_dim, removed_dim));
     const double emax = std::max(er.eigenvalues().maxCoeff(), 1e-300);
     Eigen::VectorXd inv = er.eigenvalues();
     for (int i = 0; i < inv.size(); ++i) inv[i] = inv[i] > 1e-12 * emax ? 1.0 / inv[i] : 0.0;
     const Eigen::MatrixXd Hrr_inv = er.eigenvectors() * inv.asDiagonal() * er.eigenvectors().transpose();
     const Eigen::MatrixXd Hsr = H.bottomLeftCorner(sep_dim, removed_dim);
+    if (cfg.incremental_smoothing) {
+      StepConditional c;
+      c.step = s;
+      c.removed = removed;
+      c.separator.assign(order.begin() + removed.size(), order.end());
+      c.removed_sizes.assign(order_sizes.begin(), order_sizes.begin() + removed.size());
+      c.separator_sizes.assign(order_sizes.begin() + removed.size(), order_sizes.end());
+      c.removed_lin = Values(c.removed, c.removed_sizes);
+      c.separator_lin = Values(c.separator, c.separator_sizes);
+      c.G = -Hrr_inv * Hsr.transpose();
+      if (cfg.covariance) {
+        std::vector<int> informative;
+        for (int i = 0; i < removed_dim; ++i) if (inv[i] > 0.0) informative.push_back(i);
+        c.S.resize(static_cast<Eigen::Index>(informative.size()), removed_dim);
+        for (std::size_t i = 0; i < informative.size(); ++i) {
+          c.S.row(static_cast<Eigen::Index>(i)) =
+              std::sqrt(er.eigenvalues()[informative[i]]) * er.eigenvectors().col(informative[i]).transpose();
+        }
+      }
+      conditionals.push_back(std::move(c));
+    }
+    if (sep_dim == 0) return;
     const Eigen::MatrixXd Hm = H.bottomRightCorner(sep_dim, sep_dim) - Hsr * Hrr_inv * Hsr.transpose();
     const Eigen::VectorXd bm = b.tail(sep_dim) - Hsr * Hrr_inv * b.head(removed_dim);
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (Hm + Hm.transpose()));
@@ -221,6 +277,17 @@ struct FixedLagSmoother {
     problem->AddResidualBlock(new MarginalPriorFactor(sizes, x_bar, S, r0), nullptr, sep);
   }
 
+  // The window's length in steps (0: in time, window_duration).
+  int WindowSteps() const {
+    if (cfg.incremental_window_steps > 0) return cfg.incremental_window_steps;
+    // At least ten updates' worth: a window of three 5-step updates left the notched block's
+    // pushes 20 to 60 % above batch (tests/python), ten of them within batch's spread.
+    return cfg.incremental_update_every_steps > 0
+               ? std::max(kDefaultWindowStepsAtSensorRate, 10 * cfg.incremental_update_every_steps)
+               : 0;
+  }
+  static constexpr int kDefaultWindowStepsAtSensorRate = 15;
+
   // Adds the steps up to `target` (every remaining one when take_all) and solves the window.
   double Update(double target, bool take_all) {
     const auto start = std::chrono::steady_clock::now();
@@ -244,7 +311,12 @@ struct FixedLagSmoother {
     std::vector<int> leaving;
     const double t_now = builder.steps()[next_step - 1].t;
     int s = lo;
-    while (s < next_step - 3 && builder.steps()[s].t < t_now - window_duration) leaving.push_back(s++);
+    const int window_steps = WindowSteps();
+    if (window_steps > 0) {
+      while (s < next_step - window_steps) leaving.push_back(s++);
+    } else {
+      while (s < next_step - 3 && builder.steps()[s].t < t_now - window_duration) leaving.push_back(s++);
+    }
     const auto record_start = std::chrono::steady_clock::now();
     Record(leaving, summary.chain.get());
     const auto marginalize_start = std::chrono::steady_clock::now();
@@ -271,6 +343,12 @@ struct FixedLagSmoother {
     std::vector<int> rest;
     for (int i = lo; i < next_step; ++i) rest.push_back(i);
     Record(rest);
+    if (cfg.incremental_smoothing) {
+      // The window eliminated in time order too, then one backward pass over every conditional.
+      for (int i : rest) Marginalize(i);
+      lo = next_step;
+      SmoothBackwards();
+    }
     total_update_time += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     EstimationResult r;
     r.model = builder.model();
@@ -283,6 +361,72 @@ struct FixedLagSmoother {
     builder.DropUnobservableForces(r);
     r.metrics = ComputeMetrics(traj, r.states);
     return r;
+  }
+
+  // The backward (Rauch-Tung-Striebel) pass over the conditionals, newest first: each step's
+  // blocks move with the final estimate of their separator, x_r = x_r_lin + G (x_s - x_s_lin).
+  // Covariances: the conditionals multiply to the whole chain's linearized Gaussian, whose
+  // information is sum_k A_k^T S_k^T S_k A_k with A_k = [I, -G_k] on (step k, its separator): a
+  // block-banded matrix whose marginals come from one sparse Cholesky factor and a selected
+  // inversion (SparseMarginals, AMD order). The covariance form of the recursion,
+  // Sigma_rr = H_rr^-1 + G Sigma_ss G^T, is the same algebra in time order, and it is unstable
+  // here: with a stiff constant-velocity prior G extrapolates backwards (|G| up to 20 on an MIT
+  // recording) and rounding in the frontier's nearly singular covariance of two consecutive
+  // poses grew to -1e164 within 400 steps.
+  void SmoothBackwards() {
+    for (int k = static_cast<int>(conditionals.size()) - 1; k >= 0; --k) {
+      const StepConditional& c = conditionals[k];
+      const Eigen::VectorXd x_r = c.removed_lin + c.G * (Values(c.separator, c.separator_sizes) - c.separator_lin);
+      int off = 0;
+      for (std::size_t q = 0; q < c.removed.size(); ++q) {
+        for (int j = 0; j < c.removed_sizes[q]; ++j) c.removed[q][j] = x_r[off + j];
+        off += c.removed_sizes[q];
+      }
+      StateEstimate& state = states[c.step];
+      const StateEstimate fresh = builder.State(c.step);
+      state.object_pose = fresh.object_pose;
+      state.finger_pose = fresh.finger_pose;
+      state.contact = fresh.contact;
+      state.force = fresh.force;
+    }
+    if (cfg.covariance) SmoothedCovariances();
+    conditionals.clear();
+  }
+
+  void SmoothedCovariances() {
+    ceres::Problem chain;  // linear factors, one per conditional
+    std::unordered_set<double*> eliminated;
+    for (const StepConditional& c : conditionals) eliminated.insert(c.removed.begin(), c.removed.end());
+    for (const StepConditional& c : conditionals) {
+      if (c.S.rows() == 0) continue;
+      std::vector<double*> blocks(c.removed);
+      blocks.insert(blocks.end(), c.separator.begin(), c.separator.end());
+      std::vector<int> sizes(c.removed_sizes);
+      sizes.insert(sizes.end(), c.separator_sizes.begin(), c.separator_sizes.end());
+      const int nr = static_cast<int>(c.removed_lin.size()), ns = static_cast<int>(c.separator_lin.size());
+      Eigen::MatrixXd A(c.S.rows(), nr + ns);
+      A.leftCols(nr) = c.S;
+      A.rightCols(ns) = -c.S * c.G;
+      Eigen::VectorXd x_lin(nr + ns);
+      x_lin << c.removed_lin, c.separator_lin;
+      chain.AddResidualBlock(new MarginalPriorFactor(sizes, x_lin, A, Eigen::VectorXd::Zero(c.S.rows())), nullptr, blocks);
+    }
+    // Blocks no step owns (constant in the window's problem) stay constant.
+    std::vector<double*> all;
+    chain.GetParameterBlocks(&all);
+    for (double* b : all) if (!eliminated.count(b)) chain.SetParameterBlockConstant(b);
+    // Selected inversion, or ceres::Covariance's QR on J when J^T J is too ill-conditioned for it
+    // (both as in batch).
+    std::vector<int> idx;
+    std::vector<StateEstimate> out;
+    for (const StepConditional& c : conditionals) {
+      idx.push_back(c.step);
+      out.push_back(states[c.step]);
+    }
+    const std::string status = internal::ComputeCovariances(chain, builder, idx, out, cfg.covariance_method, nullptr, nullptr, nullptr);
+    stats.covariance_status = status == "ok" ? status : "smoothed covariances " + status;
+    if (status != "ok") return;
+    for (std::size_t k = 0; k < idx.size(); ++k) states[idx[k]] = out[k];
   }
 
   StateEstimate LatestState(const char* who) const {
@@ -436,7 +580,11 @@ struct OnlineEstimator::Impl {
   // camera is waited for while an occluded one, or a tactile sensor silent out of contact, does
   // not hold the others back.
   double SettledTime() const {
-    const double live = std::max(max_latency, 1.5 * smoother.cfg.incremental_update_every * object_period);
+    // At the sensor rate (incremental_update_every_steps) only max_latency counts: a camera slower
+    // than the update rate is not waited for between its frames.
+    const double live = smoother.cfg.incremental_update_every_steps >= 1
+                            ? max_latency
+                            : std::max(max_latency, 1.5 * smoother.cfg.incremental_update_every * object_period);
     double settled = newest_t;
     for (double t : last_seen) {
       if (std::isfinite(t) && newest_t - t <= live) settled = std::min(settled, t);

@@ -138,7 +138,22 @@ struct EstimatorConfig {
   /// Estimator steps between updates (1: an update at every step, the sensor rate); when set
   /// (>= 1) it takes precedence over incremental_update_every. 0: unset.
   int incremental_update_every_steps = 0;
+  /// Estimator steps kept in the window (>= 3); when set it takes precedence over
+  /// incremental_window. 0: unset, which means incremental_window object periods, or 15 steps
+  /// (60 ms at 250 Hz; 10 k steps when k = incremental_update_every_steps is 2 or more) when
+  /// incremental_update_every_steps is set: an update at the sensor rate
+  /// re-solves a short window, and the final smoothing pass (incremental_smoothing) brings the
+  /// older states to the batch estimate's accuracy.
+  int incremental_window_steps = 0;
   int incremental_max_iterations = 50;
+  /// The final result of the incremental mode (Finish()): true (the default) smooths the whole
+  /// trajectory backwards through the Gaussian conditionals its steps left when they were
+  /// marginalized (a Rauch-Tung-Striebel pass on the chain, as iSAM2's back-substitution without
+  /// relinearizing the old part): every state then uses all the measurements, before and after it,
+  /// with its smoothed marginal covariance. false: every state as it was when it left the window
+  /// (what a robot knew a window after the fact). The updates' own estimates (LatestState) are
+  /// the same either way.
+  bool incremental_smoothing = true;
 };
 
 /// Parses a JSON object overriding fields of `base` (the defaults unless given); `source` names

@@ -63,7 +63,10 @@ struct OnlineStreams {
   bool force = true;           ///< a force/torque sensor reports the contact force
   /// How far (s, in the samples' time) a stream may lag the newest sample of any stream and
   /// still be waited for by Update(); a stream further behind (also at least 1.5 k object
-  /// periods) counts as silent: an occluded camera, a tactile sensor out of contact.
+  /// periods, except with incremental_update_every_steps) counts as silent: an occluded camera,
+  /// a tactile sensor out of contact. For updates at the sensor rate set it below the slowest
+  /// stream's period (else every update waits for the next camera frame); a frame that then
+  /// arrives after the update covering its time is dropped (DroppedLateSamples).
   double max_latency = 0.2;
 };
 
