@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer harnesses (fuzz/) with clang, ASan and UBSan in build-fuzz/ and runs each for
+# Builds the libFuzzer harnesses (fuzz/) with clang, ASan and UBSan (scripts/sanitize-build.sh, in
+# build-sanitize/, the tree the sanitized tests use too) and runs each for
 # SECONDS (default 60) on a corpus seeded from the project's own files (data/, a simulated
 # trajectory, hand-written configs) and, when present, ../shared's MIT sample. A finding (crash,
 # sanitizer report, leak, timeout) stops that harness and leaves crash-*/leak-*/timeout-* in
@@ -11,33 +12,16 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 SECONDS_EACH=${SECONDS_EACH:-60}
 SHARED_DIR=${SHARED_DIR:-../shared}
-BUILD=${FUZZ_BUILD_DIR:-build-fuzz}
+BUILD=${FUZZ_BUILD_DIR:-build-sanitize}
 OUT=${FUZZ_OUT:-out/fuzz}
-bash scripts/install-deps.sh > /dev/null
-# clang with its libFuzzer and sanitizer runtimes (Debian 12: clang 14), when missing.
-missing=()
-for p in clang libclang-rt-14-dev llvm-14; do
-  dpkg-query -W -f='${Status}' "$p" 2> /dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  sudo_cmd=()
-  [ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
-  "${sudo_cmd[@]}" apt-get update -qq
-  "${sudo_cmd[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" > /dev/null
-fi
 targets=("$@")
 [ ${#targets[@]} -gt 0 ] || targets=(fuzz_shape_json fuzz_trajectory_json fuzz_points_csv fuzz_obj_footprint
                                      fuzz_mit_hdf5 fuzz_mit_json fuzz_estimator_config fuzz_evaluation_config)
-# -O1 and line tables only (libFuzzer's advice): symbolized reports, a build that fits CI.
-CC=clang CXX=clang++ cmake -S . -B "$BUILD" -DCMAKE_BUILD_TYPE= -DCMAKE_CXX_FLAGS="-O1 -gline-tables-only" -DPUSHGRAPH_BUILD_FUZZERS=ON \
-  -DPUSHGRAPH_BUILD_TESTS=OFF -DPUSHGRAPH_BUILD_EXAMPLES=OFF -DPUSHGRAPH_BUILD_BENCH=OFF -DPUSHGRAPH_BUILD_PYTHON=OFF > /dev/null
-start=$(date +%s)
 # The tool only makes a seed: the main build's when there is one.
 P=${PUSHGRAPH:-build/tools/pushgraph}
 tool_target=()
 [ -x "$P" ] || { P="$BUILD/tools/pushgraph"; tool_target=(pushgraph); }
-cmake --build "$BUILD" -j"$(nproc)" --target "${targets[@]}" "${tool_target[@]}"
-echo "fuzz: built in $(( $(date +%s) - start )) s"
+SANITIZE_BUILD_DIR="$BUILD" bash scripts/sanitize-build.sh "${targets[@]}" "${tool_target[@]}"
 
 # Seeds: the project's own files, and what the tool makes (the trajectory format).
 seeds="$OUT/seeds"

@@ -12,6 +12,8 @@
 // - separate polygons are placed in disjoint disks.
 #include <pushgraph/geometry/shape.h>
 
+#include "test_scale.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -21,21 +23,8 @@
 
 namespace pushgraph::geometry::testing {
 
-/// Multiplier for iteration counts: PUSHGRAPH_TEST_SCALE (default 1; e.g. 0.2 under sanitizers).
-inline double TestScale() {
-  static const double scale = [] {
-    const char* s = std::getenv("PUSHGRAPH_TEST_SCALE");
-    if (s == nullptr || *s == '\0') return 1.0;
-    const double v = std::atof(s);
-    return v > 0.0 ? v : 1.0;
-  }();
-  return scale;
-}
-
-/// n scaled by TestScale(), at least `minimum`.
-inline int Scaled(int n, int minimum = 1) {
-  return std::max(minimum, static_cast<int>(std::lround(n * TestScale())));
-}
+using pushgraph::testing::Scaled;     // test_scale.h: PUSHGRAPH_TEST_SCALE
+using pushgraph::testing::TestScale;
 
 constexpr double kPi = 3.14159265358979323846;
 

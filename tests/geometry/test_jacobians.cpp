@@ -212,7 +212,10 @@ std::vector<NamedShape> JacobianShapes() {
 TEST(PointQueryJacobians, PosedQueryAgainstNumericDifferences) {
   std::mt19937_64 rng(105);
   const auto angles = SpecialAngles();
-  for (const auto& [name, shape] : JacobianShapes()) {
+  for (const auto& named : JacobianShapes()) {
+    // Not a structured binding: lambdas below capture the shape (C++17 forbids capturing bindings; clang enforces it).
+    const std::string& name = named.name;
+    const Shape& shape = named.shape;
     JacobianTally tally_point(name + " d/d point"), tally_pose(name + " d/d pose");
     const int n = Scaled(150, 20);
     std::vector<Vec2> local_points;
@@ -280,7 +283,10 @@ TEST(PointQueryJacobians, PosedQueryAgainstNumericDifferences) {
 
 TEST(PointQueryJacobians, SignedDistanceGradient) {
   std::mt19937_64 rng(106);
-  for (const auto& [name, shape] : JacobianShapes()) {
+  for (const auto& named : JacobianShapes()) {
+    // Not a structured binding: lambdas below capture the shape (C++17 forbids capturing bindings; clang enforces it).
+    const std::string& name = named.name;
+    const Shape& shape = named.shape;
     JacobianTally tally(name + " SignedDistance gradient");
     for (int i = 0; i < Scaled(100, 20); ++i) {
       const Vec2 p = testing::RandomPointNear(rng, shape.bounds(), 0.3);

@@ -302,7 +302,7 @@ TEST(FactorJacobians, QuasiStaticBothForms) {
   EXPECT_TRUE(tlcm.MostlyChecked(0.95));
   // With c and mu fixed at the geometry's and the constructor's values it is the plain load factor.
   {
-    const QsCase& c = QuasiStaticCases(rng, g).front();
+    const QsCase c = QuasiStaticCases(rng, g).front();  // a copy: the vector is a temporary
     const LimitSurfaceLoadFactor plain(g, 0.3 * 0.8 * 9.81, 1e-3, 0.05, 0.1);
     const LimitSurfaceLoadFactorWithParameters fixed(g, 0.8 * 9.81, 0.3, {}, 1e-3, 0.05, 0.1);
     EXPECT_NEAR(Residual(plain, c)[0], Residual(fixed, c)[0], 1e-12 * (1.0 + std::abs(Residual(plain, c)[0])));

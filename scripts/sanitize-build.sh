@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# The one sanitizer build that `scripts/test.sh --sanitize` and scripts/fuzz.sh share: clang with
+# AddressSanitizer and UndefinedBehaviorSanitizer on every library, test, example and the tool,
+# plus libFuzzer's coverage instrumentation (PUSHGRAPH_BUILD_FUZZERS), at -O1 with line tables
+# (symbolized reports, a build that fits CI), in build-sanitize/ (SANITIZE_BUILD_DIR). Installs
+# clang with its libFuzzer and sanitizer runtimes (Debian 12: clang 14) when missing. Builds the
+# targets given, or everything.
+#
+#   bash scripts/sanitize-build.sh                      # everything
+#   bash scripts/sanitize-build.sh fuzz_shape_json      # one target
+set -euo pipefail
+cd "$(dirname "$0")/.."
+BUILD=${SANITIZE_BUILD_DIR:-build-sanitize}
+bash scripts/install-deps.sh > /dev/null
+missing=()
+for p in clang libclang-rt-14-dev llvm-14; do
+  dpkg-query -W -f='${Status}' "$p" 2> /dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  sudo_cmd=()
+  [ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
+  "${sudo_cmd[@]}" apt-get update -qq
+  "${sudo_cmd[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" > /dev/null
+fi
+CC=clang CXX=clang++ cmake -S . -B "$BUILD" -DCMAKE_BUILD_TYPE= -DCMAKE_CXX_FLAGS="-O1 -gline-tables-only" \
+  -DPUSHGRAPH_BUILD_FUZZERS=ON -DPUSHGRAPH_BUILD_TESTS=ON -DPUSHGRAPH_BUILD_EXAMPLES=ON -DPUSHGRAPH_BUILD_BENCH=OFF \
+  -DPUSHGRAPH_BUILD_PYTHON=OFF > /dev/null
+start=$(date +%s)
+if [ $# -gt 0 ]; then
+  cmake --build "$BUILD" -j"$(nproc)" --target "$@"
+else
+  cmake --build "$BUILD" -j"$(nproc)"
+fi
+echo "sanitize-build: built in $(( $(date +%s) - start )) s ($BUILD)"
