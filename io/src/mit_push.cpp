@@ -7,10 +7,15 @@
 #include <H5Cpp.h>
 #include <nlohmann/json.hpp>
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <mutex>
 #include <filesystem>
 #include <cstdint>
 #include <fstream>
@@ -106,6 +111,102 @@ Raw ReadH5(const std::string& path) {
   } catch (const H5::Exception& e) {
     if (stage == "open") throw IoError(path + ": cannot open: " + DescribeUnopenableH5(path));
     throw IoError(path + ": cannot read " + stage + " (truncated or corrupt HDF5: " + e.getDetailMsg() + ")");
+  }
+  return raw;
+}
+
+// libhdf5 1.10 can crash on a corrupt file: a recording with the root group's B-tree address
+// overwritten by 0xFF bytes (found by fuzz_mit_hdf5) makes H5Lexists copy from a null buffer, and
+// the tool died with SIGSEGV. So the file is read by a child process that sends the rows back
+// through a pipe; a child that dies becomes a clear error, and HDF5's global state in this
+// process is never touched by a corrupt file. One read at a time: HDF5 (serial build) is not
+// thread-safe, and a fork while another thread is inside it would copy its half-updated state.
+Raw ReadH5InChild(const std::string& path) {
+  static std::mutex hdf5_mutex;
+  std::lock_guard<std::mutex> lock(hdf5_mutex);
+  int fds[2];
+  if (pipe(fds) != 0) throw IoError(path + ": cannot read (pipe: " + std::strerror(errno) + ")");
+  const pid_t pid = fork();
+  if (pid < 0) {
+    close(fds[0]);
+    close(fds[1]);
+    throw IoError(path + ": cannot read (fork: " + std::strerror(errno) + ")");
+  }
+  auto send = [](int fd, const void* data, std::size_t n) {
+    const char* p = static_cast<const char*>(data);
+    while (n > 0) {
+      const ssize_t w = write(fd, p, n);
+      if (w < 0 && errno == EINTR) continue;
+      if (w <= 0) return false;
+      p += w;
+      n -= static_cast<std::size_t>(w);
+    }
+    return true;
+  };
+  if (pid == 0) {  // the child: read, send, and leave without running this process's exit handlers
+    close(fds[0]);
+    std::string error;
+    Raw raw;
+    try {
+      raw = ReadH5(path);
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    const std::uint64_t failed = error.empty() ? 0 : 1;
+    bool ok = send(fds[1], &failed, sizeof failed);
+    if (failed) {
+      const std::uint64_t n = error.size();
+      ok = ok && send(fds[1], &n, sizeof n) && send(fds[1], error.data(), error.size());
+    } else {
+      for (int k = 0; k < 3 && ok; ++k) {
+        const std::vector<Row>& rows = Slot(raw, k);
+        const std::uint64_t n = rows.size();
+        ok = send(fds[1], &n, sizeof n) && send(fds[1], rows.data(), rows.size() * sizeof(Row));
+      }
+    }
+    close(fds[1]);
+    _exit(ok ? 0 : 3);
+  }
+  close(fds[1]);
+  std::string bytes;
+  char buffer[65536];
+  for (;;) {
+    const ssize_t r = read(fds[0], buffer, sizeof buffer);
+    if (r < 0 && errno == EINTR) continue;
+    if (r <= 0) break;
+    bytes.append(buffer, static_cast<std::size_t>(r));
+  }
+  close(fds[0]);
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    const std::string how = WIFSIGNALED(status) ? "signal " + std::to_string(WTERMSIG(status)) + ", " + strsignal(WTERMSIG(status))
+                                                : "exit status " + std::to_string(WEXITSTATUS(status));
+    throw IoError(path + ": a corrupt HDF5 file: the HDF5 library crashed reading it (" + how + ")");
+  }
+  std::size_t at = 0;
+  auto take = [&](void* out, std::size_t n) {
+    if (bytes.size() - at < n) throw IoError(path + ": cannot read (the HDF5 reader's reply was cut short)");
+    if (n == 0) return;  // an empty vector's data() may be null
+    std::memcpy(out, bytes.data() + at, n);
+    at += n;
+  };
+  std::uint64_t failed = 0, n = 0;
+  take(&failed, sizeof failed);
+  if (failed) {
+    take(&n, sizeof n);
+    std::string error(n, '\0');
+    take(error.data(), n);
+    throw IoError(error);
+  }
+  Raw raw;
+  for (int k = 0; k < 3; ++k) {
+    take(&n, sizeof n);
+    if (n > bytes.size() / sizeof(Row)) throw IoError(path + ": cannot read (the HDF5 reader's reply was cut short)");
+    std::vector<Row>& rows = Slot(raw, k);
+    rows.resize(n);
+    take(rows.data(), n * sizeof(Row));
   }
   return raw;
 }
@@ -214,7 +315,7 @@ void Trim(std::vector<Sample>* v, double t0, double t1) {
 
 MitRecording ReadMitPush(const std::string& path, const MitReadOptions& o) {
   const bool json = path.size() >= 5 && path.compare(path.size() - 5, 5, ".json") == 0;
-  Raw raw = json ? ReadJson(path) : ReadH5(path);
+  Raw raw = json ? ReadJson(path) : ReadH5InChild(path);
   MitRecording rec;
   rec.file = path;
   for (int k = 0; k < 3; ++k) Clean(&Slot(raw, k), path, kDatasets[k], &rec);

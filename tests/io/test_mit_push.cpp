@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <algorithm>
 #include <fstream>
 #include <iterator>
 #include <iomanip>
@@ -149,6 +150,30 @@ TEST_F(MitPush, FrozenSyntheticSensorAndJsonVariant) {
   EXPECT_TRUE(rec.force_frozen);
   EXPECT_TRUE(rec.streams.force.empty());
   EXPECT_EQ(rec.streams.object_pose.size(), 200u);
+}
+
+// A finding of fuzz_mit_hdf5: a real recording whose root group's B-tree address (bytes 168 to
+// 175 of the shared files) is overwritten by 0xFF made libhdf5 1.10 copy from a null buffer
+// inside H5Lexists; the tool died with SIGSEGV. The reader now runs HDF5 in a child process.
+TEST_F(MitPush, AFileThatCrashesTheHdf5LibraryIsAClearError) {
+  const std::string file = FirstFile("ellip1");
+  if (file.empty()) GTEST_SKIP() << "MIT sample not found under " << kData;
+  std::ifstream in(file, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(bytes.size(), 176u);
+  std::fill(bytes.begin() + 168, bytes.begin() + 176, '\xff');
+  const std::string broken = (dir_ / "root_btree_undefined.h5").string();
+  std::ofstream(broken, std::ios::binary) << bytes;
+  try {
+    io::ReadMitPush(broken);
+    ADD_FAILURE() << "no error";
+  } catch (const io::IoError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(broken), std::string::npos) << what;
+    EXPECT_NE(what.find("corrupt HDF5"), std::string::npos) << what;
+  }
+  // The process is intact and reads the unbroken file as before, twice (no HDF5 state left behind).
+  for (int i = 0; i < 2; ++i) EXPECT_GT(io::ReadMitPush(file).streams.object_pose.size(), 100u);
 }
 
 TEST_F(MitPush, BrokenFilesGetClearErrors) {
