@@ -148,7 +148,7 @@ void Incremental(benchmark::State& state, bool covariance) {
 void BM_IncrementalQs(benchmark::State& s) { Incremental(s, false); }
 void BM_IncrementalQsWithCovariance(benchmark::State& s) { Incremental(s, true); }
 // Args: steps, update every k steps (0: every 5 object samples), solver (0 chain, 1 Ceres).
-// An update at every step (the 250 Hz sensor rate) keeps a 25-step window; 50000 steps (200 s of
+// An update at every step (the 250 Hz sensor rate) keeps a 15-step window; 50000 steps (200 s of
 // pushing) with the chain solver only (Ceres' per-call overhead makes it minutes).
 BENCHMARK(BM_IncrementalQs)
     ->ArgsProduct({{500, 2000, 8000}, {0}, {0, 1}})

@@ -227,15 +227,18 @@ struct FixedLagSmoother {
     for (int i = 0; i < inv.size(); ++i) inv[i] = inv[i] > 1e-12 * emax ? 1.0 / inv[i] : 0.0;
     const Eigen::MatrixXd Hrr_inv = er.eigenvectors() * inv.asDiagonal() * er.eigenvectors().transpose();
     const Eigen::MatrixXd Hsr = H.bottomLeftCorner(sep_dim, removed_dim);
+    const std::vector<double*> sep(order.begin() + removed.size(), order.end());
+    const std::vector<int> sep_sizes(order_sizes.begin() + removed.size(), order_sizes.end());
+    const Eigen::VectorXd x_bar = Values(sep, sep_sizes);  // the separator's linearization point
     if (cfg.incremental_smoothing) {
       StepConditional c;
       c.step = s;
       c.removed = removed;
-      c.separator.assign(order.begin() + removed.size(), order.end());
+      c.separator = sep;
       c.removed_sizes.assign(order_sizes.begin(), order_sizes.begin() + removed.size());
-      c.separator_sizes.assign(order_sizes.begin() + removed.size(), order_sizes.end());
+      c.separator_sizes = sep_sizes;
       c.removed_lin = Values(c.removed, c.removed_sizes);
-      c.separator_lin = Values(c.separator, c.separator_sizes);
+      c.separator_lin = x_bar;
       c.G = -Hrr_inv * Hsr.transpose();
       if (cfg.covariance) {
         std::vector<int> informative;
@@ -264,24 +267,14 @@ struct FixedLagSmoother {
       S.row(i) = std::sqrt(lambda) * u.transpose();
       r0[i] = u.dot(bm) / std::sqrt(lambda);
     }
-    std::vector<double*> sep(order.begin() + removed.size(), order.end());
-    std::vector<int> sizes;
-    Eigen::VectorXd x_bar(sep_dim);
-    int off = 0;
-    for (double* p : sep) {
-      const int n = problem->ParameterBlockSize(p);
-      sizes.push_back(n);
-      for (int j = 0; j < n; ++j) x_bar[off + j] = p[j];
-      off += n;
-    }
-    problem->AddResidualBlock(new MarginalPriorFactor(sizes, x_bar, S, r0), nullptr, sep);
+    problem->AddResidualBlock(new MarginalPriorFactor(sep_sizes, x_bar, S, r0), nullptr, sep);
   }
 
   // The window's length in steps (0: in time, window_duration).
   int WindowSteps() const {
     if (cfg.incremental_window_steps > 0) return cfg.incremental_window_steps;
-    // At least ten updates' worth: a window of three 5-step updates left the notched block's
-    // pushes 20 to 60 % above batch (tests/python), ten of them within batch's spread.
+    // At least ten updates' worth: a window of three 5-step updates left two of three notched-block
+    // pushes 27 % and 58 % above batch (tests/python); with ten, all three were at or below it.
     return cfg.incremental_update_every_steps > 0
                ? std::max(kDefaultWindowStepsAtSensorRate, 10 * cfg.incremental_update_every_steps)
                : 0;
@@ -372,7 +365,7 @@ struct FixedLagSmoother {
   // Sigma_rr = H_rr^-1 + G Sigma_ss G^T, is the same algebra in time order, and it is unstable
   // here: with a stiff constant-velocity prior G extrapolates backwards (|G| up to 20 on an MIT
   // recording) and rounding in the frontier's nearly singular covariance of two consecutive
-  // poses grew to -1e164 within 400 steps.
+  // poses grew to -1e164 within 450 steps.
   void SmoothBackwards() {
     for (int k = static_cast<int>(conditionals.size()) - 1; k >= 0; --k) {
       const StepConditional& c = conditionals[k];
@@ -382,12 +375,7 @@ struct FixedLagSmoother {
         for (int j = 0; j < c.removed_sizes[q]; ++j) c.removed[q][j] = x_r[off + j];
         off += c.removed_sizes[q];
       }
-      StateEstimate& state = states[c.step];
-      const StateEstimate fresh = builder.State(c.step);
-      state.object_pose = fresh.object_pose;
-      state.finger_pose = fresh.finger_pose;
-      state.contact = fresh.contact;
-      state.force = fresh.force;
+      states[c.step] = builder.State(c.step);  // covariances: SmoothedCovariances
     }
     if (cfg.covariance) SmoothedCovariances();
     conditionals.clear();

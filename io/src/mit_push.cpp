@@ -66,6 +66,8 @@ Raw ReadH5(const std::string& path) {
   std::string stage = "open";
   try {
     H5::H5File file(path, H5F_ACC_RDONLY);
+    std::error_code size_ec;
+    const double file_bytes = static_cast<double>(std::filesystem::file_size(path, size_ec));
     for (int k = 0; k < 3; ++k) {
       stage = std::string("dataset '") + kDatasets[k] + "'";
       if (!file.nameExists(kDatasets[k])) throw IoError(path + ": missing dataset '" + std::string(kDatasets[k]) + "'");
@@ -82,8 +84,6 @@ Raw ReadH5(const std::string& path) {
         throw IoError(path + ": dataset '" + kDatasets[k] + "' is not numeric");
       // A header that claims more rows than the file can hold (corrupt, or a fuzzer's) must not
       // become a huge allocation: even compressed, 8-byte values rarely shrink 64-fold.
-      std::error_code size_ec;
-      const double file_bytes = static_cast<double>(std::filesystem::file_size(path, size_ec));
       const double claimed_bytes = static_cast<double>(dims[0]) * 4.0 * sizeof(double);
       if (!size_ec && claimed_bytes > 64.0 * file_bytes + 4096.0)
         throw IoError(path + ": dataset '" + kDatasets[k] + "' claims " + std::to_string(dims[0]) +
