@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <sstream>
 #include <string>
 
 namespace pushgraph::graph::internal {
@@ -95,7 +96,22 @@ double ForceFaultBound(double force_p95, const push::ObjectDescription& object) 
 void ValidateTrajectory(const push::Trajectory& traj) {
   if (traj.object.shape.empty()) throw GraphError("trajectory: object.shape is missing or empty");
   if (traj.finger.shape.empty()) throw GraphError("trajectory: finger.shape is missing or empty");
+  // Pushes with several fingers or contacts are simulated and stored (push::MultiPushingModel,
+  // "fingers" in the file format), but the factor graphs model one point contact.
+  if (!traj.extra_fingers.empty())
+    throw GraphError("trajectory: " + std::to_string(push::FingerCount(traj)) +
+                     " fingers: the estimator models one finger with one contact (several fingers are not estimated yet)");
   const auto& m = traj.measured;
+  for (std::size_t i = 1; i < m.contact_point.size(); ++i) {
+    if (m.contact_point[i].t == m.contact_point[i - 1].t) {
+      std::ostringstream text;
+      text.precision(17);
+      text << "trajectory: streams.contact_point[" << i - 1 << "] and [" << i << "] are two contacts at t = "
+           << m.contact_point[i].t
+           << " s: the estimator models one point contact (several contacts at once are not estimated yet)";
+      throw GraphError(text.str());
+    }
+  }
   for (std::size_t i = 0; i < m.object_pose.size(); ++i) {
     CheckFinite(std::isfinite(m.object_pose[i].t) && m.object_pose[i].pose.vector().allFinite(), "object_pose", i);
   }

@@ -72,63 +72,106 @@ class Reader {
     }
   }
 
-  // Rows [t, v1, ..., vn]; sorted by time (stable), duplicates rejected.
+  // Rows [t, v1, ..., vn], or [t, i, v1, ..., vn] with a finger index i when `fingers` > 1: one
+  // time-sorted (stable) list per finger; a repeated time is an error unless `repeats` (several
+  // contacts of one finger at once).
   template <typename Sample, typename Make>
-  std::vector<Sample> Rows(const json& value, std::size_t width, const std::string& path, Make make) const {
+  std::vector<std::vector<Sample>> Rows(const json& value, std::size_t width, const std::string& path, Make make,
+                                        int fingers = 1, bool repeats = false) const {
     if (!value.is_array()) Fail(path, "must be an array of rows");
-    std::vector<Sample> out;
-    out.reserve(value.size());
+    const bool indexed = fingers > 1;
+    const std::size_t row_width = width + (indexed ? 1 : 0);
+    std::vector<std::vector<Sample>> out(static_cast<std::size_t>(fingers));
+    std::vector<std::vector<std::size_t>> row_of(out.size());  // file row of each sample
     for (std::size_t i = 0; i < value.size(); ++i) {
       const std::string row_path = path + "[" + std::to_string(i) + "]";
       const json& row = value[i];
-      if (!row.is_array() || row.size() != width)
-        Fail(row_path, "must be a row of " + std::to_string(width) + " numbers, got " + row.dump());
-      std::vector<double> v(width);
-      for (std::size_t k = 0; k < width; ++k) v[k] = Number(row[k], row_path + "[" + std::to_string(k) + "]");
-      out.push_back(make(v));  // out[i] is row [i] of the file
+      if (!row.is_array() || row.size() != row_width)
+        Fail(row_path, "must be a row of " + std::to_string(row_width) + " numbers" +
+                           (indexed ? " [t, finger, ...]" : "") + ", got " + row.dump());
+      std::vector<double> v;
+      v.reserve(width);
+      std::size_t finger = 0;
+      for (std::size_t k = 0; k < row_width; ++k) {
+        const double x = Number(row[k], row_path + "[" + std::to_string(k) + "]");
+        if (indexed && k == 1) {
+          if (x != std::floor(x) || x < 0.0 || x >= fingers)
+            Fail(row_path + "[1]", "finger index " + Text(x) + " is not one of the " + std::to_string(fingers) +
+                                       " fingers (0 to " + std::to_string(fingers - 1) + ")");
+          finger = static_cast<std::size_t>(x);
+        } else {
+          v.push_back(x);
+        }
+      }
+      out[finger].push_back(make(v));
+      row_of[finger].push_back(i);
     }
+    for (std::size_t f = 0; f < out.size(); ++f) out[f] = Sorted(std::move(out[f]), row_of[f], path, repeats, indexed ? static_cast<int>(f) : -1);
+    return out;
+  }
+
+  template <typename Sample>
+  std::vector<Sample> Sorted(std::vector<Sample> rows, const std::vector<std::size_t>& row_of, const std::string& path,
+                             bool repeats, int finger) const {
+    const std::string whose = finger >= 0 ? " of finger " + std::to_string(finger) : "";
     if (notes_ != nullptr) {
       std::size_t late = 0, first = 0;
-      double latest = out.empty() ? 0.0 : out[0].t;
-      for (std::size_t i = 1; i < out.size(); ++i) {
-        if (out[i].t < latest && late++ == 0) first = i;  // after a later stamp
-        latest = std::max(latest, out[i].t);
+      double latest = rows.empty() ? 0.0 : rows[0].t;
+      for (std::size_t i = 1; i < rows.size(); ++i) {
+        if (rows[i].t < latest && late++ == 0) first = row_of[i];  // after a later stamp
+        latest = std::max(latest, rows[i].t);
       }
       if (late > 0) {
-        notes_->push_back(path + ": sorted " + std::to_string(late) + " row(s) that came after a later time stamp (first: row [" +
-                          std::to_string(first) + "])");
+        notes_->push_back(path + ": sorted " + std::to_string(late) + " row(s)" + whose +
+                          " that came after a later time stamp (first: row [" + std::to_string(first) + "])");
       }
     }
-    std::vector<std::size_t> order(out.size());  // rows in time order
+    std::vector<std::size_t> order(rows.size());  // rows in time order
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return out[a].t < out[b].t; });
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return rows[a].t < rows[b].t; });
     std::vector<Sample> sorted;
-    sorted.reserve(out.size());
+    sorted.reserve(rows.size());
     for (std::size_t i = 0; i < order.size(); ++i) {
-      if (i > 0 && out[order[i]].t == out[order[i - 1]].t) {
+      if (!repeats && i > 0 && rows[order[i]].t == rows[order[i - 1]].t) {
         std::ostringstream o;
         o.precision(17);
-        o << "rows [" << order[i - 1] << "] and [" << order[i] << "] have the same time stamp "
-          << out[order[i]].t;
+        o << "rows [" << row_of[order[i - 1]] << "] and [" << row_of[order[i]] << "]" << whose
+          << " have the same time stamp " << rows[order[i]].t;
         Fail(path, o.str());
       }
-      sorted.push_back(out[order[i]]);
+      sorted.push_back(rows[order[i]]);
     }
     return sorted;
   }
 
-  Streams StreamsOf(const json& value, const std::string& path) const {
+  // The object's and finger 0's streams; `extra` receives fingers 1.. (rows carry the finger
+  // index when there are several fingers).
+  Streams StreamsOf(const json& value, const std::string& path, int fingers = 1,
+                    std::vector<push::FingerStreams>* extra = nullptr) const {
     CheckKeys(value, {"object_pose", "finger_pose", "contact_point", "force"}, path);
     Streams s;
+    std::vector<push::FingerStreams> others(static_cast<std::size_t>(fingers - 1));
     auto pose = [](const std::vector<double>& v) { return PoseSample{v[0], {v[1], v[2], v[3]}}; };
-    if (value.contains("object_pose")) s.object_pose = Rows<PoseSample>(value["object_pose"], 4, path + ".object_pose", pose);
-    if (value.contains("finger_pose")) s.finger_pose = Rows<PoseSample>(value["finger_pose"], 4, path + ".finger_pose", pose);
-    if (value.contains("contact_point"))
-      s.contact_point = Rows<PointSample>(value["contact_point"], 3, path + ".contact_point",
-                                          [](const std::vector<double>& v) { return PointSample{v[0], {v[1], v[2]}}; });
-    if (value.contains("force"))
-      s.force = Rows<ForceSample>(value["force"], 3, path + ".force",
-                                  [](const std::vector<double>& v) { return ForceSample{v[0], {v[1], v[2]}}; });
+    if (value.contains("object_pose")) s.object_pose = Rows<PoseSample>(value["object_pose"], 4, path + ".object_pose", pose)[0];
+    if (value.contains("finger_pose")) {
+      auto rows = Rows<PoseSample>(value["finger_pose"], 4, path + ".finger_pose", pose, fingers);
+      s.finger_pose = std::move(rows[0]);
+      for (std::size_t k = 1; k < rows.size(); ++k) others[k - 1].finger_pose = std::move(rows[k]);
+    }
+    if (value.contains("contact_point")) {
+      auto rows = Rows<PointSample>(value["contact_point"], 3, path + ".contact_point",
+                                    [](const std::vector<double>& v) { return PointSample{v[0], {v[1], v[2]}}; }, fingers,
+                                    /*repeats=*/true);
+      s.contact_point = std::move(rows[0]);
+      for (std::size_t k = 1; k < rows.size(); ++k) others[k - 1].contact_point = std::move(rows[k]);
+    }
+    if (value.contains("force")) {
+      auto rows = Rows<ForceSample>(value["force"], 3, path + ".force",
+                                    [](const std::vector<double>& v) { return ForceSample{v[0], {v[1], v[2]}}; }, fingers);
+      s.force = std::move(rows[0]);
+      for (std::size_t k = 1; k < rows.size(); ++k) others[k - 1].force = std::move(rows[k]);
+    }
+    if (extra) *extra = std::move(others);
     return s;
   }
 
@@ -165,17 +208,36 @@ json SigmasJson(const push::MeasurementSigmas& s) {
           {"force", s.force}};
 }
 
-json StreamsJson(const Streams& s) {
+// With extra fingers, finger rows carry the finger's index after the time, in time order.
+json StreamsJson(const Streams& s, const std::vector<const push::FingerStreams*>& extra = {}) {
+  const bool indexed = !extra.empty();
+  auto rows = [&](auto finger_0, auto of_extra, auto values) {
+    std::vector<std::pair<double, json>> all;
+    auto add = [&](const auto& samples, int finger) {
+      for (const auto& p : samples) {
+        json row = json::array({p.t});
+        if (indexed) row.push_back(finger);
+        for (double v : values(p)) row.push_back(v);
+        all.emplace_back(p.t, std::move(row));
+      }
+    };
+    add(finger_0, 0);
+    for (std::size_t k = 0; k < extra.size(); ++k) add(of_extra(*extra[k]), static_cast<int>(k + 1));
+    std::stable_sort(all.begin(), all.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    json out = json::array();
+    for (auto& r : all) out.push_back(std::move(r.second));
+    return out;
+  };
+  auto pose = [](const PoseSample& p) { return std::vector<double>{p.pose.x, p.pose.y, p.pose.theta}; };
   json out = json::object();
-  json op = json::array(), fp = json::array(), cp = json::array(), f = json::array();
+  json op = json::array();
   for (const PoseSample& p : s.object_pose) op.push_back({p.t, p.pose.x, p.pose.y, p.pose.theta});
-  for (const PoseSample& p : s.finger_pose) fp.push_back({p.t, p.pose.x, p.pose.y, p.pose.theta});
-  for (const PointSample& p : s.contact_point) cp.push_back({p.t, p.point.x(), p.point.y()});
-  for (const ForceSample& p : s.force) f.push_back({p.t, p.force.x(), p.force.y()});
   out["object_pose"] = op;
-  out["finger_pose"] = fp;
-  out["contact_point"] = cp;
-  out["force"] = f;
+  out["finger_pose"] = rows(s.finger_pose, [](const push::FingerStreams& f) -> const auto& { return f.finger_pose; }, pose);
+  out["contact_point"] = rows(s.contact_point, [](const push::FingerStreams& f) -> const auto& { return f.contact_point; },
+                              [](const PointSample& p) { return std::vector<double>{p.point.x(), p.point.y()}; });
+  out["force"] = rows(s.force, [](const push::FingerStreams& f) -> const auto& { return f.force; },
+                      [](const ForceSample& p) { return std::vector<double>{p.force.x(), p.force.y()}; });
   return out;
 }
 
@@ -190,7 +252,7 @@ Trajectory ParseTrajectoryJson(const std::string& text, const std::string& sourc
   }
   if (const std::string dup = geometry::FindDuplicateJsonKey(text); !dup.empty()) throw IoError(source + ": " + dup);
   const Reader r(source, notes);
-  r.CheckKeys(doc, {"format", "object", "finger", "streams", "ground_truth", "measurement_sigmas"}, "top level");
+  r.CheckKeys(doc, {"format", "object", "finger", "fingers", "streams", "ground_truth", "measurement_sigmas"}, "top level");
   const json& format = r.Require(doc, "format", "top level");
   if (!format.is_string() || format.get<std::string>() != kTrajectoryFormat)
     r.Fail("format", std::string("expected \"") + kTrajectoryFormat + "\", got " + format.dump());
@@ -206,12 +268,37 @@ Trajectory ParseTrajectoryJson(const std::string& text, const std::string& sourc
     if (!object["pressure"].is_string() || object["pressure"].get<std::string>() != "uniform")
       r.Fail("object.pressure", "only \"uniform\" is supported in trajectory files, got " + object["pressure"].dump());
   }
-  const json& finger = r.Require(doc, "finger", "top level");
-  r.CheckKeys(finger, {"shape", "mu_contact"}, "finger");
-  t.finger.shape = r.ShapeOf(r.Require(finger, "shape", "finger"), "finger.shape");
-  t.finger.mu_contact = r.NonNegative(r.Require(finger, "mu_contact", "finger"), "finger.mu_contact");
-  if (doc.contains("streams")) t.measured = r.StreamsOf(doc["streams"], "streams");
-  if (doc.contains("ground_truth")) t.ground_truth = r.StreamsOf(doc["ground_truth"], "ground_truth");
+  // "finger": one finger; "fingers": [finger 0, finger 1, ...] (not both).
+  if (doc.contains("finger") == doc.contains("fingers"))
+    r.Fail("top level", doc.contains("finger") ? "has both \"finger\" and \"fingers\": give one"
+                                                : "missing field \"finger\" (or \"fingers\")");
+  std::vector<push::FingerDescription> fingers;
+  auto finger_of = [&](const json& finger, const std::string& path) {
+    r.CheckKeys(finger, {"shape", "mu_contact"}, path);
+    push::FingerDescription f;
+    f.shape = r.ShapeOf(r.Require(finger, "shape", path), path + ".shape");
+    f.mu_contact = r.NonNegative(r.Require(finger, "mu_contact", path), path + ".mu_contact");
+    return f;
+  };
+  if (doc.contains("finger")) {
+    fingers.push_back(finger_of(doc["finger"], "finger"));
+  } else {
+    const json& list = doc["fingers"];
+    if (!list.is_array() || list.empty()) r.Fail("fingers", "must be a non-empty array of fingers");
+    for (std::size_t i = 0; i < list.size(); ++i) fingers.push_back(finger_of(list[i], "fingers[" + std::to_string(i) + "]"));
+  }
+  t.finger = fingers[0];
+  const int count = static_cast<int>(fingers.size());
+  std::vector<push::FingerStreams> measured_extra, truth_extra;
+  if (doc.contains("streams")) t.measured = r.StreamsOf(doc["streams"], "streams", count, &measured_extra);
+  if (doc.contains("ground_truth")) t.ground_truth = r.StreamsOf(doc["ground_truth"], "ground_truth", count, &truth_extra);
+  for (int k = 1; k < count; ++k) {
+    push::ExtraFinger e;
+    e.finger = fingers[k];
+    if (!measured_extra.empty()) e.measured = std::move(measured_extra[k - 1]);
+    if (t.ground_truth) e.ground_truth = std::move(truth_extra[k - 1]);
+    t.extra_fingers.push_back(std::move(e));
+  }
   if (doc.contains("measurement_sigmas"))
     t.measurement_sigmas = r.SigmasOf(doc["measurement_sigmas"], "measurement_sigmas");
   return t;
@@ -238,15 +325,33 @@ std::string TrajectoryToJson(const Trajectory& t, int indent) {
                  {"mass", t.object.mass},
                  {"mu_surface", t.object.mu_surface},
                  {"pressure", "uniform"}};
-  json finger = {{"shape", ShapeJson(t.finger.shape)}, {"mu_contact", t.finger.mu_contact}};
+  auto finger_json = [](const push::FingerDescription& f) {
+    return json{{"shape", ShapeJson(f.shape)}, {"mu_contact", f.mu_contact}};
+  };
+  const bool several = !t.extra_fingers.empty();
+  const char* finger_key = several ? "fingers" : "finger";
+  json finger = finger_json(t.finger);
+  std::vector<const push::FingerStreams*> measured_extra, truth_extra;
+  if (several) {
+    finger = json::array({finger});
+    for (const push::ExtraFinger& e : t.extra_fingers) {
+      finger.push_back(finger_json(e.finger));
+      measured_extra.push_back(&e.measured);
+      if (t.ground_truth && !e.ground_truth)
+        throw IoError("trajectory JSON: extra finger " + std::to_string(measured_extra.size()) +
+                      " has no ground truth while the trajectory has");
+      if (e.ground_truth) truth_extra.push_back(&*e.ground_truth);
+    }
+  }
   if (indent < 0) {
-    json doc = {{"format", kTrajectoryFormat}, {"object", object}, {"finger", finger}, {"streams", StreamsJson(t.measured)}};
-    if (t.ground_truth) doc["ground_truth"] = StreamsJson(*t.ground_truth);
+    json doc = {{"format", kTrajectoryFormat}, {"object", object}, {finger_key, finger},
+                {"streams", StreamsJson(t.measured, measured_extra)}};
+    if (t.ground_truth) doc["ground_truth"] = StreamsJson(*t.ground_truth, truth_extra);
     if (t.measurement_sigmas) doc["measurement_sigmas"] = SigmasJson(*t.measurement_sigmas);
     return doc.dump();
   }
-  auto streams = [](const Streams& s) {
-    const json j = StreamsJson(s);
+  auto streams = [](const Streams& s, const std::vector<const push::FingerStreams*>& extra) {
+    const json j = StreamsJson(s, extra);
     std::string out = "{";
     bool first_stream = true;
     for (const char* key : {"object_pose", "finger_pose", "contact_point", "force"}) {
@@ -259,8 +364,8 @@ std::string TrajectoryToJson(const Trajectory& t, int indent) {
     return out + "\n }";
   };
   std::string out = "{\"format\": \"" + std::string(kTrajectoryFormat) + "\",\n \"object\": " + object.dump() +
-                    ",\n \"finger\": " + finger.dump() + ",\n \"streams\": " + streams(t.measured);
-  if (t.ground_truth) out += ",\n \"ground_truth\": " + streams(*t.ground_truth);
+                    ",\n \"" + finger_key + "\": " + finger.dump() + ",\n \"streams\": " + streams(t.measured, measured_extra);
+  if (t.ground_truth) out += ",\n \"ground_truth\": " + streams(*t.ground_truth, truth_extra);
   if (t.measurement_sigmas) out += ",\n \"measurement_sigmas\": " + SigmasJson(*t.measurement_sigmas).dump();
   return out + "}";
 }

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <string>
 
@@ -37,6 +38,48 @@ void ValidatePlan(const PushPlan& p) {
     Require(std::isfinite(rates[i]) && rates[i] >= 0.0,
             std::string("rates.") + names[i] + " must be finite and >= 0 (got " + std::to_string(rates[i]) + ")");
   ValidateNoise(p.noise);
+  for (std::size_t i = 0; i < p.extra_fingers.size(); ++i)
+    Require(!p.extra_fingers[i].shape.empty(), "extra_fingers[" + std::to_string(i) + "].shape is empty");
+  // Fingers move together at one pose: they must not overlap each other.
+  std::vector<const FingerDescription*> fingers{&p.finger};
+  for (const FingerDescription& f : p.extra_fingers) fingers.push_back(&f);
+  for (std::size_t i = 0; i < fingers.size(); ++i)
+    for (std::size_t j = i + 1; j < fingers.size(); ++j) {
+      const double sd = geometry::ShapePairQuerier(fingers[i]->shape, fingers[j]->shape).Query({}, {}).signed_distance;
+      Require(sd > 0.0, "fingers " + std::to_string(i) + " and " + std::to_string(j) +
+                            " overlap each other (separation " + std::to_string(sd) + " m at the pusher's pose)");
+    }
+}
+
+// All fingers of the plan (finger 0 first).
+std::vector<FingerDescription> AllFingers(const PushPlan& p) {
+  std::vector<FingerDescription> fingers{p.finger};
+  fingers.insert(fingers.end(), p.extra_fingers.begin(), p.extra_fingers.end());
+  return fingers;
+}
+
+// The multi-contact answer summarized as a single-contact response (SimulationState::response).
+PushResponse Summarize(const MultiPushResponse& r) {
+  PushResponse out;
+  out.touching = r.touching;
+  out.twist = r.twist;
+  out.load = r.load;
+  out.force = r.finger_force.empty() ? Vec2::Zero() : r.finger_force[0];
+  out.torque_residual = r.wrench_residual;
+  if (!r.contacts.empty()) {
+    out.contact_point = r.contacts[0].point;
+    out.contact_normal = r.contacts[0].normal;
+    out.separation = r.contacts[0].separation;
+  }
+  if (r.moving) {
+    // The step's mode: sliding if any contact slides, else sticking if any sticks.
+    out.mode = ContactMode::kSeparated;
+    for (const ContactState& c : r.contacts) {
+      if (c.mode == ContactMode::kSliding) out.mode = ContactMode::kSliding;
+      if (c.mode == ContactMode::kSticking && out.mode == ContactMode::kSeparated) out.mode = ContactMode::kSticking;
+    }
+  }
+  return out;
 }
 
 // Direction of the path just after arc length s; zero once the path has ended.
@@ -88,16 +131,35 @@ std::vector<Vec2> StraightPushPath(const PushPlan& plan, double push_angle, doub
   const Vec2 centroid = geometry::Act(plan.object_pose, MakeSupport(area_spec).centroid);
   const Vec2 u(std::cos(push_angle), std::sin(push_angle));
   const Vec2 left(-u.y(), u.x());
-  const geometry::Box2 ob = plan.object.shape.bounds(), fb = plan.finger.shape.bounds();
+  const geometry::Box2 ob = plan.object.shape.bounds();
+  geometry::Box2 fb = plan.finger.shape.bounds();
+  for (const FingerDescription& f : plan.extra_fingers) {
+    if (f.shape.empty()) continue;
+    fb.min = fb.min.cwiseMin(f.shape.bounds().min);
+    fb.max = fb.max.cwiseMax(f.shape.bounds().max);
+  }
   const double reach = (ob.max - ob.min).norm() + (fb.max - fb.min).norm() + fb.max.norm() + fb.min.norm() +
                        (plan.object_pose.translation() - centroid).norm() + standoff + 0.01;
   const Vec2 start_far = centroid + offset * left - reach * u;
-  const geometry::ShapePairQuerier querier(plan.object.shape, plan.finger.shape);
+  std::vector<geometry::ShapePairQuerier> queriers;
+  for (const FingerDescription& f : AllFingers(plan)) {
+    if (f.shape.empty()) throw PushError("StraightPushPath: empty finger");
+    queriers.emplace_back(plan.object.shape, f.shape);
+  }
+  // The separation of the nearest finger (all fingers share the pusher's pose).
+  struct {
+    const std::vector<geometry::ShapePairQuerier>& queriers;
+    double Query(const Pose2& object, const Pose2& pusher) const {
+      double best = std::numeric_limits<double>::infinity();
+      for (const auto& q : queriers) best = std::min(best, q.Query(object, pusher).signed_distance);
+      return best;
+    }
+  } nearest{queriers};
   // Conservative advancement along +u until the separation equals the standoff.
   double travelled = 0.0;
   for (int iteration = 0; iteration < 100000; ++iteration) {
     const Vec2 p = start_far + travelled * u;
-    const double sd = querier.Query(plan.object_pose, Pose2{p.x(), p.y(), plan.finger_theta}).signed_distance;
+    const double sd = nearest.Query(plan.object_pose, Pose2{p.x(), p.y(), plan.finger_theta});
     if (sd - standoff <= 1e-12) {
       if (sd < 0.5 * standoff) throw PushError("StraightPushPath: the finger would start in contact");
       // The travel to first contact along u (longer than the separation when the line meets
@@ -108,7 +170,7 @@ std::vector<Vec2> StraightPushPath(const PushPlan& plan, double push_angle, doub
         to_contact += gap;
         if (to_contact > 2.0 * reach) break;
         const Vec2 q = start + to_contact * u;
-        gap = querier.Query(plan.object_pose, Pose2{q.x(), q.y(), plan.finger_theta}).signed_distance;
+        gap = nearest.Query(plan.object_pose, Pose2{q.x(), q.y(), plan.finger_theta});
       }
       if (gap > 1e-9)
         throw PushError("StraightPushPath: the push line (angle " + std::to_string(push_angle) + " rad, offset " +
@@ -125,6 +187,9 @@ std::vector<Vec2> StraightPushPath(const PushPlan& plan, double push_angle, doub
 
 SimulationResult Simulate(const PushPlan& plan) {
   ValidatePlan(plan);
+  const std::vector<FingerDescription> fingers = AllFingers(plan);
+  const std::size_t finger_count = fingers.size();
+  const bool multi = plan.multi_contact || finger_count > 1;
   PushingSpec spec;
   spec.object = plan.object;
   spec.finger = plan.finger;
@@ -132,6 +197,16 @@ SimulationResult Simulate(const PushPlan& plan) {
   spec.contact_tolerance = plan.contact_tolerance;
   spec.penetration_tolerance = plan.penetration_tolerance;
   const PushingModel model(spec);
+  std::optional<MultiPushingModel> multi_model;
+  if (multi) {
+    MultiPushingSpec m;
+    m.object = plan.object;
+    m.fingers = fingers;
+    m.surface = plan.surface;
+    m.contact_tolerance = plan.contact_tolerance;
+    m.penetration_tolerance = plan.penetration_tolerance;
+    multi_model.emplace(std::move(m));
+  }
 
   const double path_length = PathLength(plan.waypoints);
   const double duration = plan.duration > 0.0 ? plan.duration : path_length / plan.speed;
@@ -155,24 +230,55 @@ SimulationResult Simulate(const PushPlan& plan) {
   traj.object = plan.object;
   traj.finger = plan.finger;
   Streams truth;
+  std::vector<FingerStreams> extra_truth(finger_count - 1);
 
   const Vec2 start = PathPoint(plan.waypoints, 0.0);
   Pose2 object = plan.object_pose;
   Pose2 finger{start.x(), start.y(), plan.finger_theta};
-  const double initial_separation = model.querier().Query(object, finger).signed_distance;
-  if (initial_separation < -plan.contact_tolerance)
-    throw PushError("PushPlan: the finger starts inside the object (separation " +
-                            std::to_string(initial_separation) + " m)");
+  for (std::size_t i = 0; i < finger_count; ++i) {
+    const double initial_separation =
+        geometry::ShapePairQuerier(plan.object.shape, fingers[i].shape).Query(object, finger).signed_distance;
+    if (initial_separation < -plan.contact_tolerance)
+      throw PushError("PushPlan: " + (finger_count > 1 ? "finger " + std::to_string(i) : std::string("the finger")) +
+                      " starts inside the object (separation " + std::to_string(initial_separation) + " m)");
+  }
+  auto poses = [&](const Pose2& f) { return std::vector<Pose2>(finger_count, f); };
+  auto motions = [&](const Vec2& d) { return std::vector<Vec2>(finger_count, d); };
+  auto separation_of = [&](const Pose2& o, const Pose2& f) {
+    return multi ? multi_model->Separation(o, poses(f)) : model.querier().Query(o, f).signed_distance;
+  };
   SimulationStats& stats = result.stats;
 
   auto record = [&](double t, unsigned streams) {
     const double s = std::min(plan.speed * t, path_length);
     const Vec2 direction = s < path_length ? PathDirection(plan.waypoints, s) : Vec2::Zero();
-    SimulationState state{t, object, finger, model.Respond(object, finger, plan.speed * direction)};
+    SimulationState state{t, object, finger, {}, std::nullopt};
+    if (multi) {
+      state.contacts = multi_model->Respond(object, poses(finger), motions(plan.speed * direction));
+      state.response = Summarize(*state.contacts);
+    } else {
+      state.response = model.Respond(object, finger, plan.speed * direction);
+    }
     if (streams & kObject) truth.object_pose.push_back({t, object});
-    if (streams & kFinger) truth.finger_pose.push_back({t, finger});
-    if ((streams & kContact) && state.response.touching) truth.contact_point.push_back({t, state.response.contact_point});
-    if (streams & kForce) truth.force.push_back({t, state.response.force});
+    if (streams & kFinger) {
+      truth.finger_pose.push_back({t, finger});
+      for (FingerStreams& e : extra_truth) e.finger_pose.push_back({t, finger});
+    }
+    if (streams & kContact) {
+      if (multi) {
+        // Every contact, one row each (a finger wedged in a notch: two rows at this time).
+        for (const ContactState& c : state.contacts->contacts) {
+          if (c.finger == 0) truth.contact_point.push_back({t, c.point});
+          else extra_truth[c.finger - 1].contact_point.push_back({t, c.point});
+        }
+      } else if (state.response.touching) {
+        truth.contact_point.push_back({t, state.response.contact_point});
+      }
+    }
+    if (streams & kForce) {
+      truth.force.push_back({t, multi ? state.contacts->finger_force[0] : state.response.force});
+      for (std::size_t k = 1; k < finger_count; ++k) extra_truth[k - 1].force.push_back({t, state.contacts->finger_force[k]});
+    }
     result.states.push_back(state);
   };
 
@@ -195,21 +301,38 @@ SimulationResult Simulate(const PushPlan& plan) {
     const Vec2 displacement = p1 - p0;
     // Follow the path exactly: the finger's reference point is put back on the path
     // (Step moves it by the same displacement; this removes floating-point drift).
-    const PushStep step = model.Step(object, finger, displacement);
-    object = step.object_pose;
+    ContactMode mode;
+    double residual;
+    if (multi) {
+      MultiPushStep step;
+      try {
+        step = multi_model->Step(object, poses(finger), motions(displacement));
+      } catch (const PushError& e) {
+        throw PushError("PushPlan: at t = " + std::to_string(t) + " s: " + e.what());
+      }
+      object = step.object_pose;
+      const PushResponse summary = Summarize(step.response);
+      mode = summary.mode;
+      residual = std::max(step.response.wrench_residual, step.response.kinematic_residual);
+    } else {
+      const PushStep step = model.Step(object, finger, displacement);
+      object = step.object_pose;
+      mode = step.response.mode;
+      residual = step.response.torque_residual;
+    }
     finger = {p1.x(), p1.y(), plan.finger_theta};
     ++stats.steps;
-    switch (step.response.mode) {
+    switch (mode) {
       case ContactMode::kSticking: ++stats.sticking_steps; break;
       case ContactMode::kSliding: ++stats.sliding_steps; break;
       case ContactMode::kSeparated: ++stats.separated_steps; break;
     }
-    const double separation = model.querier().Query(object, finger).signed_distance;
+    const double separation = separation_of(object, finger);
     stats.max_penetration = std::max(stats.max_penetration, -separation);
-    if (step.response.mode != ContactMode::kSeparated) {
+    if (mode != ContactMode::kSeparated) {
       stats.contact_time += t_next - t;
       stats.max_gap_in_contact = std::max(stats.max_gap_in_contact, separation);
-      stats.max_torque_residual = std::max(stats.max_torque_residual, step.response.torque_residual);
+      stats.max_torque_residual = std::max(stats.max_torque_residual, residual);
     }
     t = t_next;
     if (at_sample) {
@@ -222,6 +345,13 @@ SimulationResult Simulate(const PushPlan& plan) {
 
   traj.measured = ApplyNoise(truth, plan.noise, plan.seed);
   traj.measurement_sigmas = SigmasOf(plan.noise);
+  for (std::size_t k = 0; k + 1 < finger_count; ++k) {
+    // Each finger's own sensors: the finger's streams with the plan's noise, their own seed.
+    const FingerStreams& e = extra_truth[k];
+    const Streams noisy = ApplyNoise(Streams{{}, e.finger_pose, e.contact_point, e.force}, plan.noise,
+                                     plan.seed + 0x9E3779B97F4A7C15ull * (k + 1));
+    traj.extra_fingers.push_back({fingers[k + 1], {noisy.finger_pose, noisy.contact_point, noisy.force}, e});
+  }
   traj.ground_truth = std::move(truth);
   return result;
 }

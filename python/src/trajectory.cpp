@@ -123,6 +123,10 @@ void CheckKeys(const py::dict& d, const std::vector<std::string>& allowed, const
 }  // namespace
 
 py::dict TrajectoryToDict(const Trajectory& t) {
+  // The dict carries one finger; a multi-finger push would lose its other fingers silently.
+  if (!t.extra_fingers.empty())
+    throw py::value_error("trajectory with " + std::to_string(pushgraph::push::FingerCount(t)) +
+                          " fingers: the Python binding carries one finger (several fingers are not exposed yet)");
   py::dict d;
   py::dict object, finger;
   object["shape"] = t.object.shape;

@@ -117,4 +117,67 @@ TEST(TrajectoryJson, BadInputNamesFileAndPath) {
   ExpectError(twice, "duplicate key \"mass\" in /object");
 }
 
+// Several fingers: "fingers" lists them; finger rows carry the finger's index after the time;
+// contact_point may repeat a time (one row per contact); every row goes to its finger.
+std::string MultiDoc(const std::string& streams, const std::string& extra = "") {
+  return R"({"format": "pushgraph-trajectory-1", "object": {"shape": )" + kShape +
+         R"(, "mass": 0.8374, "mu_surface": 0.25}, "fingers": [{"shape": )" + kFinger +
+         R"(, "mu_contact": 0.3}, {"shape": )" + kFinger + R"(, "mu_contact": 0.5}], "streams": )" + streams + extra + "}";
+}
+
+TEST(TrajectoryJson, SeveralFingersRoundTrip) {
+  const auto t = ParseTrajectoryJson(MultiDoc(
+      R"({"object_pose": [[0.0, 0.1, 0.2, 0.3]],
+          "finger_pose": [[0.0, 1, -0.05, 0.02, 0.0], [0.0, 0, -0.05, -0.02, 0.0], [0.004, 0, -0.049, -0.02, 0.0]],
+          "contact_point": [[0.004, 0, -0.045, 0.001], [0.004, 0, -0.045, 0.003], [0.004, 1, -0.045, 0.02]],
+          "force": [[0.004, 1, 1.5, -0.25], [0.004, 0, 1.0, 0.0]]})",
+      R"(, "ground_truth": {"force": [[0.004, 1, 1.4, -0.2]]})"));
+  ASSERT_EQ(t.extra_fingers.size(), 1u);
+  EXPECT_EQ(t.extra_fingers[0].finger.mu_contact, 0.5);
+  ASSERT_EQ(t.measured.finger_pose.size(), 2u);
+  EXPECT_EQ(t.measured.finger_pose[1].pose.x, -0.049);
+  ASSERT_EQ(t.measured.contact_point.size(), 2u);  // two contacts of finger 0 at t = 0.004
+  EXPECT_EQ(t.measured.contact_point[1].point.y(), 0.003);
+  ASSERT_EQ(t.extra_fingers[0].measured.finger_pose.size(), 1u);
+  EXPECT_EQ(t.extra_fingers[0].measured.finger_pose[0].pose.y, 0.02);
+  ASSERT_EQ(t.extra_fingers[0].measured.contact_point.size(), 1u);
+  EXPECT_EQ(t.extra_fingers[0].measured.force[0].force.x(), 1.5);
+  EXPECT_EQ(t.measured.force[0].force.x(), 1.0);
+  ASSERT_TRUE(t.extra_fingers[0].ground_truth.has_value());
+  EXPECT_EQ(t.extra_fingers[0].ground_truth->force[0].force.x(), 1.4);
+  EXPECT_TRUE(t.ground_truth->force.empty());
+  // Written and read back: the same values, rows in time order with their finger's index.
+  const std::string text = TrajectoryToJson(t);
+  EXPECT_NE(text.find("\"fingers\""), std::string::npos);
+  EXPECT_NE(text.find("[0.004,1,1.5,-0.25]"), std::string::npos) << text;
+  const auto back = ParseTrajectoryJson(text);
+  EXPECT_EQ(TrajectoryToJson(back), text);
+  ASSERT_EQ(back.extra_fingers.size(), 1u);
+  EXPECT_EQ(back.extra_fingers[0].measured.contact_point[0].point.y(), 0.02);
+  // One finger: the single-finger form, unchanged.
+  auto one = back;
+  one.extra_fingers.clear();
+  EXPECT_EQ(TrajectoryToJson(one).find("\"fingers\""), std::string::npos);
+}
+
+TEST(TrajectoryJson, SeveralFingersBadInputNamesRowAndFinger) {
+  ExpectError(MultiDoc(R"({"force": [[0.0, 2, 1.0, 0.0]]})"), "streams.force[0][1]: finger index 2 is not one of the 2 fingers");
+  ExpectError(MultiDoc(R"({"force": [[0.0, 0.5, 1.0, 0.0]]})"), "finger index 0.5");
+  ExpectError(MultiDoc(R"({"force": [[0.0, -1, 1.0, 0.0]]})"), "finger index -1");
+  ExpectError(MultiDoc(R"({"force": [[0.0, 1.0, 0.0]]})"), "must be a row of 4 numbers [t, finger, ...]");
+  ExpectError(MultiDoc(R"({"force": [[0.1, 1, 1.0, 0.0], [0.1, 1, 2.0, 0.0]]})"),
+              "rows [0] and [1] of finger 1 have the same time stamp");
+  ExpectError(MultiDoc("{}", R"(, "finger": {"shape": )" + kFinger + R"(, "mu_contact": 0.3})"),
+              "has both \"finger\" and \"fingers\"");
+  ExpectError(R"({"format": "pushgraph-trajectory-1", "object": {"shape": )" + kShape +
+                  R"(, "mass": 1, "mu_surface": 0.25}, "fingers": []})",
+              "fingers: must be a non-empty array");
+  ExpectError(R"({"format": "pushgraph-trajectory-1", "object": {"shape": )" + kShape +
+                  R"(, "mass": 1, "mu_surface": 0.25}, "fingers": [{"shape": )" + kFinger + R"(, "mu_contact": -1}]})",
+              "fingers[0].mu_contact");
+  // A single finger's contact_point may repeat a time (a finger wedged in a notch); other
+  // streams may not.
+  EXPECT_EQ(ParseTrajectoryJson(Doc(R"({"contact_point": [[0.1, 0, 0], [0.1, 1, 0]]})")).measured.contact_point.size(), 2u);
+}
+
 }  // namespace

@@ -7,6 +7,7 @@
 #include <pushgraph/io/trajectory_json.h>
 #include <pushgraph/push/simulator.h>
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <memory>
@@ -43,6 +44,8 @@ struct SimulateOptions {
   double outliers = 0.0;
   std::vector<std::string> frozen;
   bool no_ground_truth = false;
+  std::vector<std::string> finger_paths;  // --fingers: several fingers at the pusher's pose
+  bool multi_contact = false;
 };
 
 void Positive(double value, const std::string& name) {
@@ -71,7 +74,12 @@ std::pair<double, double> ParseWindow(const std::string& text, const std::string
 }
 
 void Run(const SimulateOptions& o) {
-  CheckOutputsAreNew({{"--object", o.object_path}, {"--finger", o.finger_path}}, {{"-o", o.output}});
+  std::vector<NamedPath> inputs{{"--object", o.object_path}, {"--finger", o.finger_path}};
+  for (const std::string& path : o.finger_paths) inputs.push_back({"--fingers", path});
+  CheckOutputsAreNew(inputs, {{"-o", o.output}});
+  if (o.finger_paths.size() == 1)
+    throw CliError("--fingers needs two or more finger files (one finger: --finger FILE, with --multi-contact for "
+                   "all its contacts)");
   push::PushPlan plan;
   Positive(o.mass, "--mass");
   Positive(o.mu_surface, "--mu-surface");
@@ -92,7 +100,12 @@ void Run(const SimulateOptions& o) {
   NonNegative(o.occlusion_scale, "--occlusion-scale");
 
   plan.object = {LoadShapeArgument(o.object_path, "--object"), o.mass, o.mu_surface};
-  plan.finger = {LoadShapeArgument(o.finger_path, "--finger"), o.mu_contact};
+  plan.finger = {LoadShapeArgument(o.finger_paths.empty() ? o.finger_path : o.finger_paths[0],
+                                   o.finger_paths.empty() ? "--finger" : "--fingers"),
+                 o.mu_contact};
+  for (std::size_t i = 1; i < o.finger_paths.size(); ++i)
+    plan.extra_fingers.push_back({LoadShapeArgument(o.finger_paths[i], "--fingers"), o.mu_contact});
+  plan.multi_contact = o.multi_contact;
   plan.surface = o.surface == "ellipsoid" ? push::SurfaceModel::kEllipsoid : push::SurfaceModel::kExact;
   plan.object_pose = ParsePose(o.object_pose, "--object-pose");
   plan.speed = o.speed;
@@ -169,6 +182,12 @@ void Run(const SimulateOptions& o) {
   out["max_gap_in_contact"] = s.max_gap_in_contact;
   out["max_torque_residual"] = s.max_torque_residual;
   out["final_object_pose"] = {end.x, end.y, end.theta};
+  out["fingers"] = push::FingerCount(trajectory);
+  out["multi_contact"] = plan.multi_contact || !plan.extra_fingers.empty();
+  std::size_t most_contacts = 0;
+  for (const push::SimulationState& state : result.states)
+    if (state.contacts) most_contacts = std::max(most_contacts, state.contacts->contacts.size());
+  if (plan.multi_contact || !plan.extra_fingers.empty()) out["max_simultaneous_contacts"] = most_contacts;
   out["samples"] = {{"object_pose", trajectory.measured.object_pose.size()},
                     {"finger_pose", trajectory.measured.finger_pose.size()},
                     {"contact_point", trajectory.measured.contact_point.size()},
@@ -184,7 +203,14 @@ void RegisterSimulate(CLI::App& app) {
   cmd->add_option("-o,--output", o->output, "Trajectory JSON file to write (pushgraph-trajectory-1)")->required();
   cmd->add_option("--object", o->object_path, "Object shape JSON (also the support region; uniform pressure)")
       ->capture_default_str();
-  cmd->add_option("--finger", o->finger_path, "Finger shape JSON (any shape)")->capture_default_str();
+  auto* finger = cmd->add_option("--finger", o->finger_path, "Finger shape JSON (any shape)")->capture_default_str();
+  cmd->add_option("--fingers", o->finger_paths,
+                  "Two or more finger shape JSON files moving together (instead of --finger): every finger has the "
+                  "pusher's pose, placed by its own shape coordinates; all contacts of all fingers are modelled")
+      ->excludes(finger);
+  cmd->add_flag("--multi-contact", o->multi_contact,
+                "Model every contact of the finger (a finger wedged in a notch touches both walls; a flat "
+                "pusher face touches along a segment) instead of the nearest one");
   cmd->add_option("--mass", o->mass, "Object mass in kg (> 0)")->check(MassValue())->capture_default_str();
   cmd->add_option("--mu-surface", o->mu_surface, "Object-table friction coefficient (> 0)")
       ->check(FrictionValue(false))
@@ -246,7 +272,9 @@ void RegisterSimulate(CLI::App& app) {
       "Quasi-static pushing with point contact and Coulomb friction (sticking/sliding by motion cones),\n"
       "exact limit surface unless --surface ellipsoid. Default job: the 5 mm disk finger pushes\n"
       "data/shapes/notched_block.json (0.5 kg) 5 cm along +y, 1 cm left of its centroid, at 5 cm/s.\n"
-      "Streams: object 25 Hz, finger/contact/force 250 Hz. Prints a JSON summary; see docs/simulator.md.");
+      "Streams: object 25 Hz, finger/contact/force 250 Hz. Prints a JSON summary; see docs/simulator.md.\n"
+      "Several contacts (--fingers, --multi-contact): the file lists \"fingers\" and finger rows carry\n"
+      "the finger's index after the time; contact_point has a row per contact (docs/formats.md).");
   cmd->callback([o] { Run(*o); });
 }
 

@@ -21,10 +21,12 @@
 // time t are the model's instantaneous answer for the finger's velocity just after t.
 #include <pushgraph/push/errors.h>
 #include <pushgraph/push/noise.h>
+#include <pushgraph/push/multi_contact.h>
 #include <pushgraph/push/pushing.h>
 #include <pushgraph/push/trajectory.h>
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 namespace pushgraph::push {
@@ -55,6 +57,14 @@ struct PushPlan {
   double penetration_tolerance = 1e-10;  ///< m (PushingSpec::penetration_tolerance)
   NoiseModel noise;                ///< default: no noise
   std::uint64_t seed = 1;
+  /// More fingers moving with the first (a hand with several fingers, two arms, ...): every
+  /// finger has the pusher's pose (the path point, finger_theta), so place each one by its
+  /// shape's own coordinates (e.g. Shape::Disk(r, {0, 0.02})). Fingers must not overlap.
+  std::vector<FingerDescription> extra_fingers;
+  /// Every contact of every finger (MultiPushingModel: a finger wedged in a notch touches both
+  /// walls, a flat pusher face touches along a segment). On whenever extra_fingers is not empty;
+  /// off: one contact, the nearest (PushingModel).
+  bool multi_contact = false;
 };
 
 /// A straight push: the finger starts at separation `standoff` (m) from the object on the line
@@ -74,6 +84,9 @@ struct SimulationState {
   /// For the finger's velocity just after t (separated when at rest); response.twist is then
   /// the object's body velocity (m/s, m/s, rad/s of the centre of pressure, shape axes).
   PushResponse response;
+  /// Multi-contact runs: every contact with its mode and force. `response` then summarizes it
+  /// (the twist and load, finger 0's net force, the first contact's point, normal and mode).
+  std::optional<MultiPushResponse> contacts;
 };
 
 struct SimulationStats {

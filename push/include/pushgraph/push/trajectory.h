@@ -79,13 +79,41 @@ struct MeasurementSigmas {
   double force = 0.0;         ///< N
 };
 
+/// The streams of one finger of a push with several fingers.
+struct FingerStreams {
+  std::vector<PoseSample> finger_pose;
+  std::vector<PointSample> contact_point;  ///< may repeat a time: one row per contact
+  std::vector<ForceSample> force;          ///< the finger's net force on the object
+};
+
+/// Finger 1, 2, ... of a push with several fingers (finger 0 is Trajectory::finger, its streams
+/// in Trajectory::measured): its description and streams.
+struct ExtraFinger {
+  FingerDescription finger;
+  FingerStreams measured;
+  std::optional<FingerStreams> ground_truth;  ///< present when the trajectory's is
+};
+
 struct Trajectory {
   ObjectDescription object;
-  FingerDescription finger;
+  FingerDescription finger;   ///< finger 0
+  /// The object's stream and finger 0's. contact_point may repeat a time (a finger touching the
+  /// object at several points, e.g. wedged in a notch: one row per contact).
   Streams measured;
   std::optional<Streams> ground_truth;
   std::optional<MeasurementSigmas> measurement_sigmas;
+  std::vector<ExtraFinger> extra_fingers;  ///< empty for the usual single-finger push
 };
+
+/// 1 + extra fingers.
+inline int FingerCount(const Trajectory& t) { return 1 + static_cast<int>(t.extra_fingers.size()); }
+
+/// Whether a contact stream holds several contacts at one time (a multi-contact push).
+inline bool HasRepeatedTimes(const std::vector<PointSample>& samples) {
+  for (std::size_t i = 1; i < samples.size(); ++i)
+    if (samples[i].t == samples[i - 1].t) return true;
+  return false;
+}
 
 /// A time-sorted, non-empty stream's value at t by linear interpolation, clamped to the first
 /// and last samples outside them (initial guesses, plot positions).
