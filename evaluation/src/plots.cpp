@@ -139,13 +139,8 @@ std::string TrajectorySvg(const push::Trajectory& trajectory, const graph::Estim
   const double legend_width = 270.0, margin_left = 58.0, margin_top = options.title.empty() ? 16.0 : 40.0;
   const double map_width_max = width - legend_width - margin_left - 10.0;
   const double map_height_max = 1.1 * width;
-  const double scale = std::min(map_width_max / (bounds.xmax - bounds.xmin), map_height_max / (bounds.ymax - bounds.ymin));
-  WorldView view;
-  view.scale = scale;
-  view.xmin = bounds.xmin;
-  view.ymax = bounds.ymax;
-  view.x0 = margin_left;
-  view.y0 = margin_top;
+  const WorldView view = FitView(bounds, map_width_max, map_height_max, margin_left, margin_top);
+  const double scale = view.scale;
   const double map_w = (bounds.xmax - bounds.xmin) * scale, map_h = (bounds.ymax - bounds.ymin) * scale;
   const double legend_x = margin_left + map_w + 22.0;
 

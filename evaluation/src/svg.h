@@ -68,6 +68,18 @@ struct WorldView {
 };
 
 
+/// The equal-aspect view of `bounds` in a box at most max_width x max_height pixels whose top
+/// left corner is (x0, y0).
+inline WorldView FitView(const Bounds& bounds, double max_width, double max_height, double x0, double y0) {
+  WorldView view;
+  view.scale = std::min(max_width / (bounds.xmax - bounds.xmin), max_height / (bounds.ymax - bounds.ymin));
+  view.xmin = bounds.xmin;
+  view.ymax = bounds.ymax;
+  view.x0 = x0;
+  view.y0 = y0;
+  return view;
+}
+
 /// Closed rings as one SVG path; a polyline broken where consecutive times are over max_gap apart.
 std::string RingsPath(const std::vector<std::vector<Vec2>>& rings, const WorldView& view);
 std::string PolylinePath(const std::vector<double>& t, const std::vector<Vec2>& points, double max_gap,

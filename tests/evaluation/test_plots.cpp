@@ -270,6 +270,44 @@ TEST(PlotSvg, FootprintsDrawHolesAndRoundedBoundaries) {
   EXPECT_GT(PathPoints(FirstPath(rounded, "finger")).size(), 20u);  // the capsule finger, sampled
 }
 
+// A push with two fingers, finger 0 touching at two points at once at t = 0.04.
+TEST(PushSvg, DrawsEveryFingerContactAndForceAtTheMarkedTimes) {
+  push::Trajectory t;
+  t.object.shape = geometry::Shape::Box(0.09, 0.09);
+  t.finger.shape = geometry::Shape::Disk(0.004, {0.0, 0.02});
+  push::ExtraFinger second;
+  second.finger.shape = geometry::Shape::Disk(0.004, {0.0, -0.02});
+  push::Streams truth;
+  push::FingerStreams truth_second;
+  for (int k = 0; k < 3; ++k) {
+    const double time = 0.04 * k;
+    truth.object_pose.push_back({time, {0.001 * k, 0.0, 0.0}});
+    truth.finger_pose.push_back({time, {-0.05 + 0.001 * k, 0.0, 0.0}});
+    truth_second.finger_pose.push_back({time, {-0.05 + 0.001 * k, 0.0, 0.0}});
+    truth.force.push_back({time, {1.0, 0.0}});
+    truth_second.force.push_back({time, {0.5, 0.1}});
+    truth_second.contact_point.push_back({time, {-0.045, -0.02}});
+  }
+  truth.contact_point = {{0.0, {-0.045, 0.02}}, {0.04, {-0.045, 0.019}}, {0.04, {-0.045, 0.021}}, {0.08, {-0.045, 0.02}}};
+  t.ground_truth = truth;
+  second.ground_truth = truth_second;
+  t.extra_fingers.push_back(second);
+  evaluation::PushPlotOptions options;
+  options.marks = 3;
+  const std::string svg = evaluation::PushSvg(t, options);
+  EXPECT_EQ(Count(svg, "class='footprint'"), 3);
+  EXPECT_EQ(Count(svg, "class='finger-0'"), 3);
+  EXPECT_EQ(Count(svg, "class='finger-1'"), 3);
+  EXPECT_EQ(Count(svg, "class='finger-1-path'"), 1);
+  EXPECT_EQ(Count(svg, "class='contact'"), 4 + 3);  // both of finger 0's contacts at t = 0.04
+  EXPECT_EQ(Count(svg, "class='force-0'"), 3);
+  EXPECT_EQ(Count(svg, "class='force-1'"), 3);
+  EXPECT_NE(svg.find("up to 2 contacts of one finger at once"), std::string::npos);
+  // Without ground truth (or asked for the measurements): the measured streams, here empty.
+  options.ground_truth = false;
+  EXPECT_THROW(evaluation::PushSvg(t, options), evaluation::EvaluationError);
+}
+
 TEST(PlotSvg, ErrorsNameThePathOrTheProblem) {
   const push::Trajectory traj = Push(true);
   const graph::EstimationResult result = Result(traj, true, true);

@@ -495,6 +495,41 @@ TEST_F(SimulateCli, BadInputIsOneLineError) {
   }
 }
 
+TEST_F(SimulateCli, SeveralFingersAndContactsAreWrittenAndDrawn) {
+  // Two disk fingers of one pusher (placed by their own shape coordinates), and one finger
+  // wedged in the notched block's V with --multi-contact.
+  const std::string left = (dir_ / "left.json").string(), right = (dir_ / "right.json").string();
+  std::ofstream(left) << R"({"polygons": [{"outer": [[0, 0.02]]}], "radius": 0.004})";
+  std::ofstream(right) << R"({"polygons": [{"outer": [[0, -0.02]]}], "radius": 0.004})";
+  const std::string two = (dir_ / "two.json").string(), two_svg = (dir_ / "two.svg").string();
+  pushgraph::testing::ToolRun r =
+      RunTool("-o " + two + " --fingers " + left + " " + right + " --push-angle 0 --offset 0 --distance 0.02 --svg " + two_svg);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("\"fingers\": 2"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"max_simultaneous_contacts\": 2"), std::string::npos) << r.out;
+  const Trajectory t = io::LoadTrajectoryJson(two);
+  ASSERT_EQ(FingerCount(t), 2);
+  EXPECT_FALSE(t.extra_fingers[0].measured.force.empty());
+  std::ifstream svg_in(two_svg);
+  std::stringstream svg;
+  svg << svg_in.rdbuf();
+  EXPECT_NE(svg.str().find("class='finger-1'"), std::string::npos);
+  EXPECT_NE(svg.str().find("class='force-1'"), std::string::npos);
+  const std::string wedge = (dir_ / "wedge.json").string();
+  r = RunTool("-o " + wedge + " --multi-contact --push-angle -1.5707963267948966 --offset 0 --distance 0.02");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("\"max_simultaneous_contacts\": 2"), std::string::npos) << r.out;
+  EXPECT_TRUE(HasRepeatedTimes(io::LoadTrajectoryJson(wedge).measured.contact_point));
+  // One file after --fingers is a mistake, said in one line; so are overlapping fingers.
+  r = RunTool("-o " + (dir_ / "bad.json").string() + " --fingers " + left);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("--fingers needs two or more"), std::string::npos) << r.err;
+  r = RunTool("-o " + (dir_ / "bad.json").string() + " --fingers " + left + " " + left);
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("overlap each other"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+}
+
 TEST_F(SimulateCli, EveryFlagInHelpIsDocumented) {
   const pushgraph::testing::ToolRun run = RunTool("--help");
   ASSERT_EQ(run.status, 0) << run.err;

@@ -4,6 +4,7 @@
 // JSON summary (contact time, sticking/sliding steps, max penetration, load residual).
 #include "cli_common.h"
 
+#include <pushgraph/evaluation/plots.h>
 #include <pushgraph/io/trajectory_json.h>
 #include <pushgraph/push/simulator.h>
 
@@ -46,6 +47,7 @@ struct SimulateOptions {
   bool no_ground_truth = false;
   std::vector<std::string> finger_paths;  // --fingers: several fingers at the pusher's pose
   bool multi_contact = false;
+  std::string svg;  // --svg: a picture of the push
 };
 
 void Positive(double value, const std::string& name) {
@@ -76,7 +78,7 @@ std::pair<double, double> ParseWindow(const std::string& text, const std::string
 void Run(const SimulateOptions& o) {
   std::vector<NamedPath> inputs{{"--object", o.object_path}, {"--finger", o.finger_path}};
   for (const std::string& path : o.finger_paths) inputs.push_back({"--fingers", path});
-  CheckOutputsAreNew(inputs, {{"-o", o.output}});
+  CheckOutputsAreNew(inputs, {{"-o", o.output}, {"--svg", o.svg}});
   if (o.finger_paths.size() == 1)
     throw CliError("--fingers needs two or more finger files (one finger: --finger FILE, with --multi-contact for "
                    "all its contacts)");
@@ -165,6 +167,12 @@ void Run(const SimulateOptions& o) {
   push::Trajectory trajectory = result.trajectory;
   if (o.no_ground_truth) trajectory.ground_truth.reset();
   io::SaveTrajectoryJson(trajectory, o.output);
+  if (!o.svg.empty()) {
+    evaluation::PushPlotOptions picture;
+    picture.title = "simulated push: " + std::to_string(push::FingerCount(trajectory)) + " finger(s)" +
+                    (plan.multi_contact || !plan.extra_fingers.empty() ? ", every contact" : "");
+    evaluation::WriteSvgFile(o.svg, evaluation::PushSvg(trajectory, picture));
+  }
 
   const push::SimulationStats& s = result.stats;
   // The simulator's own last state (the object stream may be disabled, --rate-object 0).
@@ -268,6 +276,8 @@ void RegisterSimulate(CLI::App& app) {
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   cmd->add_flag("--no-ground-truth", o->no_ground_truth, "Leave the ground_truth streams out of the file");
+  cmd->add_option("--svg", o->svg,
+                  "Also draw the push (ground truth: footprints, every finger, contact point and finger force)");
   cmd->footer(
       "Quasi-static pushing with point contact and Coulomb friction (sticking/sliding by motion cones),\n"
       "exact limit surface unless --surface ellipsoid. Default job: the 5 mm disk finger pushes\n"

@@ -50,6 +50,21 @@ std::string TrajectorySvg(const push::Trajectory& trajectory, const graph::Estim
 void WriteTrajectorySvg(const std::string& path, const push::Trajectory& trajectory,
                         const graph::EstimationResult& result, const TrajectoryPlotOptions& options = {});
 
+struct PushPlotOptions {
+  int marks = 12;           ///< about this many marked times along the push (footprints, fingers, forces)
+  std::string title;
+  int width_px = 960;       ///< at least 480
+  bool ground_truth = true; ///< draw the ground truth when the trajectory has it, else the measurements
+};
+
+/// A push as it happened, every finger and every contact: the object's footprint at the marked
+/// times (the last filled), each finger's shape at its pose there and its path (one colour per
+/// finger), every contact point of those times (a finger wedged in a notch shows two), and each
+/// finger's force as an arrow from the middle of its contacts. Draws the ground truth (or the
+/// measurements without it, or with options.ground_truth false). For a simulated push
+/// (`pushgraph simulate --svg`), single- or multi-contact.
+std::string PushSvg(const push::Trajectory& trajectory, const PushPlotOptions& options = {});
+
 struct TimeSeries {
   std::string label;
   std::vector<double> t, value;
