@@ -90,7 +90,8 @@ std::string MitGroup(const std::string& path) {
 // An `obj` folder holding NAME.obj beside or above the recording (the dataset's layout:
 
 push::Trajectory LoadCleanTrajectory(const EvaluationItem& item, const EvaluationOptions& o) {
-  if (item.source == EvaluationItem::Source::kSimulated) return SimulatedPush(o.simulation, item.sim_index, o.seed);
+  if (item.source == EvaluationItem::Source::kSimulated)
+    return SimulatedPush(item.multi_contact_sim ? o.multi_contact_simulation : o.simulation, item.sim_index, o.seed);
   if (DetectInputKind(item.path) == InputKind::kTrajectory) {
     push::Trajectory t = io::LoadTrajectoryJson(item.path);
     if (t.ground_truth) t.measured = *t.ground_truth;  // the clean streams get the protocol's noise
@@ -258,6 +259,7 @@ push::Trajectory SimulatedPush(const SimulationSpec& spec, int index, std::uint6
   plan.object = spec.object;
   plan.finger = spec.finger;
   plan.speed = spec.speed;
+  plan.multi_contact = spec.multi_contact;
   const geometry::Box2 b = plan.object.shape.bounds();
   const double half = 0.5 * std::min(b.max.x() - b.min.x(), b.max.y() - b.min.y());
   std::mt19937_64 rng(SplitMix(SplitMix(seed) ^ static_cast<std::uint64_t>(index)));

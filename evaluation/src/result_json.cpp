@@ -43,6 +43,19 @@ std::string ResultToJson(const graph::EstimationResult& r, int indent) {
     if (s.finger_pose_cov) o["finger_pose_cov"] = Matrix(*s.finger_pose_cov);
     if (s.contact_cov) o["contact_cov"] = Matrix(*s.contact_cov);
     if (s.force_cov) o["force_cov"] = Matrix(*s.force_cov);
+    if (!s.contacts.empty()) {
+      // Two contacts: each with its point, force and covariances ("force" above is their sum).
+      Json contacts = Json::array();
+      for (const graph::ContactEstimate& c : s.contacts) {
+        Json e;
+        e["point"] = Vec(c.point);
+        if (c.force) e["force"] = Vec(*c.force);
+        if (c.point_cov) e["point_cov"] = Matrix(*c.point_cov);
+        if (c.force_cov) e["force_cov"] = Matrix(*c.force_cov);
+        contacts.push_back(std::move(e));
+      }
+      o["contacts"] = std::move(contacts);
+    }
     states.push_back(std::move(o));
   }
   j["states"] = std::move(states);

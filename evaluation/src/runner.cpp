@@ -134,6 +134,8 @@ std::string EvaluationOptions::SettingsJson() const {
                    {"push_distance", simulation.push_distance}, {"speed", simulation.speed},
                    {"offset_fraction", simulation.offset_fraction}, {"mass", simulation.object.mass},
                    {"mu_surface", simulation.object.mu_surface}, {"mu_contact", simulation.finger.mu_contact}};
+  if (multi_contact_simulation.count > 0)
+    j["simulate_multi_contact"] = {{"count", multi_contact_simulation.count}, {"name", multi_contact_simulation.name}};
   return j.dump();
 }
 
@@ -152,16 +154,20 @@ std::vector<EvaluationItem> PlanEvaluation(const std::vector<std::string>& files
     it.source = EvaluationItem::Source::kFile;
     items.push_back(it);
   }
-  for (int i = 0; i < options.simulation.count; ++i) {
-    EvaluationItem it;
-    it.index = static_cast<int>(items.size());
-    char name[32];
-    std::snprintf(name, sizeof name, "sim-%04d", i);
-    it.name = name;
-    it.group = options.simulation.name;
-    it.source = EvaluationItem::Source::kSimulated;
-    it.sim_index = i;
-    items.push_back(it);
+  for (const SimulationSpec* spec : {&options.simulation, &options.multi_contact_simulation}) {
+    const bool multi = spec == &options.multi_contact_simulation;
+    for (int i = 0; i < spec->count; ++i) {
+      EvaluationItem it;
+      it.index = static_cast<int>(items.size());
+      char name[32];
+      std::snprintf(name, sizeof name, multi ? "sim-multi-%04d" : "sim-%04d", i);
+      it.name = name;
+      it.group = spec->name;
+      it.source = EvaluationItem::Source::kSimulated;
+      it.sim_index = i;
+      it.multi_contact_sim = multi;
+      items.push_back(it);
+    }
   }
   std::map<std::string, int> plotted;
   for (EvaluationItem& it : items) it.plot = plotted[it.group]++ < options.plots_per_group;
@@ -284,7 +290,11 @@ EvaluationRow EvaluateItem(const EvaluationItem& item, const EvaluationOptions& 
       clean.object.shape = geometry::TransformShape(clean.object.shape, t.pose, t.scale, t.mirrored);
       row.stats["shape/group_aligned/sum"] = 1.0;
     }
-    const std::uint64_t item_seed = SplitMix(o.seed ^ Fnv1a(item.name));
+    // The multi-contact group's push i takes the noise seed of the single-contact group's push i
+    // (the same push line): the two groups compare push by push.
+    char sim_name[32];
+    std::snprintf(sim_name, sizeof sim_name, "sim-%04d", item.sim_index);
+    const std::uint64_t item_seed = SplitMix(o.seed ^ Fnv1a(item.multi_contact_sim ? std::string(sim_name) : item.name));
     const std::vector<RunSpec> runs = RunsFor(o.protocols, o.occlusion_mode);
     StatSink sink(&row.stats);
     std::map<std::string, push::Trajectory> noisy;

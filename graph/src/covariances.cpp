@@ -61,11 +61,12 @@ std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder, c
       // Name the state, then try the QR on J (it copes with worse conditioning than J^T J).
       marginals_error = marginals.error();
       const double* bad = marginals.failed_block();
-      const char* names[] = {"object pose", "finger pose", "contact point", "force"};
+      const char* names[] = {"object pose", "finger pose", "contact point", "force", "second contact point",
+                             "second contact force"};
       for (int i = 0; bad != nullptr && i < static_cast<int>(builder.steps().size()); ++i) {
         const StepVars& v = builder.vars()[i];
-        const double* blocks[] = {v.x, v.e, v.p, v.f};
-        for (int q = 0; q < 4; ++q) {
+        const double* blocks[] = {v.x, v.e, v.p, v.f, v.p2, v.f2};
+        for (int q = 0; q < 6; ++q) {
           if (blocks[q] != bad) continue;
           marginals_error += " [step " + std::to_string(i) + ", t = " + std::to_string(builder.steps()[i].t) +
                              ", " + names[q] + "]";
@@ -116,6 +117,18 @@ std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder, c
     if (builder.HasForceVars(i)) {
       get(v.f, c2.data());
       s.force_cov = Eigen::Matrix2d(c2);
+    }
+    if (builder.HasSecondContact(i) && s.contacts.size() == 2) {
+      // Each contact's own; the net force's would need the cross-covariance of f and f2.
+      s.contacts[0].point_cov = s.contact_cov;
+      get(v.p2, c2.data());
+      s.contacts[1].point_cov = Eigen::Matrix2d(c2);
+      if (builder.HasForceVars(i)) {
+        s.contacts[0].force_cov = s.force_cov;
+        get(v.f2, c2.data());
+        s.contacts[1].force_cov = Eigen::Matrix2d(c2);
+        s.force_cov.reset();
+      }
     }
   }
   return "ok";

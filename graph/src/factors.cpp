@@ -70,10 +70,33 @@ bool VectorMeasurementFactor::Evaluate(double const* const* parameters, double* 
   return true;
 }
 
+VectorSumMeasurementFactor::VectorSumMeasurementFactor(const Vec2& measured, double sigma)
+    : measured_(measured), w_(CheckedWeight(sigma, "force measurement")) {}
+
+bool VectorSumMeasurementFactor::Evaluate(double const* const* parameters, double* residuals,
+                                          double** jacobians) const {
+  Eigen::Map<Eigen::Vector2d>{residuals} = w_ * (Eigen::Map<const Eigen::Vector2d>(parameters[0]) +
+                                                 Eigen::Map<const Eigen::Vector2d>(parameters[1]) - measured_);
+  for (int k = 0; jacobians != nullptr && k < 2; ++k)
+    if (jacobians[k] != nullptr) Eigen::Map<RowMat22>{jacobians[k]} = w_ * Eigen::Matrix2d::Identity();
+  return true;
+}
+
 // ---------------------------------------------------------------------------------------- C
 BoundaryPointFactor::BoundaryPointFactor(geometry::Shape shape, double sigma)
     : shape_(std::move(shape)), w_(CheckedWeight(sigma, "contact on boundary")) {
   if (shape_.empty()) throw GraphError("BoundaryPointFactor: empty shape");
+}
+
+// A posed point query; false for non-finite parameters (the solver then rejects the step).
+static bool QueryPointOrReject(const geometry::Shape& shape, const double* pose, const Vec2& point,
+                               geometry::PointQuery* q, geometry::PointQueryJacobians* J) {
+  try {
+    *q = geometry::QueryPoint(shape, PoseFrom(pose), point, J);
+  } catch (const std::exception&) {
+    return false;
+  }
+  return true;
 }
 
 bool BoundaryPointFactor::Evaluate(double const* const* parameters, double* residuals,
@@ -81,17 +104,118 @@ bool BoundaryPointFactor::Evaluate(double const* const* parameters, double* resi
   const Vec2 p(parameters[1][0], parameters[1][1]);
   geometry::PointQueryJacobians J;
   geometry::PointQuery q;
-  try {
-    q = geometry::QueryPoint(shape_, PoseFrom(parameters[0]), p, &J);
-  } catch (const std::exception&) {
-    return false;  // non-finite parameters: let the solver reject the step
-  }
+  if (!QueryPointOrReject(shape_, parameters[0], p, &q, &J)) return false;
   Eigen::Map<Eigen::Vector2d>{residuals} = w_ * (p - q.closest_point);
   if (jacobians != nullptr) {
     if (jacobians[0] != nullptr) Eigen::Map<RowMat23>{jacobians[0]} = -w_ * J.J_closest_pose;
     if (jacobians[1] != nullptr) {
       Eigen::Map<RowMat22>{jacobians[1]} = w_ * (Eigen::Matrix2d::Identity() - J.J_closest_point);
     }
+  }
+  return true;
+}
+
+LocalWitnessFactor::LocalWitnessFactor(geometry::Shape object, geometry::Shape finger, double sigma)
+    : object_(std::move(object)), finger_(std::move(finger)), w_(CheckedWeight(sigma, "local contact witness")) {}
+
+bool LocalWitnessFactor::Evaluate(double const* const* parameters, double* residuals,
+                                  double** jacobians) const {
+  const Vec2 p(parameters[2][0], parameters[2][1]);
+  geometry::PointQueryJacobians Jf, Jo;
+  geometry::PointQuery on_finger, on_object;
+  if (!QueryPointOrReject(finger_, parameters[1], p, &on_finger, &Jf) ||
+      !QueryPointOrReject(object_, parameters[0], on_finger.closest_point, &on_object, &Jo))
+    return false;
+  Eigen::Map<Eigen::Vector2d>{residuals} = w_ * (p - on_object.closest_point);
+  if (jacobians != nullptr) {
+    // q = G_o(x, f), f = G_f(e, p): dq/dx = J_o,pose; dq/de = J_o,point J_f,pose; dq/dp = J_o,point J_f,point.
+    if (jacobians[0] != nullptr) Eigen::Map<RowMat23>{jacobians[0]} = -w_ * Jo.J_closest_pose;
+    if (jacobians[1] != nullptr) Eigen::Map<RowMat23>{jacobians[1]} = -w_ * Jo.J_closest_point * Jf.J_closest_pose;
+    if (jacobians[2] != nullptr)
+      Eigen::Map<RowMat22>{jacobians[2]} = w_ * (Eigen::Matrix2d::Identity() - Jo.J_closest_point * Jf.J_closest_point);
+  }
+  return true;
+}
+
+FeatureWitnessFactor::FeatureWitnessFactor(geometry::Shape object, geometry::EdgeId feature, bool vertex,
+                                           geometry::Shape finger, double sigma)
+    : finger_(std::move(finger)), vertex_(vertex), radius_(object.radius()), w_(CheckedWeight(sigma, "contact feature witness")) {
+  const auto& polygons = object.polygons();
+  if (feature.polygon < 0 || feature.polygon >= static_cast<int>(polygons.size()) || feature.ring < -1 ||
+      feature.ring >= static_cast<int>(polygons[feature.polygon].holes.size()))
+    throw GraphError("contact feature witness: the object has no ring " + std::to_string(feature.ring) + " in polygon " +
+                     std::to_string(feature.polygon));
+  const geometry::Ring& ring = object.ring(feature.polygon, feature.ring);
+  const int n = static_cast<int>(ring.size());
+  if (feature.index < 0 || feature.index >= n || (!vertex && n < 2))
+    throw GraphError("contact feature witness: the object's ring has no edge " + std::to_string(feature.index));
+  a_ = ring[feature.index];
+  b_ = ring[(feature.index + 1) % n];
+  two_sided_ = n < 3;
+}
+
+namespace {
+// The closest point q of the segment [A, B] (or of the point A when `vertex`), pushed out by r,
+// to f, with its Jacobians with respect to A, B and f (world frame).
+struct SegmentClosest {
+  Vec2 q;
+  Eigen::Matrix2d J_q_A, J_q_B, J_q_f;
+};
+SegmentClosest ClosestOnFeature(const Vec2& A, const Vec2& B, bool vertex, bool two_sided, double r, const Vec2& f) {
+  SegmentClosest out;
+  const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
+  const Vec2 d = B - A, g = f - A;
+  const double L = d.squaredNorm();
+  const double s = vertex ? 0.0 : g.dot(d) / L;
+  if (vertex || s <= 0.0 || s >= 1.0) {
+    // A vertex: q = V + r w / |w|, w = f - V.
+    const bool at_b = !vertex && s >= 1.0;
+    const Vec2 V = at_b ? B : A, w = f - V;
+    const double wn = w.norm();
+    const Eigen::Matrix2d dq_dw = (r > 0.0 && wn > 0.0) ? Eigen::Matrix2d(r * (I - w * w.transpose() / (wn * wn)) / wn)
+                                                        : Eigen::Matrix2d::Zero();
+    out.q = V + (r > 0.0 && wn > 0.0 ? Vec2(r * w / wn) : Vec2::Zero());
+    out.J_q_f = dq_dw;
+    (at_b ? out.J_q_B : out.J_q_A) = I - dq_dw;
+    (at_b ? out.J_q_A : out.J_q_B) = Eigen::Matrix2d::Zero();
+    return out;
+  }
+  // Inside the edge: q = A + s d + r n, s = g.d / L, n = (d_y, -d_x) / |d| (interior on the left).
+  const double gd = g.dot(d);
+  const Eigen::RowVector2d ds_df = d.transpose() / L;
+  const Eigen::RowVector2d ds_dA = ((-d - g).transpose() * L + 2.0 * gd * d.transpose()) / (L * L);
+  const Eigen::RowVector2d ds_dB = (g.transpose() * L - 2.0 * gd * d.transpose()) / (L * L);
+  const double dn_norm = std::sqrt(L);
+  Eigen::Matrix2d M;
+  M << 0.0, 1.0, -1.0, 0.0;
+  // A segment core (no interior) is rounded on both sides: the side of f.
+  const double side = two_sided && g.dot(M * d) < 0.0 ? -1.0 : 1.0;
+  const Vec2 n = side * M * d / dn_norm;
+  const Eigen::Matrix2d dn_dd = side * M * (I - d * d.transpose() / L) / dn_norm;
+  out.q = A + s * d + r * n;
+  out.J_q_f = d * ds_df;
+  out.J_q_A = I + d * ds_dA - s * I - r * dn_dd;
+  out.J_q_B = d * ds_dB + s * I + r * dn_dd;
+  return out;
+}
+}  // namespace
+
+bool FeatureWitnessFactor::Evaluate(double const* const* parameters, double* residuals,
+                                    double** jacobians) const {
+  const Pose2 x = PoseFrom(parameters[0]);
+  const Vec2 p(parameters[2][0], parameters[2][1]);
+  geometry::PointQueryJacobians Jf;
+  geometry::PointQuery on_finger;
+  if (!QueryPointOrReject(finger_, parameters[1], p, &on_finger, &Jf)) return false;
+  Eigen::Matrix<double, 2, 3> J_A_x, J_B_x;
+  const Vec2 A = geometry::Act(x, a_, &J_A_x), B = geometry::Act(x, b_, &J_B_x);
+  const SegmentClosest c = ClosestOnFeature(A, B, vertex_, two_sided_, radius_, on_finger.closest_point);
+  Eigen::Map<Eigen::Vector2d>{residuals} = w_ * (p - c.q);
+  if (jacobians != nullptr) {
+    if (jacobians[0] != nullptr) Eigen::Map<RowMat23>{jacobians[0]} = -w_ * (c.J_q_A * J_A_x + c.J_q_B * J_B_x);
+    if (jacobians[1] != nullptr) Eigen::Map<RowMat23>{jacobians[1]} = -w_ * c.J_q_f * Jf.J_closest_pose;
+    if (jacobians[2] != nullptr)
+      Eigen::Map<RowMat22>{jacobians[2]} = w_ * (Eigen::Matrix2d::Identity() - c.J_q_f * Jf.J_closest_point);
   }
   return true;
 }
@@ -424,25 +548,74 @@ bool QuasiStaticFactorWithC::Evaluate(double const* const* parameters, double* r
   return EvaluateQuasiStatic(geometry_, eps_v_, eps_f_, w_, true, parameters, residuals, jacobians);
 }
 
+namespace {
+// The terms of two contacts: V' and its Jacobians from the first (the same poses), g' the sum.
+struct TwoContactTerms {
+  QuasiStaticTerms t;  // V', J_V_*; g' = g'_1 + g'_2, J_g_x summed; J_g_p, J_g_f of contact 1
+  Eigen::Matrix<double, 3, 2> J_g_p2, J_g_f2;
+};
+TwoContactTerms ComputeTwoContactTerms(const QuasiStaticGeometry& geometry, double const* const* parameters) {
+  const Pose2 x_prev = PoseFrom(parameters[0]), x = PoseFrom(parameters[1]);
+  TwoContactTerms out;
+  out.t = ComputeQuasiStaticTerms(geometry, x_prev, x, Vec2(parameters[2][0], parameters[2][1]),
+                                  Vec2(parameters[3][0], parameters[3][1]));
+  const QuasiStaticTerms second = ComputeQuasiStaticTerms(geometry, x_prev, x, Vec2(parameters[4][0], parameters[4][1]),
+                                                          Vec2(parameters[5][0], parameters[5][1]));
+  out.t.g += second.g;
+  out.t.J_g_x += second.J_g_x;
+  out.J_g_p2 = second.J_g_p;
+  out.J_g_f2 = second.J_g_f;
+  return out;
+}
+}  // namespace
+
+QuasiStaticTwoContactFactor::QuasiStaticTwoContactFactor(const QuasiStaticGeometry& geometry, double eps_velocity,
+                                                         double eps_force, double sigma)
+    : geometry_(geometry), eps_v_(eps_velocity), eps_f_(eps_force), w_(CheckedWeight(sigma, "quasi-static")) {
+  CheckGeometry(geometry_);
+  CheckEps(eps_v_, eps_f_, "quasi-static");
+}
+
+bool QuasiStaticTwoContactFactor::Evaluate(double const* const* parameters, double* residuals,
+                                           double** jacobians) const {
+  const TwoContactTerms tc = ComputeTwoContactTerms(geometry_, parameters);
+  Eigen::Matrix3d J_r_V, J_r_g;
+  const bool jac = jacobians != nullptr;
+  Eigen::Map<Eigen::Vector3d>{residuals} =
+      NormalizedCross(tc.t, eps_v_, eps_f_, w_, jac ? &J_r_V : nullptr, jac ? &J_r_g : nullptr);
+  if (!jac) return true;
+  if (jacobians[0] != nullptr) Eigen::Map<RowMat33>{jacobians[0]} = J_r_V * tc.t.J_V_xprev;
+  if (jacobians[1] != nullptr) Eigen::Map<RowMat33>{jacobians[1]} = J_r_V * tc.t.J_V_x + J_r_g * tc.t.J_g_x;
+  if (jacobians[2] != nullptr) Eigen::Map<RowMat32>{jacobians[2]} = J_r_g * tc.t.J_g_p;
+  if (jacobians[3] != nullptr) Eigen::Map<RowMat32>{jacobians[3]} = J_r_g * tc.t.J_g_f;
+  if (jacobians[4] != nullptr) Eigen::Map<RowMat32>{jacobians[4]} = J_r_g * tc.J_g_p2;
+  if (jacobians[5] != nullptr) Eigen::Map<RowMat32>{jacobians[5]} = J_r_g * tc.J_g_f2;
+  return true;
+}
+
+// The load factors' arguments checked; their weight.
+static double CheckedLoadWeight(const QuasiStaticGeometry& geometry, double f_max, double eps_v, double eps_f,
+                                double sigma) {
+  CheckGeometry(geometry);
+  if (!(f_max > 0.0) || !std::isfinite(f_max)) throw GraphError("limit-surface load factor: f_max must be > 0");
+  CheckEps(eps_v, eps_f, "limit-surface load");
+  return CheckedWeight(sigma, "limit-surface load");
+}
+
 LimitSurfaceLoadFactor::LimitSurfaceLoadFactor(const QuasiStaticGeometry& geometry, double f_max,
                                                double eps_velocity, double eps_force, double sigma)
     : geometry_(geometry), f_max_(f_max), eps_v_(eps_velocity), eps_f_(eps_force),
-      w_(CheckedWeight(sigma, "limit-surface load")) {
-  CheckGeometry(geometry_);
-  if (!(f_max > 0.0) || !std::isfinite(f_max)) throw GraphError("limit-surface load factor: f_max must be > 0");
-  CheckEps(eps_v_, eps_f_, "limit-surface load");
-}
+      w_(CheckedLoadWeight(geometry, f_max, eps_velocity, eps_force, sigma)) {}
 
 namespace {
 
-// r = w s_v (b / f_max - 1), b = |g'|_eps. With J_fmax: d r / d f_max; with J_c: d r / d c.
+// r = w s_v (b / f_max - 1), b = |g'|_eps, from the terms t of the load's contact(s) (jacobians
+// [2], [3] of the first contact; [4], [5] of a second one when `second` is given). With J_fmax:
+// d r / d f_max; with J_c: d r / d c.
 bool EvaluateLoad(const QuasiStaticGeometry& geometry, double f_max, double eps_v, double eps_f, double w,
-                  double const* const* parameters, double* residuals, double** jacobians, double* J_fmax,
-                  double* J_c) {
+                  const QuasiStaticTerms& t, double* residuals, double** jacobians, double* J_fmax, double* J_c,
+                  const TwoContactTerms* second = nullptr) {
   if (!(f_max > 0.0)) return false;
-  const QuasiStaticTerms t = ComputeQuasiStaticTerms(
-      geometry, PoseFrom(parameters[0]), PoseFrom(parameters[1]),
-      Vec2(parameters[2][0], parameters[2][1]), Vec2(parameters[3][0], parameters[3][1]));
   const double v2 = t.V.squaredNorm(), e2 = eps_v * eps_v;
   const double sv = v2 / (v2 + e2);
   const double b = std::sqrt(t.g.squaredNorm() + eps_f * eps_f);
@@ -455,17 +628,36 @@ bool EvaluateLoad(const QuasiStaticGeometry& geometry, double f_max, double eps_
   if (jacobians[1] != nullptr) Eigen::Map<Eigen::RowVector3d>{jacobians[1]} = J_r_V * t.J_V_x + J_r_g * t.J_g_x;
   if (jacobians[2] != nullptr) Eigen::Map<Eigen::RowVector2d>{jacobians[2]} = J_r_g * t.J_g_p;
   if (jacobians[3] != nullptr) Eigen::Map<Eigen::RowVector2d>{jacobians[3]} = J_r_g * t.J_g_f;
+  if (second != nullptr && jacobians[4] != nullptr) Eigen::Map<Eigen::RowVector2d>{jacobians[4]} = J_r_g * second->J_g_p2;
+  if (second != nullptr && jacobians[5] != nullptr) Eigen::Map<Eigen::RowVector2d>{jacobians[5]} = J_r_g * second->J_g_f2;
   if (J_fmax != nullptr) *J_fmax = -w * sv * b / (f_max * f_max);
   // V'_z = c omega and g'_z = tau / c: dV'/dc = (0, 0, V'_z / c), dg'/dc = (0, 0, -g'_z / c).
   if (J_c != nullptr) *J_c = J_r_V(2) * (t.V.z() / geometry.c) - J_r_g(2) * (t.g.z() / geometry.c);
   return true;
 }
 
+QuasiStaticTerms OneContactTerms(const QuasiStaticGeometry& geometry, double const* const* parameters) {
+  return ComputeQuasiStaticTerms(geometry, PoseFrom(parameters[0]), PoseFrom(parameters[1]),
+                                 Vec2(parameters[2][0], parameters[2][1]), Vec2(parameters[3][0], parameters[3][1]));
+}
+
 }  // namespace
+
+LimitSurfaceLoadTwoContactFactor::LimitSurfaceLoadTwoContactFactor(const QuasiStaticGeometry& geometry, double f_max,
+                                                                   double eps_velocity, double eps_force, double sigma)
+    : geometry_(geometry), f_max_(f_max), eps_v_(eps_velocity), eps_f_(eps_force),
+      w_(CheckedLoadWeight(geometry, f_max, eps_velocity, eps_force, sigma)) {}
+
+bool LimitSurfaceLoadTwoContactFactor::Evaluate(double const* const* parameters, double* residuals,
+                                                double** jacobians) const {
+  const TwoContactTerms tc = ComputeTwoContactTerms(geometry_, parameters);
+  return EvaluateLoad(geometry_, f_max_, eps_v_, eps_f_, w_, tc.t, residuals, jacobians, nullptr, nullptr, &tc);
+}
 
 bool LimitSurfaceLoadFactor::Evaluate(double const* const* parameters, double* residuals,
                                       double** jacobians) const {
-  return EvaluateLoad(geometry_, f_max_, eps_v_, eps_f_, w_, parameters, residuals, jacobians, nullptr, nullptr);
+  return EvaluateLoad(geometry_, f_max_, eps_v_, eps_f_, w_, OneContactTerms(geometry_, parameters), residuals, jacobians,
+                      nullptr, nullptr);
 }
 
 LimitSurfaceLoadFactorWithParameters::LimitSurfaceLoadFactorWithParameters(
@@ -496,7 +688,7 @@ bool LimitSurfaceLoadFactorWithParameters::Evaluate(double const* const* paramet
   double J_fmax = 0.0, J_c = 0.0;
   const bool want_c = jacobians != nullptr && c_index >= 0 && jacobians[c_index] != nullptr;
   const bool want_mu = jacobians != nullptr && mu_index >= 0 && jacobians[mu_index] != nullptr;
-  if (!EvaluateLoad(geometry, mu * normal_load_, eps_v_, eps_f_, w_, parameters, residuals, jacobians,
+  if (!EvaluateLoad(geometry, mu * normal_load_, eps_v_, eps_f_, w_, OneContactTerms(geometry, parameters), residuals, jacobians,
                     want_mu ? &J_fmax : nullptr, want_c ? &J_c : nullptr)) {
     return false;
   }

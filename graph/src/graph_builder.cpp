@@ -2,6 +2,7 @@
 
 #include <ceres/normal_prior.h>
 
+#include <pushgraph/geometry/contacts.h>
 #include <pushgraph/geometry/point_query.h>
 #include <pushgraph/graph/incremental.h>
 #include <pushgraph/graph/marginals.h>
@@ -90,6 +91,19 @@ int GraphBuilder::AppendSteps(double until) {
       steps_.back().t = t;
     }
     Step& s = steps_.back();
+    if (stream == 2 && s.contact >= 0) {
+      // Two contact rows at one time: a finger touching the object at two points.
+      if (s.contact2 >= 0) {
+        std::ostringstream text;
+        text.precision(17);
+        text << "trajectory: streams.contact_point has more than two contacts at t = " << t
+             << " s (rows " << s.contact << ", " << s.contact2 << ", " << index
+             << "): the estimator models at most two contacts of the finger";
+        throw GraphError(text.str());
+      }
+      s.contact2 = index;
+      continue;
+    }
     int* slot = stream == 0 ? &s.object : stream == 1 ? &s.finger : stream == 2 ? &s.contact : &s.force;
     *slot = index;
   }
@@ -97,7 +111,17 @@ int GraphBuilder::AppendSteps(double until) {
   for (std::size_t i = first_new; i < steps_.size(); ++i) {
     Step& s = steps_[i];
     if (streams_.contact_point) {
-      s.in_contact = NearestGap(m.contact_point, s.t) <= cfg_.contact_max_gap;
+      int k = -1;
+      s.in_contact = NearestGap(m.contact_point, s.t, &k) <= cfg_.contact_max_gap;
+      // Two contacts while the nearest contact time has two rows.
+      const auto& c = m.contact_point;
+      s.two_contacts = s.in_contact && k >= 0 &&
+                       ((k > 0 && c[k - 1].t == c[k].t) || (k + 1 < static_cast<int>(c.size()) && c[k + 1].t == c[k].t));
+      if (s.two_contacts && model_ == Model::kYu) {
+        // The baseline models one contact, as published: it keeps the first of the two.
+        s.two_contacts = false;
+        ++second_contacts_ignored_;
+      }
     } else if (streams_.force) {
       int k = -1;
       const double gap = NearestGap(m.force, s.t, &k);
@@ -314,6 +338,7 @@ void GraphBuilder::Initialize(int i, double limit) {
       const auto q = geometry::QueryPoint(traj_.object.shape, Pose2{v.x[0], v.x[1], v.x[2]}, Vec2(v.e[0], v.e[1]));
       v.p[0] = q.closest_point.x(); v.p[1] = q.closest_point.y();
     }
+    if (s.two_contacts) InitializeSecondContact(i, causal);
     if (s.force >= 0) {
       v.f[0] = m.force[s.force].force.x(); v.f[1] = m.force[s.force].force.y();
     } else if (!m.force.empty() && !causal) {
@@ -327,7 +352,82 @@ void GraphBuilder::Initialize(int i, double limit) {
       d = d.norm() > 0 ? Vec2(0.1 * d.normalized()) : Vec2(0.1, 0.0);
       v.f[0] = d.x(); v.f[1] = d.y();
     }
+    if (s.two_contacts) {
+      // The measured (net) force shared by both contacts to start.
+      v.f2[0] = v.f[0] = 0.5 * v.f[0];
+      v.f2[1] = v.f[1] = 0.5 * v.f[1];
+    }
   }
+}
+
+bool GraphBuilder::TwoContactFeatures(int i, ContactFeature out[2]) const {
+  const StepVars& v = vars_[i];
+  const Pose2 x{v.x[0], v.x[1], v.x[2]}, e{v.e[0], v.e[1], v.e[2]};
+  // Candidates: every object feature the finger is near at the current values (3 sigma of a
+  // contact measurement: the values may be that far off), each once, nearest first.
+  const double tolerance = 3.0 * cfg_.measurement.contact;
+  std::vector<geometry::ContactPoint> found;
+  try {
+    found = geometry::FindContacts(traj_.object.shape, x, traj_.finger.shape, e, {tolerance, tolerance});
+  } catch (const geometry::GeometryError&) {
+    return false;
+  }
+  std::sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.separation < b.separation; });
+  std::vector<std::pair<ContactFeature, Vec2>> distinct;
+  for (const geometry::ContactPoint& c : found) {
+    ContactFeature f;
+    f.edge = c.object_feature;
+    f.vertex = c.kind != geometry::ContactPoint::Kind::kFingerVertexObjectEdge;
+    const bool seen = std::any_of(distinct.begin(), distinct.end(), [&](const auto& d) {
+      return d.first.vertex == f.vertex && d.first.edge.polygon == f.edge.polygon && d.first.edge.ring == f.edge.ring &&
+             d.first.edge.index == f.edge.index;
+    });
+    if (!seen) distinct.push_back({f, c.object_point});
+    if (distinct.size() == 2) break;
+  }
+  if (distinct.size() < 2) return false;
+  // Each contact variable to the feature nearer its current value.
+  const Vec2 p1(v.p[0], v.p[1]), p2(v.p2[0], v.p2[1]);
+  const bool swap = (p1 - distinct[1].second).norm() + (p2 - distinct[0].second).norm() <
+                    (p1 - distinct[0].second).norm() + (p2 - distinct[1].second).norm();
+  out[0] = distinct[swap ? 1 : 0].first;
+  out[1] = distinct[swap ? 0 : 1].first;
+  return true;
+}
+
+void GraphBuilder::InitializeSecondContact(int i, bool causal) {
+  const auto& m = traj_.measured;
+  Step& s = steps_[i];
+  StepVars& v = vars_[i];
+  const StepVars* prev = i > 0 && steps_[i - 1].two_contacts ? &vars_[i - 1] : nullptr;
+  Vec2 a(v.p[0], v.p[1]), b = a;
+  if (s.contact >= 0 && s.contact2 >= 0) {
+    b = m.contact_point[s.contact2].point;
+  } else {
+    // The two rows of the nearest contact time (none at this step).
+    int k = -1;
+    NearestGap(m.contact_point, s.t, &k);
+    const auto& c = m.contact_point;
+    int first = k;
+    while (first > 0 && c[first - 1].t == c[k].t) --first;
+    if (!causal || c[first].t <= s.t) {
+      a = c[first].point;
+      b = first + 1 < static_cast<int>(c.size()) ? c[first + 1].point : a;
+    } else if (prev != nullptr) {
+      a = Vec2(prev->p[0], prev->p[1]);
+      b = Vec2(prev->p2[0], prev->p2[1]);
+    }
+  }
+  // Pair the rows with p and p2 as the previous step's (the sensor's row order may change).
+  if (prev != nullptr) {
+    const Vec2 p1(prev->p[0], prev->p[1]), p2(prev->p2[0], prev->p2[1]);
+    if ((a - p2).norm() + (b - p1).norm() < (a - p1).norm() + (b - p2).norm()) {
+      std::swap(a, b);
+      if (s.contact >= 0 && s.contact2 >= 0) std::swap(s.contact, s.contact2);
+    }
+  }
+  v.p[0] = a.x(); v.p[1] = a.y();
+  v.p2[0] = b.x(); v.p2[1] = b.y();
 }
 
 int GraphBuilder::SmoothInitialMotion(int max_iterations, double function_tolerance, int first, int last) {
@@ -396,10 +496,12 @@ void GraphBuilder::AddFactors(ceres::Problem& problem, int i, int parts) {
     problem.AddParameterBlock(v.x, 3);
     problem.AddParameterBlock(v.e, 3);
     if (s.in_contact) problem.AddParameterBlock(v.p, 2);
+    if (HasSecondContact(i)) problem.AddParameterBlock(v.p2, 2);
     AddKinematicFactors(problem, i);
   }
   if ((parts & kDynamic) && HasForceVars(i)) {
     problem.AddParameterBlock(v.f, 2);
+    if (HasSecondContact(i)) problem.AddParameterBlock(v.f2, 2);
     AddDynamicFactors(problem, i);
   }
 }
@@ -418,7 +520,28 @@ void GraphBuilder::AddKinematicFactors(ceres::Problem& problem, int i) {
     // C: contact point on both boundaries, finger touching the object.
     Add(problem, FactorType::kContactOnObject, new BoundaryPointFactor(traj_.object.shape, cfg_.contact_object_sigma), nullptr,
         {v.x, v.p}, {0});
-    if (cfg_.contact_finger == EstimatorConfig::ContactFinger::kWitness) {
+    if (s.two_contacts) {
+      // Two contacts: each point on the object's boundary and at its own wall's touching pair
+      // (the shape-pair witness is the single nearest pair, one of the two: it would pull both
+      // points onto the same wall).
+      if (s.contact2 >= 0) {
+        Add(problem, FactorType::kContactPoint, new VectorMeasurementFactor(m.contact_point[s.contact2].point, cfg_.measurement.contact),
+            MakeLoss(cfg_.contact_loss), {v.p2});
+      }
+      Add(problem, FactorType::kContactOnObject, new BoundaryPointFactor(traj_.object.shape, cfg_.contact_object_sigma), nullptr,
+          {v.x, v.p2}, {0});
+      ContactFeature features[2];
+      const bool on_features = TwoContactFeatures(i, features);
+      double* points[2] = {v.p, v.p2};
+      for (int k = 0; k < 2; ++k) {
+        ceres::CostFunction* cost =
+            on_features ? static_cast<ceres::CostFunction*>(new FeatureWitnessFactor(
+                              traj_.object.shape, features[k].edge, features[k].vertex, traj_.finger.shape,
+                              cfg_.contact_finger_sigma))
+                        : new LocalWitnessFactor(traj_.object.shape, traj_.finger.shape, cfg_.contact_finger_sigma);
+        Add(problem, FactorType::kContactOnFinger, cost, nullptr, {v.x, v.e, points[k]}, {0});
+      }
+    } else if (cfg_.contact_finger == EstimatorConfig::ContactFinger::kWitness) {
       Add(problem, FactorType::kContactOnFinger, new ContactWitnessFactor(querier_, cfg_.contact_finger_sigma), nullptr,
           {v.x, v.e, v.p}, {0});
     } else {
@@ -485,16 +608,40 @@ void GraphBuilder::AddDynamicFactors(ceres::Problem& problem, int i) {
   StepVars& v = vars_[i];
   // Force: measurement, weak prior, quasi-static factor.
   {
-    if (s.force >= 0) {
+    const bool two = s.two_contacts;
+    if (s.force >= 0 && two) {
+      // The finger's sensor measures the sum of its contacts' forces.
+      Add(problem, FactorType::kForce, new VectorSumMeasurementFactor(m.force[s.force].force, cfg_.measurement.force),
+          MakeLoss(cfg_.force_loss), {v.f, v.f2});
+    } else if (s.force >= 0) {
       Add(problem, FactorType::kForce, new VectorMeasurementFactor(m.force[s.force].force, cfg_.measurement.force),
           MakeLoss(cfg_.force_loss), {v.f});
     }
     Add(problem, FactorType::kForcePrior, new VectorMeasurementFactor(Vec2::Zero(), cfg_.force_prior_sigma), nullptr, {v.f});
+    if (two) Add(problem, FactorType::kForcePrior, new VectorMeasurementFactor(Vec2::Zero(), cfg_.force_prior_sigma), nullptr, {v.f2});
     if (i >= 1 && HasForceVars(i - 1)) {
       Add(problem, FactorType::kForceContinuity, new VectorRandomWalkFactor(s.t - steps_[i - 1].t, cfg_.force_random_walk),
           nullptr, {vars_[i - 1].f, v.f});
     }
-    if (i >= 1) {
+    if (two && i >= 1 && HasForceVars(i - 1) && HasSecondContact(i - 1)) {
+      Add(problem, FactorType::kForceContinuity, new VectorRandomWalkFactor(s.t - steps_[i - 1].t, cfg_.force_random_walk),
+          nullptr, {vars_[i - 1].f2, v.f2});
+    }
+    if (i >= 1 && two) {
+      // D and the load of both contacts' summed wrench (c and mu at their given values).
+      QuasiStaticGeometry g = qs_;
+      g.dt = s.t - steps_[i - 1].t;
+      const double rate_scale = std::sqrt(0.01 / g.dt);  // per-10-ms sigmas (config.h)
+      Add(problem, FactorType::kQuasiStatic,
+          new QuasiStaticTwoContactFactor(g, cfg_.eps_velocity, cfg_.eps_force, cfg_.quasi_static_sigma * rate_scale),
+          nullptr, {vars_[i - 1].x, v.x, v.p, v.f, v.p2, v.f2}, {0, 1});
+      if (use_load_factor_) {
+        Add(problem, FactorType::kLimitSurfaceLoad,
+            new LimitSurfaceLoadTwoContactFactor(g, f_max_, cfg_.eps_velocity, cfg_.eps_force,
+                                                 cfg_.limit_surface_sigma * rate_scale),
+            nullptr, {vars_[i - 1].x, v.x, v.p, v.f, v.p2, v.f2}, {0, 1});
+      }
+    } else if (i >= 1) {
       QuasiStaticGeometry g = qs_;
       g.dt = s.t - steps_[i - 1].t;
       const double rate_scale = std::sqrt(0.01 / g.dt);  // per-10-ms sigmas (config.h)
@@ -542,10 +689,15 @@ std::vector<double*> GraphBuilder::Blocks(int i) {
   std::vector<double*> b{vars_[i].x, vars_[i].e};
   if (HasContactVars(i)) b.push_back(vars_[i].p);
   if (HasForceVars(i)) b.push_back(vars_[i].f);
+  if (HasSecondContact(i)) b.push_back(vars_[i].p2);
+  if (HasSecondContact(i) && HasForceVars(i)) b.push_back(vars_[i].f2);
   return b;
 }
 
 void GraphBuilder::DropUnobservableForces(EstimationResult& result) const {
+  if (second_contacts_ignored_ > 0)
+    result.warnings.push_back("the Yu-Rodriguez baseline models one contact: the second contact of " +
+                              std::to_string(second_contacts_ignored_) + " steps with two was left out");
   if (ForceScaleObservable()) return;
   for (StateEstimate& s : result.states) {
     s.force.reset();
@@ -571,6 +723,16 @@ void GraphBuilder::SetState(int i, const StateEstimate& st) {
   }
   v.f[0] = st.force ? st.force->x() : 0.0;
   v.f[1] = st.force ? st.force->y() : 0.0;
+  if (HasSecondContact(i) && st.contacts.size() == 2) {
+    v.p2[0] = st.contacts[1].point.x(); v.p2[1] = st.contacts[1].point.y();
+    const Vec2 f1 = st.contacts[0].force.value_or(Vec2::Zero()), f2 = st.contacts[1].force.value_or(Vec2::Zero());
+    v.f[0] = f1.x(); v.f[1] = f1.y();
+    v.f2[0] = f2.x(); v.f2[1] = f2.y();
+  } else if (HasSecondContact(i)) {
+    v.p2[0] = v.p[0]; v.p2[1] = v.p[1];
+    v.f2[0] = v.f[0] = 0.5 * v.f[0];
+    v.f2[1] = v.f[1] = 0.5 * v.f[1];
+  }
 }
 
 void GraphBuilder::SetSharedParameters(std::optional<double> c, std::optional<double> mu) {
@@ -586,6 +748,16 @@ StateEstimate GraphBuilder::State(int i) const {
   s.finger_pose = {v.e[0], v.e[1], v.e[2]};
   if (HasContactVars(i)) s.contact = Vec2(v.p[0], v.p[1]);
   if (HasForceVars(i)) s.force = Vec2(v.f[0], v.f[1]);
+  if (HasSecondContact(i)) {
+    s.contacts.resize(2);
+    s.contacts[0].point = Vec2(v.p[0], v.p[1]);
+    s.contacts[1].point = Vec2(v.p2[0], v.p2[1]);
+    if (HasForceVars(i)) {
+      s.contacts[0].force = Vec2(v.f[0], v.f[1]);
+      s.contacts[1].force = Vec2(v.f2[0], v.f2[1]);
+      s.force = *s.contacts[0].force + *s.contacts[1].force;
+    }
+  }
   return s;
 }
 

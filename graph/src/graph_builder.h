@@ -53,6 +53,11 @@ struct Step {
   double t = 0.0;
   int object = -1, finger = -1, contact = -1, force = -1;
   bool in_contact = false;
+  /// A second contact (a finger wedged in a notch): the contact stream's nearest time has two
+  /// rows. `contact2` is this step's second row (-1: none at this time); Initialize pairs the
+  /// rows with the contact variables p and p2 by proximity to the previous step's.
+  bool two_contacts = false;
+  int contact2 = -1;
 };
 
 /// Parameter blocks of one step (addresses stay fixed: Ceres keeps pointers to them).
@@ -61,6 +66,8 @@ struct StepVars {
   double e[3] = {0, 0, 0};
   double p[2] = {0, 0};
   double f[2] = {0, 0};
+  double p2[2] = {0, 0};  ///< the second contact (Step::two_contacts)
+  double f2[2] = {0, 0};
 };
 
 /// What a residual block is, for the per-type diagnostics (diagnostics.h).
@@ -128,6 +135,7 @@ class GraphBuilder {
   Model model() const { return model_; }
   bool HasContactVars(int i) const { return steps_[i].in_contact; }
   bool HasForceVars(int i) const { return steps_[i].in_contact && ModelHasForce(model_); }
+  bool HasSecondContact(int i) const { return steps_[i].in_contact && steps_[i].two_contacts; }
 
   /// Initial values of step i from the measurements with time stamps <= limit (interpolated;
   /// the newest held). limit = INFINITY in batch; the update time in incremental mode.
@@ -174,7 +182,8 @@ class GraphBuilder {
   bool ForceScaleObservable() const {
     return !ModelHasForce(model_) || streams_.force || (model_ == Model::kQs && use_load_factor_);
   }
-  /// Drops the forces of `result` (and says why in its warnings) when !ForceScaleObservable().
+  /// Drops the forces of `result` (and says why in its warnings) when !ForceScaleObservable();
+  /// warns when the baseline left second contacts out.
   void DropUnobservableForces(EstimationResult& result) const;
   /// Whether an estimated c / mu sits on a bound of AddSharedParameterPrior's [0.2, 5] x start.
   bool c_at_bound() const { return estimate_c_ && AtBound(c_var_[0], qs_.c); }
@@ -207,6 +216,16 @@ class GraphBuilder {
   void AddPoseMeasurementFactors(ceres::Problem& problem, int i);   ///< M of both poses
   void AddConstantVelocityFactors(ceres::Problem& problem, int i);  ///< V on steps i-2, i-1, i
   void AddDynamicFactors(ceres::Problem& problem, int i);
+  /// Step i's second contact point from its rows, paired with the previous step's (Initialize).
+  void InitializeSecondContact(int i, bool causal);
+  /// The object features (edge, or vertex) of step i's two contacts at the current values:
+  /// geometry::FindContacts within 3 contact-measurement sigmas, the two nearest distinct
+  /// features, each given to the contact variable nearer it. False when fewer than two.
+  struct ContactFeature {
+    geometry::EdgeId edge;
+    bool vertex = false;
+  };
+  bool TwoContactFeatures(int i, ContactFeature out[2]) const;
   /// Querier (the given one, else a new one), quasi-static geometry, friction (both constructors).
   void SetUpShapes(std::shared_ptr<const geometry::ShapePairQuerier> querier);
 
@@ -236,6 +255,7 @@ class GraphBuilder {
   /// Describe or the diagnostics (that problem is gone after it).
   bool warm_start_ = false;
   int adding_step_ = -1;  ///< the step whose factors are being added (-1: shared)
+  int second_contacts_ignored_ = 0;  ///< Yu baseline: steps with two contacts it models as one
   std::unordered_map<ceres::ResidualBlockId, std::pair<FactorType, int>> origin_;  ///< for Describe
   double frame_sigma_centroid_ = 0.01, frame_sigma_theta_ = 0.2;
 };

@@ -42,6 +42,15 @@ double Nees(const Vector& e, const Matrix& cov) {
 
 }  // namespace
 
+// The true contact rows at exactly t (several when the finger touches at several points).
+std::vector<Vec2> TruthRowsAt(const std::vector<push::PointSample>& truth, double t) {
+  std::vector<Vec2> rows;
+  auto it = std::lower_bound(truth.begin(), truth.end(), t - 1e-9,
+                             [](const push::PointSample& a, double tt) { return a.t < tt; });
+  for (; it != truth.end() && it->t <= t + 1e-9; ++it) rows.push_back(it->point);
+  return rows;
+}
+
 std::map<std::string, double> ComputeMetrics(const push::Trajectory& traj,
                                              const std::vector<StateEstimate>& states) {
   std::map<std::string, double> m;
@@ -61,7 +70,21 @@ std::map<std::string, double> ComputeMetrics(const push::Trajectory& traj,
       if (s.finger_pose_cov) nees_finger.Add(Nees(*e, *s.finger_pose_cov));
     }
     Vec2 v;
-    if (s.contact && push::TruthPointAt(gt.contact_point, s.t, &v)) {
+    const std::vector<Vec2> rows = TruthRowsAt(gt.contact_point, s.t);
+    if (s.contact && (rows.size() >= 2 || !s.contacts.empty())) {
+      // Several contacts: each estimated contact against the nearest true one at this time.
+      std::vector<std::pair<Vec2, std::optional<Eigen::Matrix2d>>> estimated;
+      if (s.contacts.empty()) estimated.push_back({*s.contact, s.contact_cov});
+      for (const ContactEstimate& c : s.contacts) estimated.push_back({c.point, c.point_cov});
+      for (const auto& [point, cov] : estimated) {
+        if (rows.empty()) break;
+        Vec2 e = point - rows[0];
+        for (const Vec2& r : rows)
+          if ((point - r).squaredNorm() < e.squaredNorm()) e = point - r;
+        contact.Add(e.squaredNorm());
+        if (cov) nees_contact.Add(Nees(e, *cov));
+      }
+    } else if (s.contact && push::TruthPointAt(gt.contact_point, s.t, &v)) {
       const Vec2 e = *s.contact - v;
       contact.Add(e.squaredNorm());
       if (s.contact_cov) nees_contact.Add(Nees(e, *s.contact_cov));

@@ -30,12 +30,13 @@ void CheckRange(double t, double value, double bound, const std::string& stream,
   }
 }
 
+// `repeats`: a time may repeat (contact_point: one row per contact).
 template <class Sample>
-void CheckSorted(const std::vector<Sample>& s, const std::string& stream) {
+void CheckSorted(const std::vector<Sample>& s, const std::string& stream, bool repeats = false) {
   for (std::size_t i = 1; i < s.size(); ++i) {
-    if (!(s[i].t > s[i - 1].t)) {
-      throw GraphError("trajectory: streams." + stream + " is not strictly increasing in time at sample " +
-                       std::to_string(i));
+    if (!(s[i].t > s[i - 1].t) && !(repeats && s[i].t == s[i - 1].t)) {
+      throw GraphError("trajectory: streams." + stream + " is not " + (repeats ? "increasing" : "strictly increasing") +
+                       " in time at sample " + std::to_string(i));
     }
   }
 }
@@ -50,7 +51,8 @@ constexpr double kClockJumpPeriods = 1000.0;
 template <class Sample>
 double MedianPeriod(const std::vector<Sample>& s) {
   std::vector<double> d;
-  for (std::size_t i = 1; i < s.size(); ++i) d.push_back(s[i].t - s[i - 1].t);
+  for (std::size_t i = 1; i < s.size(); ++i)
+    if (s[i].t != s[i - 1].t) d.push_back(s[i].t - s[i - 1].t);  // repeated contact times: one sample time
   if (d.empty()) return 0.0;
   std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
   return d[d.size() / 2];
@@ -96,22 +98,13 @@ double ForceFaultBound(double force_p95, const push::ObjectDescription& object) 
 void ValidateTrajectory(const push::Trajectory& traj) {
   if (traj.object.shape.empty()) throw GraphError("trajectory: object.shape is missing or empty");
   if (traj.finger.shape.empty()) throw GraphError("trajectory: finger.shape is missing or empty");
-  // Pushes with several fingers or contacts are simulated and stored (push::MultiPushingModel,
-  // "fingers" in the file format), but the factor graphs model one point contact.
+  // Pushes with several fingers are simulated and stored (push::MultiPushingModel, "fingers" in
+  // the file format); the factor graphs model one finger (with up to two contacts).
   if (!traj.extra_fingers.empty())
     throw GraphError("trajectory: " + std::to_string(push::FingerCount(traj)) +
-                     " fingers: the estimator models one finger with one contact (several fingers are not estimated yet)");
+                     " fingers: the estimator models one finger (with up to two contacts); several fingers are not "
+                     "estimated yet");
   const auto& m = traj.measured;
-  for (std::size_t i = 1; i < m.contact_point.size(); ++i) {
-    if (m.contact_point[i].t == m.contact_point[i - 1].t) {
-      std::ostringstream text;
-      text.precision(17);
-      text << "trajectory: streams.contact_point[" << i - 1 << "] and [" << i << "] are two contacts at t = "
-           << m.contact_point[i].t
-           << " s: the estimator models one point contact (several contacts at once are not estimated yet)";
-      throw GraphError(text.str());
-    }
-  }
   for (std::size_t i = 0; i < m.object_pose.size(); ++i) {
     CheckFinite(std::isfinite(m.object_pose[i].t) && m.object_pose[i].pose.vector().allFinite(), "object_pose", i);
   }
@@ -141,7 +134,7 @@ void ValidateTrajectory(const push::Trajectory& traj) {
   }
   CheckSorted(m.object_pose, "object_pose");
   CheckSorted(m.finger_pose, "finger_pose");
-  CheckSorted(m.contact_point, "contact_point");
+  CheckSorted(m.contact_point, "contact_point", /*repeats=*/true);
   CheckSorted(m.force, "force");
   {
     double finest = INFINITY;

@@ -106,6 +106,63 @@ TEST(FactorJacobians, BoundaryPointNearBoundaryAndVertices) {
   EXPECT_TRUE(tally.MostlyChecked(0.9));
 }
 
+// The local witness of one of two contacts: a disk or a rounded square finger near a random
+// object's boundary (touching, slightly in, slightly apart), the contact point near the touch.
+TEST(FactorJacobians, LocalWitness) {
+  Rng rng;
+  JacobianTally tally("C local witness");
+  WorstError worst{"C local witness"};
+  int n = 0;
+  for (const Shape& object : Objects()) {
+    for (const Shape& finger : {Shape::Disk(0.005), Shape::Box(0.01, 0.01, 0.002)}) {
+      LocalWitnessFactor f(object, finger, 1e-3);
+      for (int i = 0; i < 60; ++i, ++n) {
+        const Pose2 x = rng.P(0.2);
+        // A boundary point of the object, the finger just outside it along the normal.
+        const Vec2 probe = geometry::Act(x, Vec2(rng.U(-0.07, 0.07), rng.U(-0.07, 0.07)));
+        const geometry::PointQuery q = geometry::QueryPoint(object, x, probe);
+        const Vec2 centre = q.closest_point + q.normal * (0.005 + rng.U(-0.002, 0.002));
+        const Pose2 e{centre.x(), centre.y(), rng.U(-M_PI, M_PI)};
+        const Vec2 p = q.closest_point + Vec2(rng.U(-0.002, 0.002), rng.U(-0.002, 0.002));
+        CheckCost(f, {V(x), V(e), V(p)}, tally, worst, "case " + std::to_string(n));
+      }
+    }
+  }
+  EXPECT_TRUE(tally.MostlyChecked(0.9));
+}
+
+// The witness on a given edge or vertex of the object (inside the edge, past its ends, at a
+// vertex), unrounded and rounded objects; on the nearest feature it equals the local witness.
+TEST(FactorJacobians, FeatureWitness) {
+  Rng rng;
+  JacobianTally tally("C feature witness");
+  WorstError worst{"C feature witness"};
+  int n = 0;
+  for (const Shape& base : Objects()) {
+    for (const double radius : {0.0, 0.003}) {
+      if (radius == 0.0 && base.is_degenerate_core()) continue;  // a point or segment needs its radius
+      const Shape object = base.WithRadius(radius);
+      const auto& ring = object.polygons()[0].outer;
+      for (int i = 0; i < 40; ++i, ++n) {
+        const int k = i % static_cast<int>(ring.size());
+        const bool vertex = i % 4 == 0 || ring.size() == 1;
+        FeatureWitnessFactor f(object, geometry::EdgeId{0, -1, k}, vertex, Shape::Disk(0.005), 1e-3);
+        const Pose2 x = rng.P(0.2);
+        const Vec2 a = ring[k], b = ring[(k + 1) % ring.size()];
+        const Vec2 along = a + rng.U(-0.3, 1.3) * (b - a);
+        const Vec2 out(b.y() - a.y(), a.x() - b.x());
+        const Vec2 centre = geometry::Act(x, along + out.normalized() * (radius + 0.005 + rng.U(-0.002, 0.002)));
+        const Pose2 e{centre.x(), centre.y(), rng.U(-M_PI, M_PI)};
+        const Vec2 p = geometry::Act(x, along) + Vec2(rng.U(-0.002, 0.002), rng.U(-0.002, 0.002));
+        CheckCost(f, {V(x), V(e), V(p)}, tally, worst, "case " + std::to_string(n));
+      }
+    }
+  }
+  EXPECT_TRUE(tally.MostlyChecked(0.9));
+  EXPECT_THROW(FeatureWitnessFactor(Objects()[0], geometry::EdgeId{0, 5, 0}, false, Shape::Disk(0.005), 1e-3), GraphError);
+  EXPECT_THROW(FeatureWitnessFactor(Objects()[0], geometry::EdgeId{0, -1, 999}, false, Shape::Disk(0.005), 1e-3), GraphError);
+}
+
 TEST(FactorJacobians, TouchingAndIntersection) {
   Rng rng;
   JacobianTally t_touch("C touching"), t_int("S");
@@ -311,6 +368,45 @@ TEST(FactorJacobians, QuasiStaticBothForms) {
   EXPECT_TRUE(tl.MostlyChecked(0.95));
   EXPECT_TRUE(td.MostlyChecked(0.95));
   EXPECT_TRUE(ty.MostlyChecked(0.95));
+}
+
+// Two contacts (a finger wedged in a notch): D and the load of the summed wrench, and the
+// finger's net-force measurement. The second contact is another random case's point and force
+// (some near zero: a contact about to open). With the second force zero, D is the one-contact D.
+TEST(FactorJacobians, TwoContactQuasiStaticAndNetForce) {
+  Rng rng;
+  QuasiStaticGeometry g;
+  g.c = 0.0344;
+  g.centre_of_pressure = Vec2(0.003, -0.002);
+  g.dt = 0.004;
+  QuasiStaticTwoContactFactor d2(g, 1e-3, 0.05, 0.1);
+  LimitSurfaceLoadTwoContactFactor l2(g, 2.0, 1e-3, 0.05, 0.1);
+  VectorSumMeasurementFactor sum(Vec2(0.7, -0.2), 0.05);
+  QuasiStaticFactor d1(g, 1e-3, 0.05, 0.1);
+  JacobianTally td("D, two contacts"), tl("limit-surface load, two contacts"), ts("net force");
+  WorstError wd{"D with two contacts"}, wl{"limit-surface load with two contacts"}, ws{"net force measurement"};
+  const std::vector<QsCase> cases = QuasiStaticCases(rng, g), others = QuasiStaticCases(rng, g);
+  for (std::size_t n = 0; n < cases.size(); ++n) {
+    const QsCase& c = cases[n];
+    const QsCase& o = others[(n * 7 + 3) % others.size()];
+    Vec2 f2 = o.f;
+    if (n % 5 == 0) f2 *= 1e-6;  // nearly open
+    const std::string ctx = "case " + std::to_string(n);
+    CheckCost(d2, {V(c.x_prev), V(c.x), V(c.p), V(c.f), V(o.p), V(f2)}, td, wd, ctx);
+    CheckCost(l2, {V(c.x_prev), V(c.x), V(c.p), V(c.f), V(o.p), V(f2)}, tl, wl, ctx);
+    CheckCost(sum, {V(c.f), V(f2)}, ts, ws, ctx);
+    // The second contact without force is no contact.
+    const std::vector<Eigen::VectorXd> values{V(c.x_prev), V(c.x), V(c.p), V(c.f), V(o.p), V(Vec2::Zero())};
+    const double* two[] = {values[0].data(), values[1].data(), values[2].data(), values[3].data(), values[4].data(),
+                           values[5].data()};
+    Eigen::Vector3d r2, r1;
+    ASSERT_TRUE(d2.Evaluate(two, r2.data(), nullptr));
+    ASSERT_TRUE(d1.Evaluate(two, r1.data(), nullptr));
+    EXPECT_LE((r2 - r1).norm(), 1e-12 * (1.0 + r1.norm())) << ctx;
+  }
+  EXPECT_TRUE(td.MostlyChecked(0.95));
+  EXPECT_TRUE(tl.MostlyChecked(0.95));
+  EXPECT_TRUE(ts.MostlyChecked(0.95));
 }
 
 

@@ -34,6 +34,7 @@ namespace fs = std::filesystem;
 struct EvaluateOptions {
   std::vector<std::string> inputs;
   int simulate = 0;
+  int simulate_multi = 0;  // --simulate-multi-contact
   std::string sim_object = DefaultDataDir() + "/shapes/notched_block.json";
   std::string sim_finger = DefaultDataDir() + "/shapes/disk_finger_5mm.json";
   double sim_mass = 0.5, sim_mu = 0.3, sim_mu_contact = 0.4;
@@ -125,13 +126,18 @@ void RunEvaluate(const EvaluateOptions& o) {
     options.object_override = m;
   }
   if (o.simulate < 0) throw CliError("--simulate must be >= 0");
+  if (o.simulate_multi < 0) throw CliError("--simulate-multi-contact must be >= 0");
   options.simulation.count = o.simulate;
-  if (o.simulate > 0) {
+  if (o.simulate > 0 || o.simulate_multi > 0) {
     if (!(o.sim_mass > 0.0) || !(o.sim_mu > 0.0) || !(o.sim_mu_contact >= 0.0))
       throw CliError("--sim-mass and --sim-mu must be > 0, --sim-mu-contact >= 0");
     options.simulation.object = {LoadShapeArgument(o.sim_object, "--sim-object"), o.sim_mass, o.sim_mu};
     options.simulation.finger = {LoadShapeArgument(o.sim_finger, "--sim-finger"), o.sim_mu_contact};
     options.simulation.name = "sim:" + fs::path(o.sim_object).stem().string();
+    options.multi_contact_simulation = options.simulation;
+    options.multi_contact_simulation.count = o.simulate_multi;
+    options.multi_contact_simulation.multi_contact = true;
+    options.multi_contact_simulation.name = "sim-multi:" + fs::path(o.sim_object).stem().string();
   }
   if (o.out.empty()) throw CliError("--out DIR is required");
   if (o.plots < 0) throw CliError("--plots must be >= 0");
@@ -181,6 +187,10 @@ void RegisterEvaluate(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("evaluate", "Run the paper's evaluation protocols over many pushes (tables as Markdown/CSV)");
   cmd->add_option("inputs", o->inputs, "MIT recordings (.h5/.json) or trajectory files: files, folders (recursive) or globs");
   cmd->add_option("--simulate", o->simulate, "Also evaluate N seeded simulated pushes (varied direction and offset)")
+      ->capture_default_str();
+  cmd->add_option("--simulate-multi-contact", o->simulate_multi,
+                  "Also evaluate N simulated pushes with every contact modelled (group sim-multi: push i is "
+                  "--simulate's push i; a finger pushed into a notch wedges and touches both walls)")
       ->capture_default_str();
   cmd->add_option("--sim-object", o->sim_object, "Shape of the simulated pushes' object")->capture_default_str();
   cmd->add_option("--sim-finger", o->sim_finger, "Finger of the simulated pushes")->capture_default_str();

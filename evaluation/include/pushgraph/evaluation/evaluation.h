@@ -65,6 +65,9 @@ struct EvaluationOptions {
   std::optional<ObjectModel> object_override;
   std::string mesh_dir;
   SimulationSpec simulation;
+  /// A second simulated group, every contact modelled (SimulationSpec::multi_contact): push i is
+  /// simulation's push i (the same line and seed), so wedged pushes compare one to one.
+  SimulationSpec multi_contact_simulation;
   graph::EstimatorConfig estimator;  ///< measurement sigmas are replaced by the added noise's
   /// Pictures (plot_svg.h) of the first `plots_per_group` items of every group are written into
   /// plot_dir (when set): GROUP-INDEX-fig3.svg, the QS batch trajectory over the footprint with
@@ -85,6 +88,7 @@ struct EvaluationItem {
   std::string group;     ///< object name: one table row group
   enum class Source { kFile, kSimulated } source = Source::kSimulated;  ///< kFile: kind by DetectInputKind
   int sim_index = -1;
+  bool multi_contact_sim = false;  ///< of EvaluationOptions::multi_contact_simulation
   bool plot = false;  ///< among the first plots_per_group items of its group (PlanEvaluation)
   /// The group's shape registration (RegisterGroups): applied to the object's shape before any
   /// estimate, when the group's recordings together say the shape does not fit as given.

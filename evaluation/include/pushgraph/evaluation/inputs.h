@@ -101,6 +101,9 @@ struct SimulationSpec {
   double speed = 0.05;          ///< m/s
   double offset_fraction = 0.5;
   double standoff = 0.005;  ///< m
+  /// Every contact of the finger (push::PushPlan::multi_contact): a finger pushed into a notch
+  /// wedges and touches both walls, and the estimator gets two contact rows at those times.
+  bool multi_contact = false;
 };
 
 /// The clean (noise-free) simulated push number `index`.

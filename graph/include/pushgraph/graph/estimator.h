@@ -46,12 +46,24 @@ Mode ParseMode(const std::string& name);
 std::string ModeName(Mode mode);
 bool ModelHasForce(Model model);
 
+/// One contact of a step that has two (a finger wedged in a notch touches both walls).
+struct ContactEstimate {
+  Vec2 point{0.0, 0.0};
+  std::optional<Vec2> force;  ///< this contact's force (QS), world frame
+  std::optional<Eigen::Matrix2d> point_cov, force_cov;
+};
+
 struct StateEstimate {
   double t = 0.0;
   Pose2 object_pose;
   Pose2 finger_pose;
-  std::optional<Vec2> contact;  ///< while in contact
-  std::optional<Vec2> force;    ///< QS and baseline, while in contact
+  std::optional<Vec2> contact;  ///< while in contact (the first contact when there are two)
+  /// QS and baseline, while in contact: the finger's net force on the object (the sum over its
+  /// contacts: what its force sensor measures).
+  std::optional<Vec2> force;
+  /// Steps with two contacts: both, each with its own force and covariances (`contact` is the
+  /// first; `force_cov` is then not reported: the sum's covariance needs their cross-covariance).
+  std::vector<ContactEstimate> contacts;
   std::optional<Eigen::Matrix3d> object_pose_cov, finger_pose_cov;  ///< (x, y, theta)
   std::optional<Eigen::Matrix2d> contact_cov, force_cov;
 };

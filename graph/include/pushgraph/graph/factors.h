@@ -60,6 +60,20 @@ class VectorMeasurementFactor : public ceres::SizedCostFunction<2, 2> {
   double w_;
 };
 
+/// M for the net force of a finger touching the object at two points (a force sensor in the
+/// finger measures the sum of its contact forces): r = (a + b - measured) / sigma.
+/// Parameters: a (2), b (2).
+class VectorSumMeasurementFactor : public ceres::SizedCostFunction<2, 2, 2> {
+ public:
+  VectorSumMeasurementFactor(const Vec2& measured, double sigma);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  Vec2 measured_;
+  double w_;
+};
+
 /// C (paper Eq. 6) for one body: the contact point lies on the boundary of `shape` placed at
 /// the pose: r = (p - G(xi(pose), p)) / sigma, G the exact closest boundary point
 /// (geometry::QueryPoint). Parameters: pose (3), point (2). Used for the object (pose x_t) and
@@ -73,6 +87,46 @@ class BoundaryPointFactor : public ceres::SizedCostFunction<2, 3, 2> {
  private:
   geometry::Shape shape_;
   double w_;
+};
+
+/// C for one of several contacts (a finger wedged in a notch touches two walls), the local
+/// witness: r = (p - G_o(x, G_f(e, p))) / sigma, with G_f the finger's closest boundary point to
+/// p and G_o the object's closest boundary point to that. Its zero is the touching pair of the
+/// features near p: unlike "p on both boundaries" (two boundary factors), which a finger
+/// slightly into one wall satisfies at either of that wall's two crossings, and unlike the
+/// shape-pair witness, which is the single nearest pair (one of the two walls), each contact
+/// keeps to its own wall. Parameters: object pose (3), finger pose (3), contact point (2).
+class LocalWitnessFactor : public ceres::SizedCostFunction<2, 3, 3, 2> {
+ public:
+  LocalWitnessFactor(geometry::Shape object, geometry::Shape finger, double sigma);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  geometry::Shape object_, finger_;
+  double w_;
+};
+
+/// LocalWitnessFactor on one given feature of the object: an edge (a wall of a notch) or a
+/// vertex (an object corner on a flat pusher's face), the feature a contact was found on
+/// (geometry::FindContacts at the current estimate). q is the closest point of that feature,
+/// rounded by the object's radius, to G_f(e, p): r = (p - q) / sigma. Two contacts on two walls
+/// then cannot both settle on one wall where noisy contact measurements pull them together.
+/// Parameters: object pose (3), finger pose (3), contact point (2).
+class FeatureWitnessFactor : public ceres::SizedCostFunction<2, 3, 3, 2> {
+ public:
+  /// `feature`: an edge of `object` (its start vertex when `vertex`). Throws GraphError for an
+  /// edge the object does not have.
+  FeatureWitnessFactor(geometry::Shape object, geometry::EdgeId feature, bool vertex, geometry::Shape finger,
+                       double sigma);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  geometry::Shape finger_;
+  Vec2 a_, b_;          ///< the edge's end points (object frame); a_ alone for a vertex
+  bool vertex_, two_sided_ = false;  ///< two-sided: a segment core, rounded on both sides
+  double radius_, w_;
 };
 
 /// C(x_t, e_t): the finger touches the object, r = signed separation / sigma (exact, from
@@ -211,6 +265,22 @@ class QuasiStaticFactor : public ceres::SizedCostFunction<3, 3, 3, 2, 2> {
   double eps_v_, eps_f_, w_;
 };
 
+/// D with two contacts (a finger wedged in a notch, touching both walls): the load is the sum
+/// of both contacts' wrenches, g' = g'(p_1, f_1) + g'(p_2, f_2) (QuasiStaticTerms of each, about
+/// the same centre of pressure), and the residual is QuasiStaticFactor's normalized cross
+/// product of V' and that g'. Parameters: x_prev (3), x_t (3), p_1 (2), f_1 (2), p_2 (2), f_2 (2).
+class QuasiStaticTwoContactFactor : public ceres::SizedCostFunction<3, 3, 3, 2, 2, 2, 2> {
+ public:
+  QuasiStaticTwoContactFactor(const QuasiStaticGeometry& geometry, double eps_velocity, double eps_force,
+                              double sigma);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  QuasiStaticGeometry geometry_;
+  double eps_v_, eps_f_, w_;
+};
+
 /// D with the limit-surface ratio c as a fifth parameter block (1), shared by every step, to
 /// estimate c jointly with the trajectory (EstimatorConfig::estimate_c). Same residual as
 /// QuasiStaticFactor; Evaluate fails (Ceres shortens the step) for c <= 0.
@@ -235,6 +305,20 @@ class LimitSurfaceLoadFactor : public ceres::SizedCostFunction<1, 3, 3, 2, 2> {
  public:
   LimitSurfaceLoadFactor(const QuasiStaticGeometry& geometry, double f_max, double eps_velocity,
                          double eps_force, double sigma);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  QuasiStaticGeometry geometry_;
+  double f_max_, eps_v_, eps_f_, w_;
+};
+
+/// LimitSurfaceLoadFactor with two contacts: |g'| of the summed load (QuasiStaticTwoContactFactor)
+/// on the surface while sliding. Parameters as QuasiStaticTwoContactFactor.
+class LimitSurfaceLoadTwoContactFactor : public ceres::SizedCostFunction<1, 3, 3, 2, 2, 2, 2> {
+ public:
+  LimitSurfaceLoadTwoContactFactor(const QuasiStaticGeometry& geometry, double f_max, double eps_velocity,
+                                   double eps_force, double sigma);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
