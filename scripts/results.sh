@@ -22,7 +22,8 @@ P="$BUILD_DIR/tools/pushgraph"
 
 inputs=()
 if [ -d "$MIT" ]; then inputs+=("$MIT/ellip1" "$MIT/rect1"); else echo "results.sh: no MIT sample at $MIT, simulated pushes only" >&2; fi
-cmd=(evaluate "${inputs[@]}" --simulate "$SIMULATED" --protocol all --seed 1 -j "$JOBS" --out "$OUT")
+cmd=(evaluate "${inputs[@]}" --simulate "$SIMULATED" --simulate-multi-contact "$SIMULATED" --protocol all --seed 1 -j "$JOBS"
+     --out "$OUT")
 start=$(date +%s)
 "$P" "${cmd[@]}" > /dev/null
 seconds=$(( $(date +%s) - start ))
@@ -42,7 +43,9 @@ state="$(git rev-parse --short HEAD 2>/dev/null || echo unknown)$(git diff --qui
   echo "  frozen, from the object's motion until it comes to rest; each object's mesh is checked against all of its"
   echo "  recordings together and used as shipped when it fits, docs/evaluation.md) and $SIMULATED"
   echo "  simulated pushes (group \`sim:notched_block\`: the non-convex notched block with two holes, 0.5 kg,"
-  echo "  5 mm disk finger, 5 cm straight pushes in random directions and offsets, exact limit surface)."
+  echo "  5 mm disk finger, 5 cm straight pushes in random directions and offsets, exact limit surface) and"
+  echo "  the same $SIMULATED pushes simulated with every contact (group \`sim-multi:notched_block\`: pushes 2 and 6"
+  echo "  wedge the finger in the V, which then touches both walls; the estimator models both contacts there)."
   echo "- rect1's force sensor is frozen in every recording (the reader drops the stream), so rect1 has no"
   echo "  force rows; MIT recordings have no contact stream, so their contact rows are absent too."
   echo "- Machine: $(nproc) cores shared with other jobs; wall time of the whole run: ${seconds} s;"

@@ -220,6 +220,42 @@ bool FeatureWitnessFactor::Evaluate(double const* const* parameters, double* res
   return true;
 }
 
+FrictionConeFactor::FrictionConeFactor(geometry::Shape object, double mu, double sigma)
+    : object_(std::move(object)), mu_(mu), w_(CheckedWeight(sigma, "friction cone")) {
+  if (!(mu >= 0.0) || !std::isfinite(mu)) throw GraphError("friction cone: mu_contact must be finite and >= 0");
+}
+
+bool FrictionConeFactor::Evaluate(double const* const* parameters, double* residuals,
+                                  double** jacobians) const {
+  const Vec2 p(parameters[1][0], parameters[1][1]), f(parameters[2][0], parameters[2][1]);
+  geometry::PointQueryJacobians J;
+  geometry::PointQuery q;
+  if (!QueryPointOrReject(object_, parameters[0], p, &q, &J)) return false;
+  // Inward normal n = -outward, tangent t = z x n; dn/d(.) = -J_normal_(.).
+  const Vec2 n = -q.normal, t(-n.y(), n.x());
+  Eigen::Matrix2d perp;
+  perp << 0.0, -1.0, 1.0, 0.0;
+  const double fn = f.dot(n), ft = f.dot(t), sign = ft >= 0.0 ? 1.0 : -1.0;
+  const bool pulls = fn < 0.0, slips = std::abs(ft) - mu_ * fn > 0.0;
+  residuals[0] = pulls ? -w_ * fn : 0.0;
+  residuals[1] = slips ? w_ * (std::abs(ft) - mu_ * fn) : 0.0;
+  if (jacobians == nullptr) return true;
+  // r0 = -w f.n; r1 = w (s f.t - mu f.n), t = perp n.
+  const Eigen::RowVector2d dr0_dn = pulls ? Eigen::RowVector2d(-w_ * f.transpose()) : Eigen::RowVector2d::Zero();
+  const Eigen::RowVector2d dr1_dn =
+      slips ? Eigen::RowVector2d(w_ * (sign * f.transpose() * perp - mu_ * f.transpose())) : Eigen::RowVector2d::Zero();
+  const Eigen::RowVector2d dr0_df = pulls ? Eigen::RowVector2d(-w_ * n.transpose()) : Eigen::RowVector2d::Zero();
+  const Eigen::RowVector2d dr1_df =
+      slips ? Eigen::RowVector2d(w_ * (sign * t.transpose() - mu_ * n.transpose())) : Eigen::RowVector2d::Zero();
+  Eigen::Matrix2d dr_dn, dr_df;
+  dr_dn << dr0_dn, dr1_dn;
+  dr_df << dr0_df, dr1_df;
+  if (jacobians[0] != nullptr) Eigen::Map<RowMat23>{jacobians[0]} = -dr_dn * J.J_normal_pose;
+  if (jacobians[1] != nullptr) Eigen::Map<RowMat22>{jacobians[1]} = -dr_dn * J.J_normal_point;
+  if (jacobians[2] != nullptr) Eigen::Map<RowMat22>{jacobians[2]} = dr_df;
+  return true;
+}
+
 // Object pose in parameters[0], finger pose in parameters[1]. A geometry error (non-finite
 // poses during a bad step) makes Ceres reject the step rather than abort the solve.
 // The touching, witness and intersection factors of a step ask the same querier about the same

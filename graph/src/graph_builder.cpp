@@ -618,7 +618,15 @@ void GraphBuilder::AddDynamicFactors(ceres::Problem& problem, int i) {
           MakeLoss(cfg_.force_loss), {v.f});
     }
     Add(problem, FactorType::kForcePrior, new VectorMeasurementFactor(Vec2::Zero(), cfg_.force_prior_sigma), nullptr, {v.f});
-    if (two) Add(problem, FactorType::kForcePrior, new VectorMeasurementFactor(Vec2::Zero(), cfg_.force_prior_sigma), nullptr, {v.f2});
+    if (two) {
+      Add(problem, FactorType::kForcePrior, new VectorMeasurementFactor(Vec2::Zero(), cfg_.force_prior_sigma), nullptr, {v.f2});
+      // Only the sum is measured: each force in its friction cone (sigma a tenth of the force
+      // sensor's) keeps the split physical.
+      for (const auto& [point, force] : {std::pair{v.p, v.f}, std::pair{v.p2, v.f2}})
+        Add(problem, FactorType::kForcePrior,
+            new FrictionConeFactor(traj_.object.shape, traj_.finger.mu_contact, 0.1 * cfg_.measurement.force), nullptr,
+            {v.x, point, force}, {0});
+    }
     if (i >= 1 && HasForceVars(i - 1)) {
       Add(problem, FactorType::kForceContinuity, new VectorRandomWalkFactor(s.t - steps_[i - 1].t, cfg_.force_random_walk),
           nullptr, {vars_[i - 1].f, v.f});

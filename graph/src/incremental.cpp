@@ -495,6 +495,7 @@ struct OnlineEstimator::Impl {
   double newest_t = -INFINITY;
   double first_t = INFINITY;
   double last_seen[4] = {-INFINITY, -INFINITY, -INFINITY, -INFINITY};  // per stream, dropped samples included
+  bool repeated_contact = false;  // the newest contact sample is the second at its time
   std::size_t seen[4] = {0, 0, 0, 0};
   int dropped_late = 0;
   // Force sensor faults (the batch rule, Estimate's DropForceSpikes): a force above 50 times the
@@ -540,10 +541,14 @@ struct OnlineEstimator::Impl {
       throw GraphError(where() + ": the stream was not declared in OnlineStreams (it decides contact gating and the load factor)");
     }
     if (!std::isfinite(t) || !finite) throw GraphError(where() + " is not finite");
-    if (!(t > last_seen[stream])) {
-      throw GraphError(where() + " is not after the previous sample (t = " + Precise(last_seen[stream]) +
-                       "): each stream must arrive in time order");
+    // A second contact point at the same time is a second contact (a finger wedged in a notch).
+    const bool second_contact = stream == 2 && t == last_seen[stream] && !repeated_contact;
+    if (!(t > last_seen[stream]) && !second_contact) {
+      throw GraphError(where() + " is not after the previous sample (t = " + Precise(last_seen[stream]) + ")" +
+                       (stream == 2 && t == last_seen[stream] ? ": at most two contacts at one time"
+                                                              : ": each stream must arrive in time order"));
     }
+    if (stream == 2) repeated_contact = second_contact;
     // A clock jump (the batch estimator's bound: 10 s or 1000 object periods): the smoother's
     // states follow the clock, so its cost would follow the jump, not the samples.
     const double jump_bound = std::max(10.0, std::isfinite(object_period) ? 1000.0 * object_period : 0.0);

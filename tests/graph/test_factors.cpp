@@ -163,6 +163,41 @@ TEST(FactorJacobians, FeatureWitness) {
   EXPECT_THROW(FeatureWitnessFactor(Objects()[0], geometry::EdgeId{0, -1, 999}, false, Shape::Disk(0.005), 1e-3), GraphError);
 }
 
+// The friction cone: forces inside (zero residual), pulling, slipping on either side, at
+// contact points near the boundary of random objects (the normal varies with pose and point).
+TEST(FactorJacobians, FrictionCone) {
+  Rng rng;
+  JacobianTally tally("friction cone");
+  WorstError worst{"friction cone"};
+  int n = 0, inside = 0;
+  for (const Shape& object : Objects()) {
+    FrictionConeFactor f(object, 0.4, 0.05);
+    for (int i = 0; i < 80; ++i, ++n) {
+      const Pose2 x = rng.P(0.2);
+      const geometry::PointQuery q =
+          geometry::QueryPoint(object, x, geometry::Act(x, Vec2(rng.U(-0.07, 0.07), rng.U(-0.07, 0.07))));
+      const Vec2 p = q.closest_point + 1e-4 * Vec2(rng.U(-1, 1), rng.U(-1, 1));
+      const double a = rng.U(-M_PI, M_PI);
+      const Vec2 force = rng.U(0.1, 3.0) * Vec2(std::cos(a), std::sin(a));
+      const std::vector<Eigen::VectorXd> values{V(x), V(p), V(force)};
+      CheckCost(f, values, tally, worst, "case " + std::to_string(n));
+      const double* blocks[] = {values[0].data(), values[1].data(), values[2].data()};
+      Eigen::Vector2d r;
+      ASSERT_TRUE(f.Evaluate(blocks, r.data(), nullptr));
+      inside += r.norm() == 0.0;
+      // Pushing straight in is inside the cone.
+      const Vec2 in = -geometry::QueryPoint(object, x, p).normal;
+      const std::vector<Eigen::VectorXd> push{V(x), V(p), V(Vec2(1.5 * in))};
+      const double* pb[] = {push[0].data(), push[1].data(), push[2].data()};
+      ASSERT_TRUE(f.Evaluate(pb, r.data(), nullptr));
+      EXPECT_EQ(r.norm(), 0.0) << "case " << n;
+    }
+  }
+  EXPECT_GT(inside, n / 20);       // some random forces are inside the cone (|angle| < atan 0.4)
+  EXPECT_LT(inside, n / 2);        // most are not
+  EXPECT_TRUE(tally.MostlyChecked(0.9));
+}
+
 TEST(FactorJacobians, TouchingAndIntersection) {
   Rng rng;
   JacobianTally t_touch("C touching"), t_int("S");

@@ -129,6 +129,24 @@ class FeatureWitnessFactor : public ceres::SizedCostFunction<2, 3, 3, 2> {
   double radius_, w_;
 };
 
+/// Coulomb's friction cone of one contact, one-sided (zero inside the cone): with n the object's
+/// inward normal at p (geometry::QueryPoint), f_n = f.n, f_t = f.(z x n),
+///   r = (max(0, -f_n), max(0, |f_t| - mu f_n)) / sigma.
+/// The finger pushes, it cannot pull, and friction is at most mu times the push. With two
+/// contacts only their sum is measured; the cone is what keeps their split physical (forces near
+/// the walls' normals, so the torque about the finger follows from the geometry).
+/// Parameters: object pose (3), contact point (2), force (2).
+class FrictionConeFactor : public ceres::SizedCostFunction<2, 3, 2, 2> {
+ public:
+  FrictionConeFactor(geometry::Shape object, double mu, double sigma);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  geometry::Shape object_;
+  double mu_, w_;
+};
+
 /// C(x_t, e_t): the finger touches the object, r = signed separation / sigma (exact, from
 /// geometry::ShapePairQuerier, positive apart, minus the penetration depth when overlapping).
 /// Parameters: object pose (3), finger pose (3).
