@@ -191,6 +191,18 @@ push::Trajectory AddNoise(const push::Trajectory& trajectory, const push::NoiseM
   t.ground_truth = clean;
   t.measured = push::ApplyNoise(clean, noise, seed);
   t.measurement_sigmas = push::SigmasOf(noise);
+  // Every other finger's streams: the same noise model, their own draws.
+  for (std::size_t k = 0; k < t.extra_fingers.size(); ++k) {
+    push::ExtraFinger& e = t.extra_fingers[k];
+    const push::FingerStreams truth = e.ground_truth ? *e.ground_truth : e.measured;
+    push::Streams streams;
+    streams.finger_pose = truth.finger_pose;
+    streams.contact_point = truth.contact_point;
+    streams.force = truth.force;
+    const push::Streams noisy = push::ApplyNoise(streams, noise, SplitMix(seed ^ (0x9e3779b97f4a7c15ULL * (k + 1))));
+    e.ground_truth = truth;
+    e.measured = {noisy.finger_pose, noisy.contact_point, noisy.force};
+  }
   return t;
 }
 
@@ -254,6 +266,23 @@ ObjectModel MitObjectModel(const std::string& name, const std::string& mesh_dir)
   return m;
 }
 
+MultiContactPushKind MultiContactPushKindOf(int index) {
+  switch (index % 4) {
+    case 1: return MultiContactPushKind::kTwoFingers;
+    case 3: return MultiContactPushKind::kFlatPusher;
+    default: return MultiContactPushKind::kOneFinger;
+  }
+}
+
+const char* MultiContactPushKindName(MultiContactPushKind kind) {
+  switch (kind) {
+    case MultiContactPushKind::kOneFinger: return "one-finger";
+    case MultiContactPushKind::kTwoFingers: return "two-fingers";
+    case MultiContactPushKind::kFlatPusher: return "flat-pusher";
+  }
+  return "?";
+}
+
 push::Trajectory SimulatedPush(const SimulationSpec& spec, int index, std::uint64_t seed) {
   push::PushPlan plan;
   plan.object = spec.object;
@@ -262,22 +291,36 @@ push::Trajectory SimulatedPush(const SimulationSpec& spec, int index, std::uint6
   plan.multi_contact = spec.multi_contact;
   const geometry::Box2 b = plan.object.shape.bounds();
   const double half = 0.5 * std::min(b.max.x() - b.min.x(), b.max.y() - b.min.y());
+  const MultiContactPushKind kind = spec.multi_contact ? MultiContactPushKindOf(index) : MultiContactPushKind::kOneFinger;
+  if (kind == MultiContactPushKind::kFlatPusher) {
+    // The pusher frame turns with the push (finger_theta below): its y axis runs across it.
+    const geometry::Box2 f = spec.finger.shape.bounds();
+    plan.finger.shape = geometry::Shape::Box(std::max(f.max.x() - f.min.x(), 1e-3), 1.6 * half);
+  }
   std::mt19937_64 rng(SplitMix(SplitMix(seed) ^ static_cast<std::uint64_t>(index)));
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::string last_error;
   for (int attempt = 0; attempt < 20; ++attempt) {
     const double angle = 2.0 * M_PI * unit(rng);
     const double offset = spec.offset_fraction * half * (2.0 * unit(rng) - 1.0);
+    if (kind != MultiContactPushKind::kOneFinger) plan.finger_theta = angle;
+    if (kind == MultiContactPushKind::kTwoFingers) {
+      // Two copies of the finger 0.8 half-extents apart, either side of the push line.
+      plan.finger.shape = geometry::TransformShape(spec.finger.shape, geometry::Pose2{0.0, 0.4 * half, 0.0});
+      plan.extra_fingers = {
+          {geometry::TransformShape(spec.finger.shape, geometry::Pose2{0.0, -0.4 * half, 0.0}), spec.finger.mu_contact}};
+    }
     try {
       plan.waypoints = push::StraightPushPath(plan, angle, offset, spec.standoff, spec.push_distance);
+      push::Trajectory t = push::Simulate(plan).trajectory;
+      t.measured = *t.ground_truth;
+      t.measurement_sigmas.reset();
+      for (push::ExtraFinger& e : t.extra_fingers) e.measured = *e.ground_truth;
+      return t;
     } catch (const std::exception& e) {
+      // A line that misses the object, or fingers that jam it: the next line.
       last_error = e.what();
-      continue;
     }
-    push::Trajectory t = push::Simulate(plan).trajectory;
-    t.measured = *t.ground_truth;
-    t.measurement_sigmas.reset();
-    return t;
   }
   throw EvaluationError("simulated push " + std::to_string(index) + ": no push line hits the object (" + last_error + ")");
 }

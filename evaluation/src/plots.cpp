@@ -75,6 +75,10 @@ std::string TrajectorySvg(const push::Trajectory& trajectory, const graph::Estim
   for (std::size_t i : marked) {
     estimated_footprints.push_back(WorldRings(trajectory.object.shape, states[i].object_pose));
     finger_shapes.push_back(WorldRings(trajectory.finger.shape, states[i].finger_pose));
+    // Every other finger (two-finger pushes) at its own estimated pose.
+    for (const graph::FingerPoseEstimate& f : states[i].other_fingers)
+      if (f.finger >= 1 && f.finger <= static_cast<int>(trajectory.extra_fingers.size()))
+        finger_shapes.push_back(WorldRings(trajectory.extra_fingers[f.finger - 1].finger.shape, f.pose));
     if (truth_poses) truth_footprints.push_back(WorldRings(trajectory.object.shape, InterpolatePose(truth->object_pose, states[i].t)));
   }
   for (const auto* set : {&estimated_footprints, &truth_footprints, &finger_shapes})
@@ -85,6 +89,7 @@ std::string TrajectorySvg(const push::Trajectory& trajectory, const graph::Estim
     bounds.Add(s.object_pose.translation());
     bounds.Add(s.finger_pose.translation());
     if (s.contact) bounds.Add(*s.contact);
+    for (const graph::ContactEstimate& c : s.contacts) bounds.Add(c.point);
   }
   for (const auto& s : measured.object_pose) bounds.Add(s.pose.translation());
   for (const auto& s : measured.finger_pose) bounds.Add(s.pose.translation());
@@ -115,7 +120,10 @@ std::string TrajectorySvg(const push::Trajectory& trajectory, const graph::Estim
     const double tolerance = 0.5 * std::max(1e-9, (states.back().t - states.front().t) / std::max<double>(1, n - 1));
     for (std::size_t i : marked) {
       const graph::StateEstimate& s = states[i];
-      if (s.force && s.contact) arrows_estimated.push_back({*s.contact, *s.force});
+      // Each contact's own force where a step has several (two contacts, two fingers).
+      for (const graph::ContactEstimate& c : s.contacts)
+        if (c.force) arrows_estimated.push_back({c.point, *c.force});
+      if (s.contacts.empty() && s.force && s.contact) arrows_estimated.push_back({*s.contact, *s.force});
       if (const auto* f = Nearest(measured.force, s.t, tolerance); f && f->force.norm() > 0.0) {
         const auto* c = Nearest(measured.contact_point, s.t, tolerance);
         if (c) arrows_measured.push_back({c->point, f->force});
@@ -219,6 +227,16 @@ std::string TrajectorySvg(const push::Trajectory& trajectory, const graph::Estim
             "' fill-opacity='0.35' fill-rule='evenodd' stroke='#555555' stroke-width='0.8'/>\n";
   body += "<path class='finger-path-estimated' d='" + PolylinePath(state_t, finger_path, infinite_gap, view) +
           "' fill='none' stroke='#555555' stroke-width='1.4'/>\n";
+  for (std::size_t k = 0; k < trajectory.extra_fingers.size(); ++k) {
+    std::vector<double> other_t;
+    std::vector<Vec2> other_path;
+    for (const graph::StateEstimate& s : states)
+      for (const graph::FingerPoseEstimate& f : s.other_fingers)
+        if (f.finger == static_cast<int>(k) + 1) other_t.push_back(s.t), other_path.push_back(f.pose.translation());
+    if (!other_path.empty())
+      body += "<path class='finger-path-estimated' d='" + PolylinePath(other_t, other_path, infinite_gap, view) +
+              "' fill='none' stroke='#555555' stroke-width='1.4' stroke-dasharray='2 2'/>\n";
+  }
   {
     std::string dots;
     for (const auto& s : measured.finger_pose)
@@ -234,10 +252,14 @@ std::string TrajectorySvg(const push::Trajectory& trajectory, const graph::Estim
             "' r='2.2' fill='" + kMeasuredColor + "' fill-opacity='0.85'/>\n";
 
   // Estimated contact points at the marked steps, then ellipses and force arrows on top.
-  for (std::size_t i : marked)
-    if (states[i].contact)
-      body += "<circle class='contact-estimated' cx='" + Num(view.X(states[i].contact->x())) + "' cy='" +
-              Num(view.Y(states[i].contact->y())) + "' r='2.4' fill='" + kContactColor + "'/>\n";
+  for (std::size_t i : marked) {
+    std::vector<Vec2> points;
+    for (const graph::ContactEstimate& c : states[i].contacts) points.push_back(c.point);
+    if (points.empty() && states[i].contact) points.push_back(*states[i].contact);
+    for (const Vec2& c : points)
+      body += "<circle class='contact-estimated' cx='" + Num(view.X(c.x())) + "' cy='" + Num(view.Y(c.y())) +
+              "' r='2.4' fill='" + kContactColor + "'/>\n";
+  }
   int ellipse_count = 0;
   if (options.ellipses) {
     const std::string object_style = std::string("fill='") + kEstimatedColor + "' fill-opacity='0.15' stroke='" +

@@ -43,11 +43,25 @@ std::string ResultToJson(const graph::EstimationResult& r, int indent) {
     if (s.finger_pose_cov) o["finger_pose_cov"] = Matrix(*s.finger_pose_cov);
     if (s.contact_cov) o["contact_cov"] = Matrix(*s.contact_cov);
     if (s.force_cov) o["force_cov"] = Matrix(*s.force_cov);
+    if (!s.other_fingers.empty()) {
+      // Two-finger pushes: every finger's pose beside finger 0's ("finger_pose").
+      Json fingers = Json::array();
+      for (const graph::FingerPoseEstimate& f : s.other_fingers) {
+        Json e;
+        e["finger"] = f.finger;
+        e["pose"] = Pose(f.pose);
+        if (f.pose_cov) e["pose_cov"] = Matrix(*f.pose_cov);
+        fingers.push_back(std::move(e));
+      }
+      o["fingers"] = std::move(fingers);
+    }
     if (!s.contacts.empty()) {
-      // Two contacts: each with its point, force and covariances ("force" above is their sum).
+      // Two contacts of finger 0: each with its point, force and covariances ("force" above is
+      // their sum); two fingers: every contact, with its finger ("force" is finger 0's own).
       Json contacts = Json::array();
       for (const graph::ContactEstimate& c : s.contacts) {
         Json e;
+        e["finger"] = c.finger;
         e["point"] = Vec(c.point);
         if (c.force) e["force"] = Vec(*c.force);
         if (c.point_cov) e["point_cov"] = Matrix(*c.point_cov);

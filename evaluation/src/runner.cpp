@@ -159,8 +159,13 @@ std::vector<EvaluationItem> PlanEvaluation(const std::vector<std::string>& files
     for (int i = 0; i < spec->count; ++i) {
       EvaluationItem it;
       it.index = static_cast<int>(items.size());
-      char name[32];
-      std::snprintf(name, sizeof name, multi ? "sim-multi-%04d" : "sim-%04d", i);
+      char name[64];
+      if (multi) {
+        // The push's kind in its name: the tables list pushes by name.
+        std::snprintf(name, sizeof name, "sim-multi-%04d-%s", i, MultiContactPushKindName(MultiContactPushKindOf(i)));
+      } else {
+        std::snprintf(name, sizeof name, "sim-%04d", i);
+      }
       it.name = name;
       it.group = spec->name;
       it.source = EvaluationItem::Source::kSimulated;

@@ -62,11 +62,11 @@ std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder, c
       marginals_error = marginals.error();
       const double* bad = marginals.failed_block();
       const char* names[] = {"object pose", "finger pose", "contact point", "force", "second contact point",
-                             "second contact force"};
+                             "second contact force", "finger 1 pose"};
       for (int i = 0; bad != nullptr && i < static_cast<int>(builder.steps().size()); ++i) {
         const StepVars& v = builder.vars()[i];
-        const double* blocks[] = {v.x, v.e, v.p, v.f, v.p2, v.f2};
-        for (int q = 0; q < 6; ++q) {
+        const double* blocks[] = {v.x, v.e, v.p, v.f, v.p2, v.f2, v.e2};
+        for (int q = 0; q < 7; ++q) {
           if (blocks[q] != bad) continue;
           marginals_error += " [step " + std::to_string(i) + ", t = " + std::to_string(builder.steps()[i].t) +
                              ", " + names[q] + "]";
@@ -118,7 +118,19 @@ std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder, c
       get(v.f, c2.data());
       s.force_cov = Eigen::Matrix2d(c2);
     }
-    if (builder.HasSecondContact(i) && s.contacts.size() == 2) {
+    if (builder.two_fingers()) {
+      // Finger 1's pose; each finger's contact and force (their own: each finger has a sensor).
+      if (!s.other_fingers.empty() && get(v.e2, c3.data())) s.other_fingers[0].pose_cov = Eigen::Matrix3d(c3);
+      for (ContactEstimate& c : s.contacts) {
+        if (c.finger == 0) {
+          c.point_cov = s.contact_cov;
+          c.force_cov = s.force_cov;
+          continue;
+        }
+        if (get(v.p2, c2.data())) c.point_cov = Eigen::Matrix2d(c2);
+        if (builder.HasSecondForceVars(i) && get(v.f2, c2.data())) c.force_cov = Eigen::Matrix2d(c2);
+      }
+    } else if (builder.HasSecondContact(i) && s.contacts.size() == 2) {
       // Each contact's own; the net force's would need the cross-covariance of f and f2.
       s.contacts[0].point_cov = s.contact_cov;
       get(v.p2, c2.data());

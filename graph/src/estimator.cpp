@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <chrono>
+#include <memory>
 #include <cmath>
 #include <cstdlib>
 #include <functional>
@@ -97,12 +98,21 @@ EstimationResult EstimateBatch(const push::Trajectory& traj, Model model, const 
   if (cfg.estimate_mu) builder.EnableMuEstimation();
   const int n = static_cast<int>(builder.steps().size());
   const auto start = std::chrono::steady_clock::now();
-  ceres::Problem problem;
+  auto owned = std::make_unique<ceres::Problem>();
   for (int i = 0; i < n; ++i) builder.Initialize(i, INFINITY);
   // One builder, one shape querier, the staging the incremental mode uses too.
-  const int stage_iterations =
-      builder.StageSteps(problem, 0, n, cfg.max_iterations, cfg.function_tolerance, "batch solve");
-  const internal::SolveOutcome summary = builder.Solve(problem, cfg.max_iterations, cfg.function_tolerance, "batch solve");
+  int stage_iterations = builder.StageSteps(*owned, 0, n, cfg.max_iterations, cfg.function_tolerance, "batch solve");
+  internal::SolveOutcome summary = builder.Solve(*owned, cfg.max_iterations, cfg.function_tolerance, "batch solve");
+  // Contact features fixed at the start that the solution no longer touches: the graph again
+  // with the features at the solution (GraphBuilder::FeatureChoicesChanged).
+  for (int round = 0; round < 3 && builder.FeatureChoicesChanged() > 0; ++round) {
+    stage_iterations += summary.iterations;
+    owned = std::make_unique<ceres::Problem>();
+    builder.StartNewProblem();
+    for (int i = 0; i < n; ++i) builder.AddFactors(*owned, i, internal::GraphBuilder::kAll);
+    summary = builder.Solve(*owned, cfg.max_iterations, cfg.function_tolerance, "batch solve, contact features re-chosen");
+  }
+  ceres::Problem& problem = *owned;
   EstimationResult r;
   r.model = model;
   r.mode = Mode::kBatch;

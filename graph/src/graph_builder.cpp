@@ -55,8 +55,18 @@ GraphBuilder::GraphBuilder(const push::Trajectory& trajectory, Model model, cons
     : traj_(trajectory), model_(model), cfg_(config) {
   ValidateConfig(cfg_);
   ValidateTrajectory(traj_);
+  // Which sensors exist: any finger's non-empty stream (a finger whose stream is empty while
+  // another's is not never touched).
   streams_.contact_point = !traj_.measured.contact_point.empty();
   streams_.force = !traj_.measured.force.empty();
+  for (const push::ExtraFinger& f : traj_.extra_fingers) {
+    streams_.contact_point = streams_.contact_point || !f.measured.contact_point.empty();
+    streams_.force = streams_.force || !f.measured.force.empty();
+  }
+  // A second finger: estimated by CP, SDF and QS; the baseline (one contact, as published)
+  // leaves it out and says so.
+  two_fingers_ = !traj_.extra_fingers.empty() && model_ != Model::kYu;
+  fingers_ignored_ = !traj_.extra_fingers.empty() && model_ == Model::kYu;
   AppendSteps(INFINITY);
   SetUpShapes(std::move(querier));
 }
@@ -82,6 +92,12 @@ int GraphBuilder::AppendSteps(double until) {
   take(m.finger_pose, 1);
   take(m.contact_point, 2);
   take(m.force, 3);
+  if (two_fingers_) {
+    const push::FingerStreams& b = traj_.extra_fingers[0].measured;
+    take(b.finger_pose, 4);
+    take(b.contact_point, 5);
+    take(b.force, 6);
+  }
   std::sort(events.begin(), events.end());
   const std::size_t first_new = steps_.size();
   for (const auto& [t, stream, index] : events) {
@@ -92,24 +108,50 @@ int GraphBuilder::AppendSteps(double until) {
     }
     Step& s = steps_.back();
     if (stream == 2 && s.contact >= 0) {
-      // Two contact rows at one time: a finger touching the object at two points.
-      if (s.contact2 >= 0) {
-        std::ostringstream text;
-        text.precision(17);
-        text << "trajectory: streams.contact_point has more than two contacts at t = " << t
-             << " s (rows " << s.contact << ", " << s.contact2 << ", " << index
-             << "): the estimator models at most two contacts of the finger";
-        throw GraphError(text.str());
-      }
-      s.contact2 = index;
+      // Two contact rows at one time: a finger touching the object at two points. More: the
+      // two farthest apart (below).
+      if (s.contact2 < 0) s.contact2 = index;
       continue;
     }
-    int* slot = stream == 0 ? &s.object : stream == 1 ? &s.finger : stream == 2 ? &s.contact : &s.force;
-    *slot = index;
+    int* slots[] = {&s.object, &s.finger, &s.contact, &s.force, &s.finger_b, &s.contact_b, &s.force_b};
+    *slots[stream] = index;
   }
-  // Contact gating, on the samples received so far (all of them in batch).
+  // Three or more contact rows at one time (a flat pusher face along a face broken by a notch):
+  // the two farthest apart. For contacts along one straight finger face, which share its normal,
+  // they span every wrench the others can apply (a force at a point between them is a convex
+  // combination of the same force at the two); for others it is an approximation, and the
+  // result's warnings count those steps.
   for (std::size_t i = first_new; i < steps_.size(); ++i) {
     Step& s = steps_[i];
+    if (s.contact2 < 0) continue;
+    const auto& c = traj_.measured.contact_point;
+    int rows = 0;
+    for (int r = s.contact; r < static_cast<int>(c.size()) && c[r].t == c[s.contact].t; ++r) ++rows;
+    if (rows <= 2) continue;
+    ++steps_with_more_contacts_;
+    const auto [a, b] = FarthestContactRows(s.contact);
+    s.contact = a;
+    s.contact2 = b;
+  }
+  // Contact gating, on the samples received so far (all of them in batch): a finger touches
+  // while its nearest contact sample is within contact_max_gap, or, without a contact stream,
+  // its nearest force sample is at least contact_force_threshold; with neither, always.
+  // The sensors are the trajectory's: a finger whose contact stream is empty while another
+  // finger's is not never touched (its own force noise must not gate it in).
+  auto touching = [&](const std::vector<push::PointSample>& contact, const std::vector<push::ForceSample>& force,
+                      double t) {
+    if (streams_.contact_point) return NearestGap(contact, t) <= cfg_.contact_max_gap;
+    if (force.empty()) return !streams_.force;
+    int k = -1;
+    const double gap = NearestGap(force, t, &k);
+    return k >= 0 && gap <= cfg_.contact_max_gap && force[k].force.norm() >= cfg_.contact_force_threshold;
+  };
+  for (std::size_t i = first_new; i < steps_.size(); ++i) {
+    Step& s = steps_[i];
+    if (two_fingers_) {
+      const push::FingerStreams& b = traj_.extra_fingers[0].measured;
+      s.in_contact_b = touching(b.contact_point, b.force, s.t);
+    }
     if (streams_.contact_point) {
       int k = -1;
       s.in_contact = NearestGap(m.contact_point, s.t, &k) <= cfg_.contact_max_gap;
@@ -136,15 +178,23 @@ int GraphBuilder::AppendSteps(double until) {
 
 std::shared_ptr<const geometry::ShapePairQuerier> GraphBuilder::MakeQuerier(const push::Trajectory& trajectory,
                                                                           const EstimatorConfig& config) {
+  return MakeQuerier(trajectory, trajectory.finger.shape, config);
+}
+
+std::shared_ptr<const geometry::ShapePairQuerier> GraphBuilder::MakeQuerier(const push::Trajectory& trajectory,
+                                                                          const geometry::Shape& finger,
+                                                                          const EstimatorConfig& config) {
   geometry::ShapePairQuerier::Options pair_options;
   pair_options.angle_cache_resolution = config.finger_angle_resolution;
   pair_options.max_cached_angles = 4096;
   pair_options.check_rounded_depth = false;  // the factors never read depth_exact: no second query
-  return std::make_shared<geometry::ShapePairQuerier>(trajectory.object.shape, trajectory.finger.shape, pair_options);
+  return std::make_shared<geometry::ShapePairQuerier>(trajectory.object.shape, finger, pair_options);
 }
 
 void GraphBuilder::SetUpShapes(std::shared_ptr<const geometry::ShapePairQuerier> querier) {
   querier_ = querier ? std::move(querier) : MakeQuerier(traj_, cfg_);
+  finger_has_faces_ = !(traj_.finger.shape.is_degenerate_core() && traj_.finger.shape.num_vertices() <= 1);
+  if (two_fingers_) querier_b_ = MakeQuerier(traj_, traj_.extra_fingers[0].finger.shape, cfg_);
   if (ModelHasForce(model_)) qs_ = QuasiStaticGeometryFor(traj_, cfg_);
   if (traj_.object.mass > 0.0 && traj_.object.mu_surface > 0.0) {
     mu_surface_ = traj_.object.mu_surface;
@@ -324,6 +374,7 @@ void GraphBuilder::Initialize(int i, double limit) {
     continuous(v.x, prev->x);
     continuous(v.e, prev->e);
   }
+  if (two_fingers_) InitializeSecondFinger(i, limit);
   if (s.in_contact) {
     if (s.contact >= 0) {
       const Vec2 c = m.contact_point[s.contact].point;
@@ -360,19 +411,18 @@ void GraphBuilder::Initialize(int i, double limit) {
   }
 }
 
-bool GraphBuilder::TwoContactFeatures(int i, ContactFeature out[2]) const {
+std::vector<std::pair<GraphBuilder::ContactFeature, Vec2>> GraphBuilder::NearbyContactFeatures(int i) const {
   const StepVars& v = vars_[i];
   const Pose2 x{v.x[0], v.x[1], v.x[2]}, e{v.e[0], v.e[1], v.e[2]};
   // Candidates: every object feature the finger is near at the current values (3 sigma of a
-  // contact measurement: the values may be that far off), each once, nearest first.
+  // contact measurement: the values may be that far off), each once.
   const double tolerance = 3.0 * cfg_.measurement.contact;
   std::vector<geometry::ContactPoint> found;
   try {
     found = geometry::FindContacts(traj_.object.shape, x, traj_.finger.shape, e, {tolerance, tolerance});
   } catch (const geometry::GeometryError&) {
-    return false;
+    return {};
   }
-  std::sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.separation < b.separation; });
   std::vector<std::pair<ContactFeature, Vec2>> distinct;
   for (const geometry::ContactPoint& c : found) {
     ContactFeature f;
@@ -383,16 +433,111 @@ bool GraphBuilder::TwoContactFeatures(int i, ContactFeature out[2]) const {
              d.first.edge.index == f.edge.index;
     });
     if (!seen) distinct.push_back({f, c.object_point});
-    if (distinct.size() == 2) break;
   }
+  return distinct;
+}
+
+bool GraphBuilder::TwoContactFeatures(int i, ContactFeature out[2]) const {
+  const std::vector<std::pair<ContactFeature, Vec2>> distinct = NearbyContactFeatures(i);
+  if (finger_has_faces_) {
+    // A finger with straight faces touches one object edge at two points (a flat pusher face on
+    // an object face): each contact to the feature nearest it, the same one or not.
+    if (distinct.empty()) return false;
+    const StepVars& v = vars_[i];
+    for (int k = 0; k < 2; ++k) {
+      const Vec2 p = k == 0 ? Vec2(v.p[0], v.p[1]) : Vec2(v.p2[0], v.p2[1]);
+      out[k] = std::min_element(distinct.begin(), distinct.end(), [&](const auto& a, const auto& b) {
+                 return (p - a.second).squaredNorm() < (p - b.second).squaredNorm();
+               })->first;
+    }
+    return true;
+  }
+  // A disk touches an edge at one point: two contacts are on two distinct features (two walls).
   if (distinct.size() < 2) return false;
-  // Each contact variable to the feature nearer its current value.
+  // Each contact variable to its own feature: the pair of distinct features nearest the two
+  // current values (a flat pusher across a notch touches four features; the rows kept are the
+  // outer two, which the features nearest them match, not the nearest by separation).
+  const StepVars& v = vars_[i];
   const Vec2 p1(v.p[0], v.p[1]), p2(v.p2[0], v.p2[1]);
-  const bool swap = (p1 - distinct[1].second).norm() + (p2 - distinct[0].second).norm() <
-                    (p1 - distinct[0].second).norm() + (p2 - distinct[1].second).norm();
-  out[0] = distinct[swap ? 1 : 0].first;
-  out[1] = distinct[swap ? 0 : 1].first;
+  double best = INFINITY;
+  for (std::size_t a = 0; a < distinct.size(); ++a) {
+    for (std::size_t b = 0; b < distinct.size(); ++b) {
+      if (a == b) continue;
+      const double cost = (p1 - distinct[a].second).norm() + (p2 - distinct[b].second).norm();
+      if (cost < best) best = cost, out[0] = distinct[a].first, out[1] = distinct[b].first;
+    }
+  }
   return true;
+}
+
+std::array<long long, 2> GraphBuilder::FeatureChoice(int i) const {
+  const Step& s = steps_[i];
+  if (!s.in_contact) return {-1, -1};
+  if (!s.two_contacts) return {-1, -1};
+  ContactFeature f[2];
+  if (!TwoContactFeatures(i, f)) return {-1, -1};
+  // Vertices are not kept as fixed features (AddKinematicFactors).
+  return {f[0].vertex ? -1 : FeatureKey(f[0]), f[1].vertex ? -1 : FeatureKey(f[1])};
+}
+
+int GraphBuilder::FeatureChoicesChanged() const {
+  int changed = 0;
+  for (int i = 0; i < static_cast<int>(steps_.size()) && i < static_cast<int>(feature_choices_.size()); ++i)
+    changed += FeatureChoice(i) != feature_choices_[i];
+  return changed;
+}
+
+std::pair<int, int> GraphBuilder::FarthestContactRows(int k) const {
+  const auto& c = traj_.measured.contact_point;
+  int first = k, last = k;
+  while (first > 0 && c[first - 1].t == c[k].t) --first;
+  while (last + 1 < static_cast<int>(c.size()) && c[last + 1].t == c[k].t) ++last;
+  std::pair<int, int> best{first, std::min(first + 1, last)};
+  double farthest = -1.0;
+  for (int a = first; a <= last; ++a)
+    for (int b = a + 1; b <= last; ++b)
+      if (const double d = (c[a].point - c[b].point).squaredNorm(); d > farthest) farthest = d, best = {a, b};
+  return best;
+}
+
+void GraphBuilder::InitializeSecondFinger(int i, double limit) {
+  const bool causal = std::isfinite(limit);
+  const push::FingerStreams& b = traj_.extra_fingers[0].measured;
+  const Step& s = steps_[i];
+  StepVars& v = vars_[i];
+  const StepVars* prev = i > 0 ? &vars_[i - 1] : nullptr;
+  const Pose2 e = s.finger_b >= 0 ? b.finger_pose[s.finger_b].pose : InterpolatePose(b.finger_pose, s.t, limit);
+  v.e2[0] = e.x;
+  v.e2[1] = e.y;
+  v.e2[2] = prev != nullptr ? prev->e2[2] + geometry::WrapAngle(e.theta - prev->e2[2]) : e.theta;
+  if (!s.in_contact_b) return;
+  const bool prev_touching = causal && prev != nullptr && steps_[i - 1].in_contact_b;
+  Vec2 c;
+  if (s.contact_b >= 0) {
+    c = b.contact_point[s.contact_b].point;
+  } else if (!b.contact_point.empty() && !causal) {
+    c = push::StreamValueClamped(b.contact_point, s.t, [](const push::PointSample& a) { return Vec2(a.point); });
+  } else if (prev_touching) {
+    c = Vec2(prev->p2[0], prev->p2[1]);
+  } else {
+    // The object point nearest this finger's shape (its reference point may lie off the shape).
+    c = querier_b_->Query(Pose2{v.x[0], v.x[1], v.x[2]}, Pose2{v.e2[0], v.e2[1], v.e2[2]}).object_point;
+  }
+  v.p2[0] = c.x();
+  v.p2[1] = c.y();
+  Vec2 f;
+  if (s.force_b >= 0) {
+    f = b.force[s.force_b].force;
+  } else if (!b.force.empty() && !causal) {
+    f = push::StreamValueClamped(b.force, s.t, [](const push::ForceSample& a) { return Vec2(a.force); });
+  } else if (prev_touching) {
+    f = Vec2(prev->f2[0], prev->f2[1]);
+  } else {
+    const Vec2 d = Vec2(v.x[0], v.x[1]) - c;
+    f = d.norm() > 0 ? Vec2(0.1 * d.normalized()) : Vec2(0.1, 0.0);
+  }
+  v.f2[0] = f.x();
+  v.f2[1] = f.y();
 }
 
 void GraphBuilder::InitializeSecondContact(int i, bool causal) {
@@ -408,11 +553,10 @@ void GraphBuilder::InitializeSecondContact(int i, bool causal) {
     int k = -1;
     NearestGap(m.contact_point, s.t, &k);
     const auto& c = m.contact_point;
-    int first = k;
-    while (first > 0 && c[first - 1].t == c[k].t) --first;
+    const auto [first, second] = FarthestContactRows(k);
     if (!causal || c[first].t <= s.t) {
       a = c[first].point;
-      b = first + 1 < static_cast<int>(c.size()) ? c[first + 1].point : a;
+      b = c[second].point;
     } else if (prev != nullptr) {
       a = Vec2(prev->p[0], prev->p[1]);
       b = Vec2(prev->p2[0], prev->p2[1]);
@@ -442,9 +586,11 @@ int GraphBuilder::SmoothInitialMotion(int max_iterations, double function_tolera
   for (int i = std::max(0, first - 2); i < n; ++i) {
     if (!problem.HasParameterBlock(vars_[i].x)) problem.AddParameterBlock(vars_[i].x, 3);
     if (!problem.HasParameterBlock(vars_[i].e)) problem.AddParameterBlock(vars_[i].e, 3);
+    if (two_fingers_ && !problem.HasParameterBlock(vars_[i].e2)) problem.AddParameterBlock(vars_[i].e2, 3);
     if (i < first) {
       problem.SetParameterBlockConstant(vars_[i].x);
       problem.SetParameterBlockConstant(vars_[i].e);
+      if (two_fingers_) problem.SetParameterBlockConstant(vars_[i].e2);
     }
   }
   const SolveOutcome outcome = Solve(problem, max_iterations, function_tolerance, "motion-only initialization");
@@ -455,6 +601,15 @@ int GraphBuilder::SmoothInitialMotion(int max_iterations, double function_tolera
       const auto q = geometry::QueryPoint(traj_.object.shape, Pose2{v.x[0], v.x[1], v.x[2]}, Vec2(v.e[0], v.e[1]));
       v.p[0] = q.closest_point.x();
       v.p[1] = q.closest_point.y();
+    }
+  }
+  if (two_fingers_ && traj_.extra_fingers[0].measured.contact_point.empty()) {
+    for (int i = first; i < n; ++i) {
+      if (!steps_[i].in_contact_b) continue;
+      StepVars& v = vars_[i];
+      const Vec2 c = querier_b_->Query(Pose2{v.x[0], v.x[1], v.x[2]}, Pose2{v.e2[0], v.e2[1], v.e2[2]}).object_point;
+      v.p2[0] = c.x();
+      v.p2[1] = c.y();
     }
   }
   return outcome.iterations;
@@ -495,19 +650,22 @@ void GraphBuilder::AddFactors(ceres::Problem& problem, int i, int parts) {
   if (parts & kKinematic) {
     problem.AddParameterBlock(v.x, 3);
     problem.AddParameterBlock(v.e, 3);
+    if (two_fingers_) problem.AddParameterBlock(v.e2, 3);
     if (s.in_contact) problem.AddParameterBlock(v.p, 2);
     if (HasSecondContact(i)) problem.AddParameterBlock(v.p2, 2);
     AddKinematicFactors(problem, i);
   }
-  if ((parts & kDynamic) && HasForceVars(i)) {
-    problem.AddParameterBlock(v.f, 2);
-    if (HasSecondContact(i)) problem.AddParameterBlock(v.f2, 2);
+  if ((parts & kDynamic) && (HasForceVars(i) || HasSecondForceVars(i))) {
+    if (HasForceVars(i)) problem.AddParameterBlock(v.f, 2);
+    if (HasSecondForceVars(i)) problem.AddParameterBlock(v.f2, 2);
     AddDynamicFactors(problem, i);
   }
 }
 
 void GraphBuilder::AddKinematicFactors(ceres::Problem& problem, int i) {
   adding_step_ = i;
+  if (feature_choices_.size() < steps_.size()) feature_choices_.resize(steps_.size(), {-1, -1});
+  feature_choices_[i] = {-1, -1};
   const auto& m = traj_.measured;
   const Step& s = steps_[i];
   StepVars& v = vars_[i];
@@ -532,15 +690,30 @@ void GraphBuilder::AddKinematicFactors(ceres::Problem& problem, int i) {
           {v.x, v.p2}, {0});
       ContactFeature features[2];
       const bool on_features = TwoContactFeatures(i, features);
+      feature_choices_[i] = FeatureChoice(i);
       double* points[2] = {v.p, v.p2};
       for (int k = 0; k < 2; ++k) {
+        // An object vertex is kept as a feature only when it is the only one near: pinned to a
+        // corner at the start, a contact that is really on the adjacent edge (a flat pusher's end
+        // near the corner) holds the object shifted along that edge, and the corner is then the
+        // nearest feature at the solution too. Near others, the local witness follows p.
+        const bool fixed = on_features && !features[k].vertex;
         ceres::CostFunction* cost =
-            on_features ? static_cast<ceres::CostFunction*>(new FeatureWitnessFactor(
-                              traj_.object.shape, features[k].edge, features[k].vertex, traj_.finger.shape,
-                              cfg_.contact_finger_sigma))
-                        : new LocalWitnessFactor(traj_.object.shape, traj_.finger.shape, cfg_.contact_finger_sigma);
+            fixed ? static_cast<ceres::CostFunction*>(new FeatureWitnessFactor(
+                        traj_.object.shape, features[k].edge, features[k].vertex, traj_.finger.shape,
+                        cfg_.contact_finger_sigma))
+                  : new LocalWitnessFactor(traj_.object.shape, traj_.finger.shape, cfg_.contact_finger_sigma);
         Add(problem, FactorType::kContactOnFinger, cost, nullptr, {v.x, v.e, points[k]}, {0});
       }
+    } else if (cfg_.contact_finger == EstimatorConfig::ContactFinger::kWitness &&
+               (finger_has_faces_ || NearbyContactFeatures(i).size() >= 2)) {
+      // A finger with straight faces (a flat pusher: along a parallel object face the nearest
+      // pair is any pair of the overlap, and the shape-pair query returns a vertex's), or several
+      // object features within reach (a disk between two walls: the nearest pair may jump to the
+      // other wall): the local witness of p instead, the touching pair near p.
+      Add(problem, FactorType::kContactOnFinger,
+          new LocalWitnessFactor(traj_.object.shape, traj_.finger.shape, cfg_.contact_finger_sigma), nullptr,
+          {v.x, v.e, v.p}, {0});
     } else if (cfg_.contact_finger == EstimatorConfig::ContactFinger::kWitness) {
       Add(problem, FactorType::kContactOnFinger, new ContactWitnessFactor(querier_, cfg_.contact_finger_sigma), nullptr,
           {v.x, v.e, v.p}, {0});
@@ -570,6 +743,36 @@ void GraphBuilder::AddKinematicFactors(ceres::Problem& problem, int i) {
   } else {
     AddConstantVelocityFactors(problem, i);
   }
+  if (two_fingers_) AddSecondFingerKinematicFactors(problem, i);
+}
+
+void GraphBuilder::AddSecondFingerKinematicFactors(ceres::Problem& problem, int i) {
+  // Finger 1's own M, C, S and touching, with its own shape (querier_b_), its contact p2.
+  adding_step_ = i;
+  const push::FingerStreams& b = traj_.extra_fingers[0].measured;
+  const geometry::Shape& shape = traj_.extra_fingers[0].finger.shape;
+  const Step& s = steps_[i];
+  StepVars& v = vars_[i];
+  if (s.in_contact_b) {
+    if (s.contact_b >= 0) {
+      Add(problem, FactorType::kContactPoint, new VectorMeasurementFactor(b.contact_point[s.contact_b].point, cfg_.measurement.contact),
+          MakeLoss(cfg_.contact_loss), {v.p2});
+    }
+    Add(problem, FactorType::kContactOnObject, new BoundaryPointFactor(traj_.object.shape, cfg_.contact_object_sigma), nullptr,
+        {v.x, v.p2}, {0});
+    if (cfg_.contact_finger == EstimatorConfig::ContactFinger::kWitness) {
+      Add(problem, FactorType::kContactOnFinger, new ContactWitnessFactor(querier_b_, cfg_.contact_finger_sigma), nullptr,
+          {v.x, v.e2, v.p2}, {0});
+    } else {
+      Add(problem, FactorType::kContactOnFinger, new BoundaryPointFactor(shape, cfg_.contact_finger_sigma), nullptr, {v.e2, v.p2});
+    }
+    if (model_ == Model::kQs) {
+      Add(problem, FactorType::kTouching, new TouchingFactor(querier_b_, cfg_.touching_sigma), nullptr, {v.x, v.e2}, {0});
+    }
+  }
+  if (model_ == Model::kSdf || model_ == Model::kQs) {
+    Add(problem, FactorType::kIntersection, new IntersectionFactor(querier_b_, cfg_.intersection_sigma), nullptr, {v.x, v.e2}, {0});
+  }
 }
 
 void GraphBuilder::AddPoseMeasurementFactors(ceres::Problem& problem, int i) {
@@ -587,6 +790,12 @@ void GraphBuilder::AddPoseMeasurementFactors(ceres::Problem& problem, int i) {
         new PoseMeasurementFactor(m.finger_pose[s.finger].pose, cfg_.measurement.finger_trans, cfg_.measurement.finger_rot),
         MakeLoss(cfg_.finger_pose_loss), {v.e});
   }
+  if (two_fingers_ && s.finger_b >= 0) {
+    Add(problem, FactorType::kFingerPose,
+        new PoseMeasurementFactor(traj_.extra_fingers[0].measured.finger_pose[s.finger_b].pose, cfg_.measurement.finger_trans,
+                                  cfg_.measurement.finger_rot),
+        MakeLoss(cfg_.finger_pose_loss), {v.e2});
+  }
 }
 
 void GraphBuilder::AddConstantVelocityFactors(ceres::Problem& problem, int i) {
@@ -599,6 +808,10 @@ void GraphBuilder::AddConstantVelocityFactors(ceres::Problem& problem, int i) {
       {vars_[i - 2].x, vars_[i - 1].x, vars_[i].x});
   Add(problem, FactorType::kConstantVelocity, new ConstantVelocityFactor(dt1, dt2, st, sr), nullptr,
       {vars_[i - 2].e, vars_[i - 1].e, vars_[i].e});
+  if (two_fingers_) {
+    Add(problem, FactorType::kConstantVelocity, new ConstantVelocityFactor(dt1, dt2, st, sr), nullptr,
+        {vars_[i - 2].e2, vars_[i - 1].e2, vars_[i].e2});
+  }
 }
 
 void GraphBuilder::AddDynamicFactors(ceres::Problem& problem, int i) {
@@ -606,90 +819,102 @@ void GraphBuilder::AddDynamicFactors(ceres::Problem& problem, int i) {
   const auto& m = traj_.measured;
   const Step& s = steps_[i];
   StepVars& v = vars_[i];
-  // Force: measurement, weak prior, quasi-static factor.
-  {
-    const bool two = s.two_contacts;
-    if (s.force >= 0 && two) {
-      // The finger's sensor measures the sum of its contacts' forces.
-      Add(problem, FactorType::kForce, new VectorSumMeasurementFactor(m.force[s.force].force, cfg_.measurement.force),
-          MakeLoss(cfg_.force_loss), {v.f, v.f2});
-    } else if (s.force >= 0) {
-      Add(problem, FactorType::kForce, new VectorMeasurementFactor(m.force[s.force].force, cfg_.measurement.force),
-          MakeLoss(cfg_.force_loss), {v.f});
-    }
-    Add(problem, FactorType::kForcePrior, new VectorMeasurementFactor(Vec2::Zero(), cfg_.force_prior_sigma), nullptr, {v.f});
-    if (two) {
-      Add(problem, FactorType::kForcePrior, new VectorMeasurementFactor(Vec2::Zero(), cfg_.force_prior_sigma), nullptr, {v.f2});
-      // Only the sum is measured: each force in its friction cone (sigma a tenth of the force
-      // sensor's) keeps the split physical.
-      for (const auto& [point, force] : {std::pair{v.p, v.f}, std::pair{v.p2, v.f2}})
-        Add(problem, FactorType::kForcePrior,
-            new FrictionConeFactor(traj_.object.shape, traj_.finger.mu_contact, 0.1 * cfg_.measurement.force), nullptr,
-            {v.x, point, force}, {0});
-    }
-    if (i >= 1 && HasForceVars(i - 1)) {
-      Add(problem, FactorType::kForceContinuity, new VectorRandomWalkFactor(s.t - steps_[i - 1].t, cfg_.force_random_walk),
-          nullptr, {vars_[i - 1].f, v.f});
-    }
-    if (two && i >= 1 && HasForceVars(i - 1) && HasSecondContact(i - 1)) {
-      Add(problem, FactorType::kForceContinuity, new VectorRandomWalkFactor(s.t - steps_[i - 1].t, cfg_.force_random_walk),
-          nullptr, {vars_[i - 1].f2, v.f2});
-    }
-    if (i >= 1 && two) {
-      // D and the load of both contacts' summed wrench (c and mu at their given values).
-      QuasiStaticGeometry g = qs_;
-      g.dt = s.t - steps_[i - 1].t;
-      const double rate_scale = std::sqrt(0.01 / g.dt);  // per-10-ms sigmas (config.h)
-      Add(problem, FactorType::kQuasiStatic,
-          new QuasiStaticTwoContactFactor(g, cfg_.eps_velocity, cfg_.eps_force, cfg_.quasi_static_sigma * rate_scale),
+  const bool has1 = HasForceVars(i), has2 = HasSecondForceVars(i);
+  const bool wedged = has1 && s.two_contacts;  // both contacts finger 0's
+  // Force: measurement, weak prior, continuity.
+  if (has1 && s.force >= 0 && wedged) {
+    // The finger's sensor measures the sum of its contacts' forces.
+    Add(problem, FactorType::kForce, new VectorSumMeasurementFactor(m.force[s.force].force, cfg_.measurement.force),
+        MakeLoss(cfg_.force_loss), {v.f, v.f2});
+  } else if (has1 && s.force >= 0) {
+    Add(problem, FactorType::kForce, new VectorMeasurementFactor(m.force[s.force].force, cfg_.measurement.force),
+        MakeLoss(cfg_.force_loss), {v.f});
+  }
+  if (has2 && two_fingers_ && s.force_b >= 0) {
+    // Finger 1's own sensor.
+    Add(problem, FactorType::kForce,
+        new VectorMeasurementFactor(traj_.extra_fingers[0].measured.force[s.force_b].force, cfg_.measurement.force),
+        MakeLoss(cfg_.force_loss), {v.f2});
+  }
+  if (has1) Add(problem, FactorType::kForcePrior, new VectorMeasurementFactor(Vec2::Zero(), cfg_.force_prior_sigma), nullptr, {v.f});
+  if (has2) Add(problem, FactorType::kForcePrior, new VectorMeasurementFactor(Vec2::Zero(), cfg_.force_prior_sigma), nullptr, {v.f2});
+  if (has1 && has2) {
+    // Each force in its friction cone (sigma a tenth of the force sensor's): with two contacts
+    // of one finger only their sum is measured, and the cone keeps the split physical.
+    const double mu1 = traj_.finger.mu_contact;
+    const double mu2 = two_fingers_ ? traj_.extra_fingers[0].finger.mu_contact : mu1;
+    for (const auto& [point, force, mu] : {std::tuple{v.p, v.f, mu1}, std::tuple{v.p2, v.f2, mu2}})
+      Add(problem, FactorType::kForcePrior, new FrictionConeFactor(traj_.object.shape, mu, 0.1 * cfg_.measurement.force),
+          nullptr, {v.x, point, force}, {0});
+  }
+  if (has1 && i >= 1 && HasForceVars(i - 1)) {
+    Add(problem, FactorType::kForceContinuity, new VectorRandomWalkFactor(s.t - steps_[i - 1].t, cfg_.force_random_walk),
+        nullptr, {vars_[i - 1].f, v.f});
+  }
+  if (has2 && i >= 1 && HasSecondForceVars(i - 1)) {
+    Add(problem, FactorType::kForceContinuity, new VectorRandomWalkFactor(s.t - steps_[i - 1].t, cfg_.force_random_walk),
+        nullptr, {vars_[i - 1].f2, v.f2});
+  }
+  if (i < 1) return;
+  if (has1 && has2) {
+    // D and the load of both contacts' summed wrench (c and mu at their given values).
+    QuasiStaticGeometry g = qs_;
+    g.dt = s.t - steps_[i - 1].t;
+    const double rate_scale = std::sqrt(0.01 / g.dt);  // per-10-ms sigmas (config.h)
+    Add(problem, FactorType::kQuasiStatic,
+        new QuasiStaticTwoContactFactor(g, cfg_.eps_velocity, cfg_.eps_force, cfg_.quasi_static_sigma * rate_scale),
+        nullptr, {vars_[i - 1].x, v.x, v.p, v.f, v.p2, v.f2}, {0, 1});
+    if (use_load_factor_) {
+      Add(problem, FactorType::kLimitSurfaceLoad,
+          new LimitSurfaceLoadTwoContactFactor(g, f_max_, cfg_.eps_velocity, cfg_.eps_force,
+                                               cfg_.limit_surface_sigma * rate_scale),
           nullptr, {vars_[i - 1].x, v.x, v.p, v.f, v.p2, v.f2}, {0, 1});
-      if (use_load_factor_) {
-        Add(problem, FactorType::kLimitSurfaceLoad,
-            new LimitSurfaceLoadTwoContactFactor(g, f_max_, cfg_.eps_velocity, cfg_.eps_force,
-                                                 cfg_.limit_surface_sigma * rate_scale),
-            nullptr, {vars_[i - 1].x, v.x, v.p, v.f, v.p2, v.f2}, {0, 1});
-      }
-    } else if (i >= 1) {
-      QuasiStaticGeometry g = qs_;
-      g.dt = s.t - steps_[i - 1].t;
-      const double rate_scale = std::sqrt(0.01 / g.dt);  // per-10-ms sigmas (config.h)
-      if (model_ == Model::kQs) {
-        if (estimate_c_) {
-          Add(problem, FactorType::kQuasiStatic,
-                         new QuasiStaticFactorWithC(g, cfg_.eps_velocity, cfg_.eps_force, cfg_.quasi_static_sigma * rate_scale),
-                         nullptr, {vars_[i - 1].x, v.x, v.p, v.f, c_var_}, {0, 1});
-          // Prior around the geometric value; bounds keep c physical (tau / c in D).
-          if (!c_in_problem_) AddSharedParameterPrior(*this, problem, c_var_, qs_.c, cfg_.c_prior_sigma);
-          c_in_problem_ = true;
-        } else {
-          Add(problem, FactorType::kQuasiStatic,
-                         new QuasiStaticFactor(g, cfg_.eps_velocity, cfg_.eps_force, cfg_.quasi_static_sigma * rate_scale),
-                         nullptr, {vars_[i - 1].x, v.x, v.p, v.f}, {0, 1});
-        }
-        if (use_load_factor_ && (estimate_c_ || estimate_mu_)) {
-          // The same c as D's (estimated) and/or mu as variables.
-          std::vector<double*> blocks{vars_[i - 1].x, v.x, v.p, v.f};
-          if (estimate_c_) blocks.push_back(c_var_);
-          if (estimate_mu_) blocks.push_back(mu_var_);
-          Add(problem, FactorType::kLimitSurfaceLoad,
-                         new LimitSurfaceLoadFactorWithParameters(g, normal_load_, mu_surface_, {estimate_c_, estimate_mu_},
-                                                                  cfg_.eps_velocity, cfg_.eps_force,
-                                                                  cfg_.limit_surface_sigma * rate_scale),
-                         nullptr, blocks, {0, 1});
-          // Prior around the trajectory's mu; bounds keep f_max physical.
-          if (estimate_mu_ && !mu_in_problem_) AddSharedParameterPrior(*this, problem, mu_var_, mu_surface_, cfg_.mu_prior_sigma);
-          mu_in_problem_ = mu_in_problem_ || estimate_mu_;
-        } else if (use_load_factor_) {
-          Add(problem, FactorType::kLimitSurfaceLoad,
-                         new LimitSurfaceLoadFactor(g, f_max_, cfg_.eps_velocity, cfg_.eps_force,
-                                                    cfg_.limit_surface_sigma * rate_scale),
-                         nullptr, {vars_[i - 1].x, v.x, v.p, v.f}, {0, 1});
-        }
-      } else {
-        Add(problem, FactorType::kQuasiStatic, new CrossMultipliedQuasiStaticFactor(g, cfg_.yu_quasi_static_sigma * rate_scale), nullptr,
-                       {vars_[i - 1].x, v.x, v.p, v.f}, {0, 1});
-      }
     }
+  } else if (has1) {
+    AddOneContactQuasiStatic(problem, i, v.p, v.f);
+  } else {
+    AddOneContactQuasiStatic(problem, i, v.p2, v.f2);  // finger 1 alone touches
+  }
+}
+
+void GraphBuilder::AddOneContactQuasiStatic(ceres::Problem& problem, int i, double* p, double* f) {
+  StepVars& v = vars_[i];
+  QuasiStaticGeometry g = qs_;
+  g.dt = steps_[i].t - steps_[i - 1].t;
+  const double rate_scale = std::sqrt(0.01 / g.dt);  // per-10-ms sigmas (config.h)
+  if (model_ != Model::kQs) {
+    Add(problem, FactorType::kQuasiStatic, new CrossMultipliedQuasiStaticFactor(g, cfg_.yu_quasi_static_sigma * rate_scale),
+        nullptr, {vars_[i - 1].x, v.x, p, f}, {0, 1});
+    return;
+  }
+  if (estimate_c_) {
+    Add(problem, FactorType::kQuasiStatic,
+        new QuasiStaticFactorWithC(g, cfg_.eps_velocity, cfg_.eps_force, cfg_.quasi_static_sigma * rate_scale), nullptr,
+        {vars_[i - 1].x, v.x, p, f, c_var_}, {0, 1});
+    // Prior around the geometric value; bounds keep c physical (tau / c in D).
+    if (!c_in_problem_) AddSharedParameterPrior(*this, problem, c_var_, qs_.c, cfg_.c_prior_sigma);
+    c_in_problem_ = true;
+  } else {
+    Add(problem, FactorType::kQuasiStatic,
+        new QuasiStaticFactor(g, cfg_.eps_velocity, cfg_.eps_force, cfg_.quasi_static_sigma * rate_scale), nullptr,
+        {vars_[i - 1].x, v.x, p, f}, {0, 1});
+  }
+  if (use_load_factor_ && (estimate_c_ || estimate_mu_)) {
+    // The same c as D's (estimated) and/or mu as variables.
+    std::vector<double*> blocks{vars_[i - 1].x, v.x, p, f};
+    if (estimate_c_) blocks.push_back(c_var_);
+    if (estimate_mu_) blocks.push_back(mu_var_);
+    Add(problem, FactorType::kLimitSurfaceLoad,
+        new LimitSurfaceLoadFactorWithParameters(g, normal_load_, mu_surface_, {estimate_c_, estimate_mu_},
+                                                 cfg_.eps_velocity, cfg_.eps_force, cfg_.limit_surface_sigma * rate_scale),
+        nullptr, blocks, {0, 1});
+    // Prior around the trajectory's mu; bounds keep f_max physical.
+    if (estimate_mu_ && !mu_in_problem_) AddSharedParameterPrior(*this, problem, mu_var_, mu_surface_, cfg_.mu_prior_sigma);
+    mu_in_problem_ = mu_in_problem_ || estimate_mu_;
+  } else if (use_load_factor_) {
+    Add(problem, FactorType::kLimitSurfaceLoad,
+        new LimitSurfaceLoadFactor(g, f_max_, cfg_.eps_velocity, cfg_.eps_force, cfg_.limit_surface_sigma * rate_scale),
+        nullptr, {vars_[i - 1].x, v.x, p, f}, {0, 1});
   }
 }
 
@@ -698,7 +923,8 @@ std::vector<double*> GraphBuilder::Blocks(int i) {
   if (HasContactVars(i)) b.push_back(vars_[i].p);
   if (HasForceVars(i)) b.push_back(vars_[i].f);
   if (HasSecondContact(i)) b.push_back(vars_[i].p2);
-  if (HasSecondContact(i) && HasForceVars(i)) b.push_back(vars_[i].f2);
+  if (HasSecondForceVars(i)) b.push_back(vars_[i].f2);
+  if (two_fingers_) b.push_back(vars_[i].e2);
   return b;
 }
 
@@ -706,10 +932,22 @@ void GraphBuilder::DropUnobservableForces(EstimationResult& result) const {
   if (second_contacts_ignored_ > 0)
     result.warnings.push_back("the Yu-Rodriguez baseline models one contact: the second contact of " +
                               std::to_string(second_contacts_ignored_) + " steps with two was left out");
+  if (steps_with_more_contacts_ > 0)
+    result.warnings.push_back(std::to_string(steps_with_more_contacts_) +
+                              " steps have three or more contact rows at one time: each is modelled by its two rows "
+                              "farthest apart (exact for contacts along one straight finger face, an approximation "
+                              "otherwise)");
+  if (fingers_ignored_)
+    result.warnings.push_back("the Yu-Rodriguez baseline models one finger: finger 1 of this two-finger push was left out "
+                              "(its pose, contacts and forces are not estimated)");
   if (ForceScaleObservable()) return;
   for (StateEstimate& s : result.states) {
     s.force.reset();
     s.force_cov.reset();
+    for (ContactEstimate& c : s.contacts) {
+      c.force.reset();
+      c.force_cov.reset();
+    }
   }
   const std::string how = model_ == Model::kYu
                               ? "the baseline has no limit-surface load"
@@ -731,7 +969,19 @@ void GraphBuilder::SetState(int i, const StateEstimate& st) {
   }
   v.f[0] = st.force ? st.force->x() : 0.0;
   v.f[1] = st.force ? st.force->y() : 0.0;
-  if (HasSecondContact(i) && st.contacts.size() == 2) {
+  if (two_fingers_) {
+    // Finger 1's pose and its contact (the contacts entry of finger 1).
+    if (!st.other_fingers.empty()) {
+      const Pose2& e = st.other_fingers[0].pose;
+      v.e2[0] = e.x; v.e2[1] = e.y; v.e2[2] = e.theta;
+    }
+    for (const ContactEstimate& c : st.contacts) {
+      if (c.finger != 1) continue;
+      v.p2[0] = c.point.x(); v.p2[1] = c.point.y();
+      const Vec2 f = c.force.value_or(Vec2::Zero());
+      v.f2[0] = f.x(); v.f2[1] = f.y();
+    }
+  } else if (HasSecondContact(i) && st.contacts.size() == 2) {
     v.p2[0] = st.contacts[1].point.x(); v.p2[1] = st.contacts[1].point.y();
     const Vec2 f1 = st.contacts[0].force.value_or(Vec2::Zero()), f2 = st.contacts[1].force.value_or(Vec2::Zero());
     v.f[0] = f1.x(); v.f[1] = f1.y();
@@ -756,7 +1006,23 @@ StateEstimate GraphBuilder::State(int i) const {
   s.finger_pose = {v.e[0], v.e[1], v.e[2]};
   if (HasContactVars(i)) s.contact = Vec2(v.p[0], v.p[1]);
   if (HasForceVars(i)) s.force = Vec2(v.f[0], v.f[1]);
-  if (HasSecondContact(i)) {
+  if (two_fingers_) {
+    // Every contact of both fingers; contact and force stay finger 0's own.
+    s.other_fingers.push_back({1, Pose2{v.e2[0], v.e2[1], v.e2[2]}, std::nullopt});
+    if (HasContactVars(i)) {
+      ContactEstimate c;
+      c.point = Vec2(v.p[0], v.p[1]);
+      if (HasForceVars(i)) c.force = Vec2(v.f[0], v.f[1]);
+      s.contacts.push_back(c);
+    }
+    if (HasSecondContact(i)) {
+      ContactEstimate c;
+      c.finger = 1;
+      c.point = Vec2(v.p2[0], v.p2[1]);
+      if (HasSecondForceVars(i)) c.force = Vec2(v.f2[0], v.f2[1]);
+      s.contacts.push_back(c);
+    }
+  } else if (HasSecondContact(i)) {
     s.contacts.resize(2);
     s.contacts[0].point = Vec2(v.p[0], v.p[1]);
     s.contacts[1].point = Vec2(v.p2[0], v.p2[1]);

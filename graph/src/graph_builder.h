@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <algorithm>
+#include <array>
 #include <memory>
 #include <optional>
 #include <string>
@@ -58,6 +59,11 @@ struct Step {
   /// rows with the contact variables p and p2 by proximity to the previous step's.
   bool two_contacts = false;
   int contact2 = -1;
+  /// Finger 1 of a two-finger push (Trajectory::extra_fingers[0]): its rows at this time and
+  /// whether it touches. Its contact is the step's second contact (p2, f2): a step has at most
+  /// two contacts in all (two of finger 0, or one of each finger).
+  int finger_b = -1, contact_b = -1, force_b = -1;
+  bool in_contact_b = false;
 };
 
 /// Parameter blocks of one step (addresses stay fixed: Ceres keeps pointers to them).
@@ -66,8 +72,9 @@ struct StepVars {
   double e[3] = {0, 0, 0};
   double p[2] = {0, 0};
   double f[2] = {0, 0};
-  double p2[2] = {0, 0};  ///< the second contact (Step::two_contacts)
+  double p2[2] = {0, 0};  ///< the second contact (Step::two_contacts, or finger 1's)
   double f2[2] = {0, 0};
+  double e2[3] = {0, 0, 0};  ///< finger 1's pose (two-finger pushes)
 };
 
 /// What a residual block is, for the per-type diagnostics (diagnostics.h).
@@ -119,6 +126,10 @@ class GraphBuilder {
   /// The exact object-finger querier the factors use (its Minkowski obstacles cached per angle).
   static std::shared_ptr<const geometry::ShapePairQuerier> MakeQuerier(const push::Trajectory& trajectory,
                                                                       const EstimatorConfig& config);
+  /// The same for `finger` (finger 1 of a two-finger push).
+  static std::shared_ptr<const geometry::ShapePairQuerier> MakeQuerier(const push::Trajectory& trajectory,
+                                                                      const geometry::Shape& finger,
+                                                                      const EstimatorConfig& config);
   /// Online use (OnlineEstimator): `trajectory` starts with empty streams and grows as the
   /// caller appends measurements; steps come from AppendSteps. `streams` says which streams will
   /// arrive (contact gating, and the load factor runs when no force stream will).
@@ -135,7 +146,14 @@ class GraphBuilder {
   Model model() const { return model_; }
   bool HasContactVars(int i) const { return steps_[i].in_contact; }
   bool HasForceVars(int i) const { return steps_[i].in_contact && ModelHasForce(model_); }
-  bool HasSecondContact(int i) const { return steps_[i].in_contact && steps_[i].two_contacts; }
+  /// Whether step i has the second contact's variables p2 (and, with forces, f2): finger 0's
+  /// second contact, or finger 1's contact in a two-finger push.
+  bool HasSecondContact(int i) const {
+    return (steps_[i].in_contact && steps_[i].two_contacts) || steps_[i].in_contact_b;
+  }
+  bool HasSecondForceVars(int i) const { return HasSecondContact(i) && ModelHasForce(model_); }
+  /// A two-finger push: finger 1's pose is a variable of every step and its contact is p2.
+  bool two_fingers() const { return two_fingers_; }
 
   /// Initial values of step i from the measurements with time stamps <= limit (interpolated;
   /// the newest held). limit = INFINITY in batch; the update time in incremental mode.
@@ -163,6 +181,15 @@ class GraphBuilder {
   /// of iterations. Returns the iterations used.
   int StageSteps(ceres::Problem& problem, int first, int last, int max_iterations, double function_tolerance,
                  const std::string& what);
+  /// The object features the two-contact steps' contact factors were fixed to
+  /// (FeatureWitnessFactor), re-derived at the current values: the number of steps whose choice
+  /// changed. The batch solve rebuilds its problem and
+  /// solves again while this is nonzero (at most 3 times): a feature chosen at the initial values
+  /// can be the wrong one (a flat pusher's end near an object corner), and a fixed one, unlike the
+  /// nearest pair, cannot move on.
+  int FeatureChoicesChanged() const;
+  /// Forgets which shared priors (c, mu, shape frame) are in a problem: before building a new one.
+  void StartNewProblem() { c_in_problem_ = mu_in_problem_ = frame_in_problem_ = false; }
   /// Parameter blocks of step i present in the problem.
   std::vector<double*> Blocks(int i);
   /// Makes c a shared variable of every D factor (QS only; the batch solver calls this when
@@ -219,15 +246,34 @@ class GraphBuilder {
   /// Step i's second contact point from its rows, paired with the previous step's (Initialize).
   void InitializeSecondContact(int i, bool causal);
   /// The object features (edge, or vertex) of step i's two contacts at the current values:
-  /// geometry::FindContacts within 3 contact-measurement sigmas, the two nearest distinct
-  /// features, each given to the contact variable nearer it. False when fewer than two.
+  /// geometry::FindContacts within 3 contact-measurement sigmas, and of its distinct features
+  /// the pair nearest the two contact variables' current values (one each). False when fewer
+  /// than two.
   struct ContactFeature {
     geometry::EdgeId edge;
     bool vertex = false;
   };
   bool TwoContactFeatures(int i, ContactFeature out[2]) const;
+  /// The distinct object features (each with its contact point) within 3 contact sigmas of the
+  /// finger at step i's current values.
+  std::vector<std::pair<ContactFeature, Vec2>> NearbyContactFeatures(int i) const;
+  /// Step i's fixed contact features at the current values, as keys (-1: none, the nearest pair
+  /// or the local witness): what AddKinematicFactors gives its contact-on-finger factors.
+  std::array<long long, 2> FeatureChoice(int i) const;
+  static long long FeatureKey(const ContactFeature& f) {
+    return ((static_cast<long long>(f.edge.polygon) * 4096 + f.edge.ring) * 1048576 + f.edge.index) * 2 + f.vertex;
+  }
+  std::vector<std::array<long long, 2>> feature_choices_;  ///< per step, as last added
   /// Querier (the given one, else a new one), quasi-static geometry, friction (both constructors).
   void SetUpShapes(std::shared_ptr<const geometry::ShapePairQuerier> querier);
+  /// Of the contact rows at row k's time, the two farthest apart (k's own pair when two).
+  std::pair<int, int> FarthestContactRows(int k) const;
+  /// Finger 1's initial pose, contact and force at step i (two-finger pushes).
+  void InitializeSecondFinger(int i, double limit);
+  /// Finger 1's M, C, S, touching and V factors at step i.
+  void AddSecondFingerKinematicFactors(ceres::Problem& problem, int i);
+  /// D and the limit-surface load of one contact (p, f) at step i.
+  void AddOneContactQuasiStatic(ceres::Problem& problem, int i, double* p, double* f);
 
   const push::Trajectory& traj_;
   Model model_;
@@ -235,8 +281,13 @@ class GraphBuilder {
   OnlineStreams streams_;  ///< which streams exist (batch: the non-empty ones)
   std::vector<Step> steps_;
   StableArray<StepVars> vars_;  ///< appending keeps the addresses Ceres holds
-  std::size_t used_[4] = {0, 0, 0, 0};  ///< samples of each stream already in steps
+  std::size_t used_[7] = {0, 0, 0, 0, 0, 0, 0};  ///< samples of each stream already in steps (4-6: finger 1's)
   std::shared_ptr<const geometry::ShapePairQuerier> querier_;
+  bool two_fingers_ = false;  ///< finger 1 estimated (a two-finger push, not the baseline)
+  bool finger_has_faces_ = false;  ///< finger 0's core is more than a point (not a disk)
+  std::shared_ptr<const geometry::ShapePairQuerier> querier_b_;  ///< object and finger 1
+  bool fingers_ignored_ = false;  ///< the baseline left finger 1 out
+  int steps_with_more_contacts_ = 0;  ///< steps with 3+ contact rows, modelled by their farthest two
   QuasiStaticGeometry qs_;
   bool estimate_c_ = false;
   bool c_in_problem_ = false;

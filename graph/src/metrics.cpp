@@ -71,6 +71,38 @@ std::map<std::string, double> ComputeMetrics(const push::Trajectory& traj,
     }
     Vec2 v;
     const std::vector<Vec2> rows = TruthRowsAt(gt.contact_point, s.t);
+    if (!traj.extra_fingers.empty()) {
+      // Several fingers: every finger's pose, and each contact and force against its own
+      // finger's truth (the finger metrics pool the fingers).
+      const auto truth_of = [&](int k) -> const push::FingerStreams* {
+        if (k < 1 || k > static_cast<int>(traj.extra_fingers.size())) return nullptr;
+        const auto& g = traj.extra_fingers[k - 1].ground_truth;
+        return g ? &*g : nullptr;
+      };
+      for (const FingerPoseEstimate& f : s.other_fingers) {
+        const push::FingerStreams* g = truth_of(f.finger);
+        if (g == nullptr) continue;
+        if (const auto e = PoseErrorAt(g->finger_pose, s.t, f.pose)) {
+          finger.Add(*e);
+          if (f.pose_cov) nees_finger.Add(Nees(*e, *f.pose_cov));
+        }
+      }
+      for (const ContactEstimate& c : s.contacts) {
+        const push::FingerStreams* g = truth_of(c.finger);
+        if (c.finger != 0 && g == nullptr) continue;
+        const std::vector<push::PointSample>& points = c.finger == 0 ? gt.contact_point : g->contact_point;
+        if (push::TruthPointAt(points, s.t, &v)) {
+          contact.Add((c.point - v).squaredNorm());
+          if (c.point_cov) nees_contact.Add(Nees(Vec2(c.point - v), *c.point_cov));
+        }
+        const std::vector<push::ForceSample>& forces = c.finger == 0 ? gt.force : g->force;
+        if (c.force && push::TruthForceAt(forces, s.t, &v)) {
+          force.Add((*c.force - v).squaredNorm());
+          if (c.force_cov) nees_force.Add(Nees(Vec2(*c.force - v), *c.force_cov));
+        }
+      }
+      continue;
+    }
     if (s.contact && (rows.size() >= 2 || !s.contacts.empty())) {
       // Several contacts: each estimated contact against the nearest true one at this time.
       std::vector<std::pair<Vec2, std::optional<Eigen::Matrix2d>>> estimated;

@@ -98,53 +98,65 @@ double ForceFaultBound(double force_p95, const push::ObjectDescription& object) 
 void ValidateTrajectory(const push::Trajectory& traj) {
   if (traj.object.shape.empty()) throw GraphError("trajectory: object.shape is missing or empty");
   if (traj.finger.shape.empty()) throw GraphError("trajectory: finger.shape is missing or empty");
-  // Pushes with several fingers are simulated and stored (push::MultiPushingModel, "fingers" in
-  // the file format); the factor graphs model one finger (with up to two contacts).
-  if (!traj.extra_fingers.empty())
+  // The factor graphs model one finger with up to two contacts, or two fingers with one each.
+  if (traj.extra_fingers.size() > 1)
     throw GraphError("trajectory: " + std::to_string(push::FingerCount(traj)) +
-                     " fingers: the estimator models one finger (with up to two contacts); several fingers are not "
-                     "estimated yet");
+                     " fingers: the estimator models at most two fingers");
+  for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k)
+    if (traj.extra_fingers[k].finger.shape.empty())
+      throw GraphError("trajectory: fingers[" + std::to_string(k + 1) + "].shape is missing or empty");
   const auto& m = traj.measured;
   for (std::size_t i = 0; i < m.object_pose.size(); ++i) {
     CheckFinite(std::isfinite(m.object_pose[i].t) && m.object_pose[i].pose.vector().allFinite(), "object_pose", i);
-  }
-  for (std::size_t i = 0; i < m.finger_pose.size(); ++i) {
-    CheckFinite(std::isfinite(m.finger_pose[i].t) && m.finger_pose[i].pose.vector().allFinite(), "finger_pose", i);
-  }
-  for (std::size_t i = 0; i < m.contact_point.size(); ++i) {
-    CheckFinite(std::isfinite(m.contact_point[i].t) && m.contact_point[i].point.allFinite(), "contact_point", i);
-  }
-  for (std::size_t i = 0; i < m.force.size(); ++i) {
-    CheckFinite(std::isfinite(m.force[i].t) && m.force[i].force.allFinite(), "force", i);
   }
   for (std::size_t i = 0; i < m.object_pose.size(); ++i) {
     const auto& s = m.object_pose[i];
     CheckRange(s.t, std::max(std::abs(s.pose.x), std::abs(s.pose.y)), geometry::kMaxCoordinate, "object_pose", i, "|position|");
   }
-  for (std::size_t i = 0; i < m.finger_pose.size(); ++i) {
-    const auto& s = m.finger_pose[i];
-    CheckRange(s.t, std::max(std::abs(s.pose.x), std::abs(s.pose.y)), geometry::kMaxCoordinate, "finger_pose", i, "|position|");
-  }
-  for (std::size_t i = 0; i < m.contact_point.size(); ++i) {
-    const auto& s = m.contact_point[i];
-    CheckRange(s.t, s.point.cwiseAbs().maxCoeff(), geometry::kMaxCoordinate, "contact_point", i, "|position|");
-  }
-  for (std::size_t i = 0; i < m.force.size(); ++i) {
-    CheckRange(m.force[i].t, m.force[i].force.cwiseAbs().maxCoeff(), kMaxForce, "force", i, "|force|");
+  // Each finger's streams; finger k > 0's named streams.fingers[k].<stream>[its own sample index].
+  auto check_finger = [](const std::vector<push::PoseSample>& pose, const std::vector<push::PointSample>& contact,
+                         const std::vector<push::ForceSample>& force, const std::string& who) {
+    for (std::size_t i = 0; i < pose.size(); ++i) {
+      CheckFinite(std::isfinite(pose[i].t) && pose[i].pose.vector().allFinite(), who + "finger_pose", i);
+      CheckRange(pose[i].t, std::max(std::abs(pose[i].pose.x), std::abs(pose[i].pose.y)), geometry::kMaxCoordinate,
+                 who + "finger_pose", i, "|position|");
+    }
+    for (std::size_t i = 0; i < contact.size(); ++i) {
+      CheckFinite(std::isfinite(contact[i].t) && contact[i].point.allFinite(), who + "contact_point", i);
+      CheckRange(contact[i].t, contact[i].point.cwiseAbs().maxCoeff(), geometry::kMaxCoordinate, who + "contact_point", i,
+                 "|position|");
+    }
+    for (std::size_t i = 0; i < force.size(); ++i) {
+      CheckFinite(std::isfinite(force[i].t) && force[i].force.allFinite(), who + "force", i);
+      CheckRange(force[i].t, force[i].force.cwiseAbs().maxCoeff(), kMaxForce, who + "force", i, "|force|");
+    }
+    CheckSorted(pose, who + "finger_pose");
+    CheckSorted(contact, who + "contact_point", /*repeats=*/true);
+    CheckSorted(force, who + "force");
+    CheckNoClockJump(pose, who + "finger_pose", 0.0);
+    CheckNoClockJump(contact, who + "contact_point", 0.0);
+    CheckNoClockJump(force, who + "force", 0.0);
+  };
+  check_finger(m.finger_pose, m.contact_point, m.force, "");
+  for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k) {
+    const push::FingerStreams& f = traj.extra_fingers[k].measured;
+    const std::string who = "fingers[" + std::to_string(k + 1) + "].";
+    check_finger(f.finger_pose, f.contact_point, f.force, who);
+    if (f.finger_pose.empty())
+      throw GraphError("trajectory: no pose measurements of finger " + std::to_string(k + 1) +
+                       " (its finger_pose rows are missing)");
+    if (push::HasRepeatedTimes(f.contact_point) || push::HasRepeatedTimes(m.contact_point))
+      throw GraphError("trajectory: a two-finger push with two contacts of one finger at a time (contact_point rows of "
+                       "finger " + std::string(push::HasRepeatedTimes(m.contact_point) ? "0" : std::to_string(k + 1)) +
+                       " repeat a time): the estimator models two contacts in all, one per finger");
   }
   CheckSorted(m.object_pose, "object_pose");
-  CheckSorted(m.finger_pose, "finger_pose");
-  CheckSorted(m.contact_point, "contact_point", /*repeats=*/true);
-  CheckSorted(m.force, "force");
   {
     double finest = INFINITY;
     for (double p : {MedianPeriod(m.object_pose), MedianPeriod(m.finger_pose), MedianPeriod(m.contact_point), MedianPeriod(m.force)})
       if (p > 0.0) finest = std::min(finest, p);
     if (!std::isfinite(finest)) finest = 0.0;
     CheckNoClockJump(m.object_pose, "object_pose", 0.0);
-    CheckNoClockJump(m.finger_pose, "finger_pose", 0.0);
-    CheckNoClockJump(m.contact_point, "contact_point", 0.0);
-    CheckNoClockJump(m.force, "force", 0.0);
     // Between streams: the streams' spans must overlap or follow within the same bound.
     std::vector<std::pair<double, std::pair<double, std::string>>> spans;
     auto add = [&](const auto& s, const std::string& name) {
@@ -154,6 +166,13 @@ void ValidateTrajectory(const push::Trajectory& traj) {
     add(m.finger_pose, "finger_pose");
     add(m.contact_point, "contact_point");
     add(m.force, "force");
+    for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k) {
+      const push::FingerStreams& f = traj.extra_fingers[k].measured;
+      const std::string who = "fingers[" + std::to_string(k + 1) + "].";
+      add(f.finger_pose, who + "finger_pose");
+      add(f.contact_point, who + "contact_point");
+      add(f.force, who + "force");
+    }
     std::sort(spans.begin(), spans.end());
     const double bound = std::max(kClockJumpSeconds, kClockJumpPeriods * finest);
     double reach = spans.empty() ? 0.0 : spans.front().second.first;

@@ -46,6 +46,8 @@ py::dict ResultToDict(const EstimationResult& r) {
   py::array_t<double> t = NewArray({n}), object = NewArray({n, 3}), finger = NewArray({n, 3}), contact = NewArray({n, 2}),
                       force = NewArray({n, 2}), object_cov = NewArray({n, 3, 3}), finger_cov = NewArray({n, 3, 3}),
                       contact_cov = NewArray({n, 2, 2}), force_cov = NewArray({n, 2, 2});
+  // Two-contact states (a finger wedged in a notch): the second contact and each one's force.
+  py::array_t<double> second = NewArray({n, 2}), second_cov = NewArray({n, 2, 2}), forces = NewArray({n, 2, 2});
   auto put_cov = [](double* out, const auto& cov, int dim) {
     for (int k = 0; k < dim * dim; ++k) out[k] = cov ? (*cov)(k / dim, k % dim) : kNaN;
   };
@@ -64,6 +66,13 @@ py::dict ResultToDict(const EstimationResult& r) {
     put_cov(finger_cov.mutable_data() + 9 * i, s.finger_pose_cov, 3);
     put_cov(contact_cov.mutable_data() + 4 * i, s.contact_cov, 2);
     put_cov(force_cov.mutable_data() + 4 * i, s.force_cov, 2);
+    const bool two = s.contacts.size() == 2;
+    for (int k = 0; k < 2; ++k) {
+      second.mutable_data()[2 * i + k] = two ? s.contacts[1].point[k] : kNaN;
+      for (int c = 0; c < 2; ++c)
+        forces.mutable_data()[4 * i + 2 * c + k] = two && s.contacts[c].force ? (*s.contacts[c].force)[k] : kNaN;
+    }
+    put_cov(second_cov.mutable_data() + 4 * i, two ? s.contacts[1].point_cov : std::nullopt, 2);
   }
   py::dict d;
   d["model"] = ModelName(r.model);
@@ -77,6 +86,9 @@ py::dict ResultToDict(const EstimationResult& r) {
   d["finger_pose_cov"] = finger_cov;
   d["contact_cov"] = contact_cov;
   d["force_cov"] = force_cov;
+  d["second_contact"] = second;
+  d["second_contact_cov"] = second_cov;
+  d["contact_forces"] = forces;
   py::dict metrics;
   for (const auto& [k, v] : r.metrics) metrics[k.c_str()] = v;
   d["metrics"] = metrics;

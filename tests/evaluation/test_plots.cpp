@@ -308,6 +308,35 @@ TEST(PushSvg, DrawsEveryFingerContactAndForceAtTheMarkedTimes) {
   EXPECT_THROW(evaluation::PushSvg(t, options), evaluation::EvaluationError);
 }
 
+// An estimate of a two-finger push: finger 1's shape at every marked step and its path, every
+// contact of either finger and each contact's own force arrow.
+TEST(PlotSvg, EstimatesOfTwoFingersDrawBothFingersAndEveryContact) {
+  push::Trajectory traj = Push(true);
+  push::ExtraFinger second;
+  second.finger.shape = geometry::Shape::Disk(0.004, {0.0, -0.02});
+  traj.extra_fingers.push_back(second);
+  graph::EstimationResult result = Result(traj, true, true);
+  for (graph::StateEstimate& s : result.states) {
+    s.other_fingers.push_back({1, s.finger_pose, std::nullopt});
+    if (!s.contact) continue;
+    graph::ContactEstimate own, other;
+    own.point = *s.contact;
+    own.force = s.force;
+    other.finger = 1;
+    other.point = *s.contact + Vec2(0.0, -0.02);
+    other.force = Vec2(0.2, 0.5);
+    s.contacts = {own, other};
+  }
+  evaluation::TrajectoryPlotOptions options;
+  options.every = 5;  // marked steps 0, 5, 10, 15, 20; in contact at 4 of them
+  const std::string svg = evaluation::TrajectorySvg(traj, result, options);
+  EXPECT_EQ(XmlProblem(svg), "");
+  EXPECT_EQ(Count(svg, "class='finger'"), 2 * 5);
+  EXPECT_EQ(Count(svg, "class='finger-path-estimated'"), 2);
+  EXPECT_EQ(Count(svg, "class='contact-estimated'"), 2 * 4);
+  EXPECT_EQ(Count(svg, "class='force-estimated'"), 2 * 4);
+}
+
 TEST(PlotSvg, ErrorsNameThePathOrTheProblem) {
   const push::Trajectory traj = Push(true);
   const graph::EstimationResult result = Result(traj, true, true);

@@ -10,6 +10,7 @@
 
 #include <Eigen/Cholesky>
 
+#include "graph/notched_push.h"
 #include "graph/online_feed.h"
 
 #include <gtest/gtest.h>
@@ -25,21 +26,11 @@ namespace {
 // A finger pushed into the V from above, slightly off its axis: it meets one wall, slides to the
 // apex and wedges; the block then translates with it. Noise: 2 mm, 0.02 rad, 0.2 N.
 push::Trajectory WedgedPush(std::uint64_t seed) {
-  push::PushPlan plan;
-  plan.object.shape = geometry::LoadShapeJson(std::string(PUSHGRAPH_SOURCE_DIR) + "/data/shapes/notched_block.json");
-  plan.object.mass = 0.5;
-  plan.object.mu_surface = 0.3;
+  push::PushPlan plan = testing::NotchedBlockPlan(seed);
   plan.finger = {geometry::Shape::Disk(0.004), 0.4};
   plan.object_pose = {0.0, 0.0, 0.1};
   plan.multi_contact = true;
   plan.waypoints = push::StraightPushPath(plan, -M_PI / 2 + 0.25, 0.0, 0.005, 0.05);
-  plan.noise = push::DefaultNoise(push::NoiseKind::kGaussian);
-  plan.noise.object_pose.position.sigma = 0.002;
-  plan.noise.object_pose.angle.sigma = 0.02;
-  plan.noise.finger_pose.position.sigma = 0.002;
-  plan.noise.contact_point.position.sigma = 0.002;
-  plan.noise.force.position.sigma = 0.2;
-  plan.seed = seed;
   return push::Simulate(plan).trajectory;
 }
 

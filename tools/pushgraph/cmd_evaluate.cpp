@@ -189,8 +189,10 @@ void RegisterEvaluate(CLI::App& app) {
   cmd->add_option("--simulate", o->simulate, "Also evaluate N seeded simulated pushes (varied direction and offset)")
       ->capture_default_str();
   cmd->add_option("--simulate-multi-contact", o->simulate_multi,
-                  "Also evaluate N simulated pushes with every contact modelled (group sim-multi: push i is "
-                  "--simulate's push i; a finger pushed into a notch wedges and touches both walls)")
+                  "Also evaluate N simulated pushes with every contact modelled (group sim-multi), on the push "
+                  "lines of --simulate's pushes, in a cycle of four kinds: one finger (pushes 0, 2 mod 4: it may "
+                  "wedge in a notch and touch both walls), two fingers side by side (1 mod 4), a flat pusher "
+                  "(3 mod 4)")
       ->capture_default_str();
   cmd->add_option("--sim-object", o->sim_object, "Shape of the simulated pushes' object")->capture_default_str();
   cmd->add_option("--sim-finger", o->sim_finger, "Finger of the simulated pushes")->capture_default_str();

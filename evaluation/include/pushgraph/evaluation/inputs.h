@@ -106,7 +106,18 @@ struct SimulationSpec {
   bool multi_contact = false;
 };
 
-/// The clean (noise-free) simulated push number `index`.
+/// What push `index` of a multi-contact group (SimulationSpec::multi_contact) is, in a cycle of
+/// four: one finger (0, 2: the single-contact group's push on the same line, which may wedge in a
+/// notch), two fingers side by side (1: two copies of the finger moving together, 0.8 of the
+/// object's smaller half-extent apart, either side of the push line), and a flat pusher
+/// (3: a bar 1.6 half-extents long and as thick as the finger, its face across the push).
+enum class MultiContactPushKind { kOneFinger, kTwoFingers, kFlatPusher };
+MultiContactPushKind MultiContactPushKindOf(int index);
+/// "one-finger", "two-fingers", "flat-pusher".
+const char* MultiContactPushKindName(MultiContactPushKind kind);
+
+/// The clean (noise-free) simulated push number `index` (with spec.multi_contact: of the kind
+/// MultiContactPushKindOf(index), on the push line of the single-contact group's push `index`).
 push::Trajectory SimulatedPush(const SimulationSpec& spec, int index, std::uint64_t seed);
 
 /// Files from paths, folders (recursively: *.h5, *.hdf5, *.json) and glob patterns, sorted and

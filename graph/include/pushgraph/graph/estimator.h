@@ -46,11 +46,20 @@ Mode ParseMode(const std::string& name);
 std::string ModeName(Mode mode);
 bool ModelHasForce(Model model);
 
-/// One contact of a step that has two (a finger wedged in a notch touches both walls).
+/// One contact of a step that has two (a finger wedged in a notch touches both walls), or of a
+/// two-finger push (every contact of either finger).
 struct ContactEstimate {
+  int finger = 0;  ///< whose contact: 0 is Trajectory::finger, 1 the first extra finger
   Vec2 point{0.0, 0.0};
   std::optional<Vec2> force;  ///< this contact's force (QS), world frame
   std::optional<Eigen::Matrix2d> point_cov, force_cov;
+};
+
+/// A finger other than finger 0 (two-finger pushes): its pose.
+struct FingerPoseEstimate {
+  int finger = 1;
+  Pose2 pose;
+  std::optional<Eigen::Matrix3d> pose_cov;  ///< (x, y, theta)
 };
 
 struct StateEstimate {
@@ -61,9 +70,13 @@ struct StateEstimate {
   /// QS and baseline, while in contact: the finger's net force on the object (the sum over its
   /// contacts: what its force sensor measures).
   std::optional<Vec2> force;
-  /// Steps with two contacts: both, each with its own force and covariances (`contact` is the
-  /// first; `force_cov` is then not reported: the sum's covariance needs their cross-covariance).
+  /// Steps with two contacts of finger 0: both, each with its own force and covariances
+  /// (`contact` is the first; `force_cov` is then not reported: the sum's covariance needs their
+  /// cross-covariance). Two-finger pushes: every contact of either finger at this step (`contact`
+  /// and `force` are finger 0's own, absent while it does not touch).
   std::vector<ContactEstimate> contacts;
+  /// Two-finger pushes: finger 1's pose (finger_pose is finger 0's).
+  std::vector<FingerPoseEstimate> other_fingers;
   std::optional<Eigen::Matrix3d> object_pose_cov, finger_pose_cov;  ///< (x, y, theta)
   std::optional<Eigen::Matrix2d> contact_cov, force_cov;
 };

@@ -1,0 +1,225 @@
+// Estimation of a push by two fingers moving side by side (simulated with every contact,
+// push::PushPlan::extra_fingers): finger 1 has its own pose, contact and force variables with
+// its own M, C, S, touching and V factors, and D takes both fingers' summed wrench. Batch (both
+// solvers), incremental, RESULT.json's entries and the inputs refused by name.
+#include <pushgraph/evaluation/result_json.h>
+#include <pushgraph/graph/estimator.h>
+#include <pushgraph/geometry/pose.h>
+#include <pushgraph/io/trajectory_json.h>
+#include <pushgraph/push/noise.h>
+#include <pushgraph/push/simulator.h>
+
+#include <Eigen/Cholesky>
+#include <nlohmann/json.hpp>
+
+#include "graph/notched_push.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+namespace pushgraph::graph {
+namespace {
+
+// The notched block pushed by two 4 mm disks 3 cm apart, the pusher frame turned with the push;
+// the second finger (0, -3 cm in the pusher frame) meets the block later than the first.
+// Noise: 2 mm, 0.02 rad, 0.2 N on every finger's streams.
+push::Trajectory TwoFingerPush(std::uint64_t seed, double angle = M_PI / 2 + 0.2) {
+  push::PushPlan plan = testing::NotchedBlockPlan(seed);
+  plan.finger = {geometry::Shape::Disk(0.004), 0.4};
+  plan.extra_fingers = {{geometry::Shape::Disk(0.004, {0.0, -0.03}), 0.3}};
+  plan.finger_theta = angle;
+  plan.object_pose = {0.0, 0.0, 0.1};
+  plan.waypoints = push::StraightPushPath(plan, angle, 0.012, 0.005, 0.05);
+  return push::Simulate(plan).trajectory;
+}
+
+// Object position RMS and mean object-pose NEES over the object's measured times while both
+// fingers touch (truth), and the raw measurements' RMS there.
+struct PhaseError {
+  double rms = 0.0, nees = 0.0, raw_rms = 0.0;
+  int n = 0;
+};
+PhaseError BothTouching(const push::Trajectory& t, const EstimationResult& r) {
+  const push::Streams& gt = *t.ground_truth;
+  const push::FingerStreams& gt1 = *t.extra_fingers[0].ground_truth;
+  auto touches = [](const std::vector<push::PointSample>& c, double time) {
+    return std::any_of(c.begin(), c.end(), [&](const push::PointSample& p) { return std::abs(p.t - time) < 1e-9; });
+  };
+  PhaseError out;
+  double sq = 0.0, raw_sq = 0.0;
+  for (const push::PoseSample& m : t.measured.object_pose) {
+    if (!touches(gt.contact_point, m.t) || !touches(gt1.contact_point, m.t)) continue;
+    const auto truth = std::find_if(gt.object_pose.begin(), gt.object_pose.end(),
+                                    [&](const push::PoseSample& p) { return p.t == m.t; });
+    const auto est = std::find_if(r.states.begin(), r.states.end(), [&](const StateEstimate& s) { return s.t == m.t; });
+    if (truth == gt.object_pose.end() || est == r.states.end() || !est->object_pose_cov) continue;
+    Eigen::Vector3d e = est->object_pose.vector() - truth->pose.vector();
+    e.z() = geometry::WrapAngle(e.z());
+    sq += e.head<2>().squaredNorm();
+    out.nees += e.dot(est->object_pose_cov->ldlt().solve(e));
+    raw_sq += (m.pose.translation() - truth->pose.translation()).squaredNorm();
+    ++out.n;
+  }
+  if (out.n > 0) out.rms = std::sqrt(sq / out.n), out.nees /= out.n, out.raw_rms = std::sqrt(raw_sq / out.n);
+  return out;
+}
+
+// Both fingers' force measurements against their truth (RMS of the 2-D error).
+double RawForceRms(const push::Trajectory& t) {
+  double sq = 0.0;
+  int n = 0;
+  auto add = [&](const std::vector<push::ForceSample>& measured, const std::vector<push::ForceSample>& truth) {
+    for (std::size_t i = 0; i < measured.size() && i < truth.size(); ++i) sq += (measured[i].force - truth[i].force).squaredNorm(), ++n;
+  };
+  add(t.measured.force, t.ground_truth->force);
+  add(t.extra_fingers[0].measured.force, t.extra_fingers[0].ground_truth->force);
+  return std::sqrt(sq / n);
+}
+
+TEST(TwoFingers, BothFingersAreEstimatedWithTheirContactsAndForces) {
+  const push::Trajectory t = TwoFingerPush(3);
+  ASSERT_EQ(push::FingerCount(t), 2);
+  EstimatorConfig config = ApplyMeasurementSigmas(EstimatorConfig{}, *t.measurement_sigmas);
+  for (const Model model : {Model::kCp, Model::kSdf, Model::kQs}) {
+    for (const auto solver : {EstimatorConfig::Solver::kCeres, EstimatorConfig::Solver::kChain}) {
+      config.solver = solver;
+      const EstimationResult r = Estimate(t, model, Mode::kBatch, config);
+      const PhaseError both = BothTouching(t, r);
+      std::printf("[two fingers] %-3s %-6s both touching (%d poses): object %.2f mm, NEES %.2f; raw %.2f mm; "
+                  "finger rms %.2f mm, contact rms %.2f mm, force rms %.3f N (raw %.3f); %d iterations\n",
+                  ModelName(model).c_str(), solver == EstimatorConfig::Solver::kChain ? "chain" : "ceres", both.n,
+                  1e3 * both.rms, both.nees, 1e3 * both.raw_rms, 1e3 * r.metrics.at("finger_position_rms"),
+                  1e3 * r.metrics.at("contact_rms"), ModelHasForce(model) ? r.metrics.at("force_rms") : 0.0,
+                  RawForceRms(t), r.solver.iterations);
+      EXPECT_EQ(r.solver.covariance_status, "ok");
+      ASSERT_GE(both.n, 8) << ModelName(model);
+      EXPECT_LT(both.rms, 0.6 * both.raw_rms) << ModelName(model);
+      EXPECT_LT(both.nees, 3.0 * 2.0) << ModelName(model);
+      EXPECT_LT(r.metrics.at("contact_rms"), 0.002) << ModelName(model);
+      int touching1 = 0, touching_both = 0;
+      for (const StateEstimate& s : r.states) {
+        ASSERT_EQ(s.other_fingers.size(), 1u);
+        EXPECT_EQ(s.other_fingers[0].finger, 1);
+        ASSERT_TRUE(s.other_fingers[0].pose_cov.has_value());
+        int of1 = 0, of0 = 0;
+        for (const ContactEstimate& c : s.contacts) {
+          (c.finger == 1 ? of1 : of0) += 1;
+          EXPECT_TRUE(c.point_cov.has_value());
+          if (ModelHasForce(model)) EXPECT_TRUE(c.force && c.force_cov);
+        }
+        EXPECT_LE(of1, 1);
+        EXPECT_EQ(of0, s.contact ? 1 : 0);
+        touching1 += of1;
+        touching_both += of1 && of0;
+        if (ModelHasForce(model) && s.contact) {
+          // finger 0's own force, not the sum: each finger has its own sensor.
+          ASSERT_TRUE(s.force && s.force_cov);
+          EXPECT_EQ(*s.force, *s.contacts[0].force);
+        }
+      }
+      EXPECT_GT(touching1, 100) << ModelName(model);
+      EXPECT_GT(touching_both, 100) << ModelName(model);
+      if (model == Model::kQs) {
+        EXPECT_LT(r.metrics.at("force_rms"), 0.9 * RawForceRms(t));
+        // Leaving finger 1 out (what a one-finger estimator sees) is worse and overconfident.
+        push::Trajectory one = t;
+        one.extra_fingers.clear();
+        const PhaseError alone = BothTouching(t, Estimate(one, model, Mode::kBatch, config));
+        std::printf("[two fingers] qs finger 1 left out: object %.2f mm, NEES %.2f\n", 1e3 * alone.rms, alone.nees);
+        EXPECT_LT(both.rms, alone.rms);
+        EXPECT_LT(both.nees, alone.nees);
+      }
+    }
+  }
+}
+
+// The Ceres path and the chain solver reach the same minimum on a two-finger push.
+TEST(TwoFingers, BothSolversReachTheSameMinimum) {
+  const push::Trajectory t = TwoFingerPush(4);
+  EstimatorConfig config = ApplyMeasurementSigmas(EstimatorConfig{}, *t.measurement_sigmas);
+  config.covariance = false;
+  config.solver = EstimatorConfig::Solver::kCeres;
+  const EstimationResult ceres = Estimate(t, Model::kQs, Mode::kBatch, config);
+  config.solver = EstimatorConfig::Solver::kChain;
+  const EstimationResult chain = Estimate(t, Model::kQs, Mode::kBatch, config);
+  EXPECT_NEAR(ceres.solver.final_cost, chain.solver.final_cost, 1e-6 * ceres.solver.final_cost);
+  ASSERT_EQ(ceres.states.size(), chain.states.size());
+  double worst = 0.0;
+  for (std::size_t i = 0; i < ceres.states.size(); ++i) {
+    worst = std::max(worst, (ceres.states[i].object_pose.vector() - chain.states[i].object_pose.vector()).cwiseAbs().maxCoeff());
+    worst = std::max(worst, (ceres.states[i].other_fingers[0].pose.vector() -
+                             chain.states[i].other_fingers[0].pose.vector()).cwiseAbs().maxCoeff());
+  }
+  EXPECT_LT(worst, 1e-6);
+}
+
+TEST(TwoFingers, IncrementalTheBaselineAndTheResultFile) {
+  const push::Trajectory t = TwoFingerPush(5);
+  const EstimatorConfig config = ApplyMeasurementSigmas(EstimatorConfig{}, *t.measurement_sigmas);
+  const EstimationResult batch = Estimate(t, Model::kQs, Mode::kBatch, config);
+  const EstimationResult inc = Estimate(t, Model::kQs, Mode::kIncremental, config);
+  const PhaseError b = BothTouching(t, batch), i = BothTouching(t, inc);
+  std::printf("[two fingers] qs incremental both touching (%d poses): object %.2f mm, NEES %.2f (batch %.2f mm, %.2f)\n",
+              i.n, 1e3 * i.rms, i.nees, 1e3 * b.rms, b.nees);
+  EXPECT_LT(i.rms, 0.6 * i.raw_rms);
+  EXPECT_LT(inc.metrics.at("object_position_rms"), 1.3 * batch.metrics.at("object_position_rms"));
+  ASSERT_FALSE(inc.states.empty());
+  EXPECT_EQ(inc.states.back().other_fingers.size(), 1u);
+
+  // RESULT.json: every finger's pose and every contact with its finger.
+  const nlohmann::json j = nlohmann::json::parse(evaluation::ResultToJson(batch, -1));
+  int finger1_contacts = 0;
+  for (const auto& s : j.at("states")) {
+    ASSERT_EQ(s.at("fingers").size(), 1u);
+    EXPECT_EQ(s.at("fingers")[0].at("finger"), 1);
+    EXPECT_EQ(s.at("fingers")[0].at("pose").size(), 3u);
+    EXPECT_TRUE(s.at("fingers")[0].contains("pose_cov"));
+    if (!s.contains("contacts")) continue;
+    for (const auto& c : s.at("contacts")) {
+      finger1_contacts += c.at("finger") == 1;
+      EXPECT_TRUE(c.contains("point_cov") && c.contains("force"));
+    }
+  }
+  EXPECT_GT(finger1_contacts, 100);
+
+  // The baseline models one finger, as published: it leaves finger 1 out and says so.
+  const EstimationResult yu = Estimate(t, Model::kYu, Mode::kBatch, config);
+  bool said = false;
+  for (const std::string& w : yu.warnings) said = said || w.find("models one finger") != std::string::npos;
+  EXPECT_TRUE(said);
+  for (const StateEstimate& s : yu.states) EXPECT_TRUE(s.other_fingers.empty());
+}
+
+// Written and read back through the file format, the push estimates the same.
+TEST(TwoFingers, TheTrajectoryFileRoundTripsIntoTheEstimator) {
+  const push::Trajectory t = TwoFingerPush(6);
+  const push::Trajectory back = io::ParseTrajectoryJson(io::TrajectoryToJson(t));
+  ASSERT_EQ(push::FingerCount(back), 2);
+  EstimatorConfig config = ApplyMeasurementSigmas(EstimatorConfig{}, *t.measurement_sigmas);
+  config.covariance = false;
+  const EstimationResult a = Estimate(t, Model::kSdf, Mode::kBatch, config);
+  const EstimationResult b = Estimate(back, Model::kSdf, Mode::kBatch, config);
+  ASSERT_EQ(a.states.size(), b.states.size());
+  EXPECT_NEAR(a.metrics.at("object_position_rms"), b.metrics.at("object_position_rms"), 1e-6);
+}
+
+// Two contacts of one finger in a two-finger push are refused by name (two contacts in all).
+TEST(TwoFingers, AThirdContactIsRefusedByName) {
+  push::Trajectory t = TwoFingerPush(7);
+  auto& c = t.extra_fingers[0].measured.contact_point;
+  ASSERT_GT(c.size(), 10u);
+  c.insert(c.begin() + 5, c[5]);
+  try {
+    Estimate(t, Model::kQs, Mode::kBatch);
+    FAIL() << "accepted";
+  } catch (const GraphError& e) {
+    EXPECT_NE(std::string(e.what()).find("finger 1 repeat a time"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace pushgraph::graph
