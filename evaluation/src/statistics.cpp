@@ -101,13 +101,25 @@ void AccumulateRun(const push::Trajectory& traj, const graph::EstimationResult& 
       }
     }
     Vec2 v;
-    if (s.contact && push::TruthPointAt(gt.contact_point, s.t, &v)) {
-      const Eigen::Vector2d e = *s.contact - v;
+    // Every estimated contact against its finger's nearest true contact at that time (several
+    // contacts: a wedged finger, a flat pusher, two fingers).
+    std::vector<graph::ContactEstimate> contacts = s.contacts;
+    if (contacts.empty() && s.contact) contacts.push_back({0, *s.contact, s.force, s.contact_cov, s.force_cov});
+    for (const graph::ContactEstimate& c : contacts) {
+      const bool own = c.finger == 0;
+      if (!own && (c.finger > static_cast<int>(traj.extra_fingers.size()) || !traj.extra_fingers[c.finger - 1].ground_truth))
+        continue;
+      const auto& truth = own ? gt.contact_point : traj.extra_fingers[c.finger - 1].ground_truth->contact_point;
+      if (!push::TruthContactNear(truth, s.t, c.point, &v)) continue;
+      const Eigen::Vector2d e = c.point - v;
       sink.Error(prefix + "/contact", e.norm());
-      if (s.contact_cov) {
-        sink.Variance(prefix + "/contact", s.contact_cov->trace());
-        sink.Nees(prefix + "/contact", NeesOf<2>(e, *s.contact_cov), 2);
+      if (c.point_cov) {
+        sink.Variance(prefix + "/contact", c.point_cov->trace());
+        sink.Nees(prefix + "/contact", NeesOf<2>(e, *c.point_cov), 2);
       }
+      // Another finger's own force (finger 0's is `force` below).
+      if (!own && c.force && push::TruthForceAt(traj.extra_fingers[c.finger - 1].ground_truth->force, s.t, &v))
+        sink.Error(prefix + "/force", (*c.force - v).norm());
     }
     if (s.force && push::TruthForceAt(gt.force, s.t, &v)) {
       const Eigen::Vector2d e = *s.force - v;
@@ -154,7 +166,14 @@ void AccumulateRaw(const push::Trajectory& traj, const std::string& prefix, Stat
   }
   for (const push::PointSample& s : m.contact_point) {
     Vec2 v;
-    if (push::TruthPointAt(gt.contact_point, s.t, &v)) sink.Error(prefix + "/contact", (s.point - v).norm());
+    if (push::TruthContactNear(gt.contact_point, s.t, s.point, &v)) sink.Error(prefix + "/contact", (s.point - v).norm());
+  }
+  for (const push::ExtraFinger& f : traj.extra_fingers) {
+    if (!f.ground_truth) continue;
+    for (const push::PointSample& s : f.measured.contact_point) {
+      Vec2 v;
+      if (push::TruthContactNear(f.ground_truth->contact_point, s.t, s.point, &v)) sink.Error(prefix + "/contact", (s.point - v).norm());
+    }
   }
   for (const push::ForceSample& s : m.force) {
     Vec2 v;

@@ -53,6 +53,7 @@ std::map<std::string, DoubleField> DoubleFields() {
       {"random_walk_rot", PUSHGRAPH_FIELD(random_walk_rot)},
       {"contact_max_gap", PUSHGRAPH_FIELD(contact_max_gap)},
       {"contact_force_threshold", PUSHGRAPH_FIELD(contact_force_threshold)},
+      {"second_contact_tolerance", PUSHGRAPH_FIELD(second_contact_tolerance)},
       {"function_tolerance", PUSHGRAPH_FIELD(function_tolerance)},
   };
 }
@@ -237,7 +238,7 @@ void ValidateConfig(const EstimatorConfig& cfg) {
   EstimatorConfig copy = cfg;  // the field accessors take a mutable config
   for (const auto& [key, field] : DoubleFields()) {
     const double v = field(copy);
-    if (key == "c" || key == "finger_angle_resolution") {
+    if (key == "c" || key == "finger_angle_resolution" || key == "second_contact_tolerance") {
       if (!(v >= 0.0) || !std::isfinite(v)) {
         throw GraphError("config key '" + key + "' must be finite and >= 0");
       }

@@ -105,7 +105,8 @@ EstimationResult EstimateBatch(const push::Trajectory& traj, Model model, const 
   internal::SolveOutcome summary = builder.Solve(*owned, cfg.max_iterations, cfg.function_tolerance, "batch solve");
   // Contact features fixed at the start that the solution no longer touches: the graph again
   // with the features at the solution (GraphBuilder::FeatureChoicesChanged).
-  for (int round = 0; round < 3 && builder.FeatureChoicesChanged() > 0; ++round) {
+  // Without a contact stream, the steps' contact counts follow the geometry at the solution too.
+  for (int round = 0; round < 3 && builder.DetectSecondContacts(0, n) + builder.FeatureChoicesChanged() > 0; ++round) {
     stage_iterations += summary.iterations;
     owned = std::make_unique<ceres::Problem>();
     builder.StartNewProblem();

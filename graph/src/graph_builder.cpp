@@ -470,6 +470,68 @@ bool GraphBuilder::TwoContactFeatures(int i, ContactFeature out[2]) const {
   return true;
 }
 
+bool GraphBuilder::BetweenWalls(int i) const {
+  Vec2 points[2];
+  return FacingWalls(i, 3.0 * cfg_.measurement.contact, points);
+}
+
+int GraphBuilder::DetectSecondContacts(int first, int last) {
+  if (streams_.contact_point || model_ == Model::kYu || two_fingers_ || !(cfg_.second_contact_tolerance > 0.0)) return 0;
+  int changed = 0;
+  for (int i = first; i < last; ++i) {
+    Step& s = steps_[i];
+    if (!s.in_contact) continue;
+    Vec2 points[2];
+    const bool two = FacingWalls(i, cfg_.second_contact_tolerance, points);
+    if (two == s.two_contacts) continue;
+    ++changed;
+    s.two_contacts = two;
+    StepVars& v = vars_[i];
+    if (two) {
+      // Each contact on its wall, p the one nearer its current value; the force shared.
+      const Vec2 p(v.p[0], v.p[1]);
+      if ((points[1] - p).norm() < (points[0] - p).norm()) std::swap(points[0], points[1]);
+      v.p[0] = points[0].x(); v.p[1] = points[0].y();
+      v.p2[0] = points[1].x(); v.p2[1] = points[1].y();
+      v.f2[0] = v.f[0] = 0.5 * v.f[0];
+      v.f2[1] = v.f[1] = 0.5 * v.f[1];
+    } else {
+      v.f[0] += v.f2[0];  // back to one contact: the net force
+      v.f[1] += v.f2[1];
+    }
+  }
+  return changed;
+}
+
+bool GraphBuilder::FacingWalls(int i, double tolerance, Vec2 points[2]) const {
+  // Two object edges within reach, each in front of the other (a concave pair: the walls of a
+  // notch, an inside corner). Edges of a convex part (a finely tessellated ellipse) lie behind
+  // each other's lines however many are within reach; vertex pairs have no wall normal.
+  const StepVars& v = vars_[i];
+  std::vector<geometry::ContactPoint> found;
+  try {
+    found = geometry::FindContacts(traj_.object.shape, Pose2{v.x[0], v.x[1], v.x[2]}, traj_.finger.shape,
+                                   Pose2{v.e[0], v.e[1], v.e[2]}, {tolerance, tolerance});
+  } catch (const geometry::GeometryError&) {
+    return false;
+  }
+  using Kind = geometry::ContactPoint::Kind;
+  const double margin = 1e-3 * tolerance;
+  for (std::size_t a = 0; a < found.size(); ++a) {
+    for (std::size_t b = a + 1; b < found.size(); ++b) {
+      const geometry::ContactPoint &p = found[a], &q = found[b];
+      if (p.kind != Kind::kFingerVertexObjectEdge || q.kind != Kind::kFingerVertexObjectEdge) continue;
+      if ((q.object_point - p.object_point).dot(p.normal) > margin &&
+          (p.object_point - q.object_point).dot(q.normal) > margin) {
+        points[0] = p.object_point;
+        points[1] = q.object_point;
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
 std::array<long long, 2> GraphBuilder::FeatureChoice(int i) const {
   const Step& s = steps_[i];
   if (!s.in_contact) return {-1, -1};
@@ -618,6 +680,7 @@ int GraphBuilder::SmoothInitialMotion(int max_iterations, double function_tolera
 int GraphBuilder::StageSteps(ceres::Problem& problem, int first, int last, int max_iterations,
                              double function_tolerance, const std::string& what) {
   int iterations = SmoothInitialMotion(10, 1e-3, first, last);
+  DetectSecondContacts(first, last);
   if (ModelHasForce(model_)) {
     ceres::Problem warm;
     warm_start_ = true;
@@ -706,11 +769,11 @@ void GraphBuilder::AddKinematicFactors(ceres::Problem& problem, int i) {
         Add(problem, FactorType::kContactOnFinger, cost, nullptr, {v.x, v.e, points[k]}, {0});
       }
     } else if (cfg_.contact_finger == EstimatorConfig::ContactFinger::kWitness &&
-               (finger_has_faces_ || NearbyContactFeatures(i).size() >= 2)) {
+               (finger_has_faces_ || BetweenWalls(i))) {
       // A finger with straight faces (a flat pusher: along a parallel object face the nearest
-      // pair is any pair of the overlap, and the shape-pair query returns a vertex's), or several
-      // object features within reach (a disk between two walls: the nearest pair may jump to the
-      // other wall): the local witness of p instead, the touching pair near p.
+      // pair is any pair of the overlap, and the shape-pair query returns a vertex's), or a disk
+      // between two walls (the nearest pair may jump to the other wall): the local witness of p
+      // instead, the touching pair near p.
       Add(problem, FactorType::kContactOnFinger,
           new LocalWitnessFactor(traj_.object.shape, traj_.finger.shape, cfg_.contact_finger_sigma), nullptr,
           {v.x, v.e, v.p}, {0});
@@ -959,6 +1022,9 @@ void GraphBuilder::DropUnobservableForces(EstimationResult& result) const {
 
 void GraphBuilder::SetState(int i, const StateEstimate& st) {
   StepVars& v = vars_[i];
+  // Without a contact stream the estimate, not the rows, said which steps have two contacts.
+  if (!streams_.contact_point && !two_fingers_ && model_ != Model::kYu && steps_[i].in_contact)
+    steps_[i].two_contacts = st.contacts.size() == 2;
   v.x[0] = st.object_pose.x; v.x[1] = st.object_pose.y; v.x[2] = st.object_pose.theta;
   v.e[0] = st.finger_pose.x; v.e[1] = st.finger_pose.y; v.e[2] = st.finger_pose.theta;
   if (st.contact) {

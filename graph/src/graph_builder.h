@@ -188,6 +188,13 @@ class GraphBuilder {
   /// can be the wrong one (a flat pusher's end near an object corner), and a fixed one, unlike the
   /// nearest pair, cannot move on.
   int FeatureChoicesChanged() const;
+  /// Without a contact stream (the geometry, not the sensor, says how many contacts a step has):
+  /// makes each in-contact step of [first, last) a two-contact step when, at the current values,
+  /// finger 0 is within config.second_contact_tolerance of two object edges facing each other
+  /// (a wedge), with p and p2 on those edges and the force split between them, and a one-contact
+  /// step otherwise. Returns the number of steps whose count changed. Not for the baseline or
+  /// two-finger pushes.
+  int DetectSecondContacts(int first, int last);
   /// Forgets which shared priors (c, mu, shape frame) are in a problem: before building a new one.
   void StartNewProblem() { c_in_problem_ = mu_in_problem_ = frame_in_problem_ = false; }
   /// Parameter blocks of step i present in the problem.
@@ -257,6 +264,12 @@ class GraphBuilder {
   /// The distinct object features (each with its contact point) within 3 contact sigmas of the
   /// finger at step i's current values.
   std::vector<std::pair<ContactFeature, Vec2>> NearbyContactFeatures(int i) const;
+  /// Whether finger 0 at step i's current values is between two walls: two contacts within
+  /// that tolerance whose normals differ by more than 60 degrees.
+  bool BetweenWalls(int i) const;
+  /// The two facing object edges finger 0 is within `tolerance` of at step i's current values
+  /// (their contact points in a[0], a[1]); false when none.
+  bool FacingWalls(int i, double tolerance, Vec2 points[2]) const;
   /// Step i's fixed contact features at the current values, as keys (-1: none, the nearest pair
   /// or the local witness): what AddKinematicFactors gives its contact-on-finger factors.
   std::array<long long, 2> FeatureChoice(int i) const;

@@ -42,15 +42,6 @@ double Nees(const Vector& e, const Matrix& cov) {
 
 }  // namespace
 
-// The true contact rows at exactly t (several when the finger touches at several points).
-std::vector<Vec2> TruthRowsAt(const std::vector<push::PointSample>& truth, double t) {
-  std::vector<Vec2> rows;
-  auto it = std::lower_bound(truth.begin(), truth.end(), t - 1e-9,
-                             [](const push::PointSample& a, double tt) { return a.t < tt; });
-  for (; it != truth.end() && it->t <= t + 1e-9; ++it) rows.push_back(it->point);
-  return rows;
-}
-
 std::map<std::string, double> ComputeMetrics(const push::Trajectory& traj,
                                              const std::vector<StateEstimate>& states) {
   std::map<std::string, double> m;
@@ -70,7 +61,6 @@ std::map<std::string, double> ComputeMetrics(const push::Trajectory& traj,
       if (s.finger_pose_cov) nees_finger.Add(Nees(*e, *s.finger_pose_cov));
     }
     Vec2 v;
-    const std::vector<Vec2> rows = TruthRowsAt(gt.contact_point, s.t);
     if (!traj.extra_fingers.empty()) {
       // Several fingers: every finger's pose, and each contact and force against its own
       // finger's truth (the finger metrics pool the fingers).
@@ -91,7 +81,7 @@ std::map<std::string, double> ComputeMetrics(const push::Trajectory& traj,
         const push::FingerStreams* g = truth_of(c.finger);
         if (c.finger != 0 && g == nullptr) continue;
         const std::vector<push::PointSample>& points = c.finger == 0 ? gt.contact_point : g->contact_point;
-        if (push::TruthPointAt(points, s.t, &v)) {
+        if (push::TruthContactNear(points, s.t, c.point, &v)) {
           contact.Add((c.point - v).squaredNorm());
           if (c.point_cov) nees_contact.Add(Nees(Vec2(c.point - v), *c.point_cov));
         }
@@ -103,20 +93,14 @@ std::map<std::string, double> ComputeMetrics(const push::Trajectory& traj,
       }
       continue;
     }
-    if (s.contact && (rows.size() >= 2 || !s.contacts.empty())) {
-      // Several contacts: each estimated contact against the nearest true one at this time.
-      std::vector<std::pair<Vec2, std::optional<Eigen::Matrix2d>>> estimated;
-      if (s.contacts.empty()) estimated.push_back({*s.contact, s.contact_cov});
-      for (const ContactEstimate& c : s.contacts) estimated.push_back({c.point, c.point_cov});
-      for (const auto& [point, cov] : estimated) {
-        if (rows.empty()) break;
-        Vec2 e = point - rows[0];
-        for (const Vec2& r : rows)
-          if ((point - r).squaredNorm() < e.squaredNorm()) e = point - r;
-        contact.Add(e.squaredNorm());
-        if (cov) nees_contact.Add(Nees(e, *cov));
+    if (!s.contacts.empty()) {
+      // Several contacts: each against the nearest true one at this time.
+      for (const ContactEstimate& c : s.contacts) {
+        if (!push::TruthContactNear(gt.contact_point, s.t, c.point, &v)) continue;
+        contact.Add((c.point - v).squaredNorm());
+        if (c.point_cov) nees_contact.Add(Nees(Vec2(c.point - v), *c.point_cov));
       }
-    } else if (s.contact && push::TruthPointAt(gt.contact_point, s.t, &v)) {
+    } else if (s.contact && push::TruthContactNear(gt.contact_point, s.t, *s.contact, &v)) {
       const Vec2 e = *s.contact - v;
       contact.Add(e.squaredNorm());
       if (s.contact_cov) nees_contact.Add(Nees(e, *s.contact_cov));
@@ -152,7 +136,7 @@ std::map<std::string, double> ComputeMetrics(const push::Trajectory& traj,
   }
   Vec2 v;
   for (const push::PointSample& s : measured.contact_point) {
-    if (push::TruthPointAt(gt.contact_point, s.t, &v)) raw_contact.Add((s.point - v).squaredNorm());
+    if (push::TruthContactNear(gt.contact_point, s.t, s.point, &v)) raw_contact.Add((s.point - v).squaredNorm());
   }
   for (const push::ForceSample& s : measured.force) {
     if (push::TruthForceAt(gt.force, s.t, &v)) raw_force.Add((s.force - v).squaredNorm());

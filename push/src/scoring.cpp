@@ -1,5 +1,7 @@
 #include <pushgraph/push/scoring.h>
 
+#include <algorithm>
+
 #include <cmath>
 
 namespace pushgraph::push {
@@ -11,6 +13,16 @@ bool TruthPoseAt(const std::vector<PoseSample>& truth, double t, Eigen::Vector3d
 
 bool TruthPointAt(const std::vector<PointSample>& truth, double t, Vec2* point) {
   return StreamValueAt(truth, t, kTruthMaxGap, [](const PointSample& s) { return Vec2(s.point); }, point);
+}
+
+bool TruthContactNear(const std::vector<PointSample>& truth, double t, const Vec2& point, Vec2* contact) {
+  auto it = std::lower_bound(truth.begin(), truth.end(), t - 1e-9, [](const PointSample& a, double tt) { return a.t < tt; });
+  int rows = 0;
+  for (auto r = it; r != truth.end() && r->t <= t + 1e-9; ++r) {
+    if (rows == 0 || (r->point - point).squaredNorm() < (*contact - point).squaredNorm()) *contact = r->point;
+    ++rows;
+  }
+  return rows > 0 || TruthPointAt(truth, t, contact);
 }
 
 bool TruthForceAt(const std::vector<ForceSample>& truth, double t, Vec2* force) {

@@ -96,6 +96,10 @@ struct EstimatorConfig {
   // without either stream every step is in contact (the paper's constant-contact assumption).
   double contact_max_gap = 0.05;          ///< s
   double contact_force_threshold = 0.05;  ///< N
+  // Without a contact stream, a step in contact has two contacts (a finger wedged between two
+  // walls) when, at the current estimate, the finger is within this distance of two object
+  // edges that face each other (GraphBuilder::DetectSecondContacts). 0 turns it off.
+  double second_contact_tolerance = 0.001;  ///< m
   // Robust losses on measurement factors.
   LossConfig object_pose_loss, finger_pose_loss, contact_loss, force_loss;
   // Solver.

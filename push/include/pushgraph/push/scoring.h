@@ -32,6 +32,9 @@ inline constexpr double kMovingAngularSpeed = 0.02;  ///< rad/s
 bool TruthPoseAt(const std::vector<PoseSample>& truth, double t, Eigen::Vector3d* pose);
 bool TruthPointAt(const std::vector<PointSample>& truth, double t, Vec2* point);
 bool TruthForceAt(const std::vector<ForceSample>& truth, double t, Vec2* force);
+/// The true contact of a point estimated or measured at t: where the truth has several rows at t
+/// (several contacts at once), the one nearest `point`; else TruthPointAt.
+bool TruthContactNear(const std::vector<PointSample>& truth, double t, const Vec2& point, Vec2* contact);
 
 /// (x, y, theta) error of an estimate against a truth pose, theta wrapped to (-pi, pi].
 Eigen::Vector3d PoseError(const geometry::Pose2& estimate, const Eigen::Vector3d& truth);
