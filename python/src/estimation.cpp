@@ -7,6 +7,7 @@
 #include <pushgraph/graph/estimator.h>
 #include <pushgraph/graph/incremental.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -46,8 +47,11 @@ py::dict ResultToDict(const EstimationResult& r) {
   py::array_t<double> t = NewArray({n}), object = NewArray({n, 3}), finger = NewArray({n, 3}), contact = NewArray({n, 2}),
                       force = NewArray({n, 2}), object_cov = NewArray({n, 3, 3}), finger_cov = NewArray({n, 3, 3}),
                       contact_cov = NewArray({n, 2, 2}), force_cov = NewArray({n, 2, 2});
-  // Two-contact states (a finger wedged in a notch): the second contact and each one's force.
+  // Two-contact states (a finger wedged in a notch): the second contact and each one's force; in a
+  // two-finger push the second contact is finger 1's, and finger 1 has its own pose.
   py::array_t<double> second = NewArray({n, 2}), second_cov = NewArray({n, 2, 2}), forces = NewArray({n, 2, 2});
+  const bool two_fingers = std::any_of(r.states.begin(), r.states.end(), [](const StateEstimate& s) { return !s.other_fingers.empty(); });
+  py::array_t<double> finger1 = NewArray({n, 3}), finger1_cov = NewArray({n, 3, 3});
   auto put_cov = [](double* out, const auto& cov, int dim) {
     for (int k = 0; k < dim * dim; ++k) out[k] = cov ? (*cov)(k / dim, k % dim) : kNaN;
   };
@@ -66,13 +70,26 @@ py::dict ResultToDict(const EstimationResult& r) {
     put_cov(finger_cov.mutable_data() + 9 * i, s.finger_pose_cov, 3);
     put_cov(contact_cov.mutable_data() + 4 * i, s.contact_cov, 2);
     put_cov(force_cov.mutable_data() + 4 * i, s.force_cov, 2);
-    const bool two = s.contacts.size() == 2;
-    for (int k = 0; k < 2; ++k) {
-      second.mutable_data()[2 * i + k] = two ? s.contacts[1].point[k] : kNaN;
-      for (int c = 0; c < 2; ++c)
-        forces.mutable_data()[4 * i + 2 * c + k] = two && s.contacts[c].force ? (*s.contacts[c].force)[k] : kNaN;
+    // The first and the second contact: of a wedged finger its two; of two fingers finger 0's
+    // and finger 1's (either may be absent).
+    const ContactEstimate* first = nullptr;
+    const ContactEstimate* other = nullptr;
+    if (two_fingers) {
+      for (const ContactEstimate& c : s.contacts) (c.finger == 0 ? first : other) = &c;
+    } else if (s.contacts.size() == 2) {
+      first = &s.contacts[0];
+      other = &s.contacts[1];
     }
-    put_cov(second_cov.mutable_data() + 4 * i, two ? s.contacts[1].point_cov : std::nullopt, 2);
+    const ContactEstimate* both[2] = {first, other};
+    for (int k = 0; k < 2; ++k) {
+      second.mutable_data()[2 * i + k] = other ? other->point[k] : kNaN;
+      for (int c = 0; c < 2; ++c)
+        forces.mutable_data()[4 * i + 2 * c + k] = both[c] && both[c]->force ? (*both[c]->force)[k] : kNaN;
+    }
+    put_cov(second_cov.mutable_data() + 4 * i, other ? other->point_cov : std::nullopt, 2);
+    const FingerPoseEstimate* f1 = s.other_fingers.empty() ? nullptr : &s.other_fingers[0];
+    for (int k = 0; k < 3; ++k) finger1.mutable_data()[3 * i + k] = f1 ? f1->pose.vector()[k] : kNaN;
+    put_cov(finger1_cov.mutable_data() + 9 * i, f1 ? f1->pose_cov : std::nullopt, 3);
   }
   py::dict d;
   d["model"] = ModelName(r.model);
@@ -89,6 +106,10 @@ py::dict ResultToDict(const EstimationResult& r) {
   d["second_contact"] = second;
   d["second_contact_cov"] = second_cov;
   d["contact_forces"] = forces;
+  if (two_fingers) {
+    d["finger1_pose"] = finger1;
+    d["finger1_pose_cov"] = finger1_cov;
+  }
   py::dict metrics;
   for (const auto& [k, v] : r.metrics) metrics[k.c_str()] = v;
   d["metrics"] = metrics;

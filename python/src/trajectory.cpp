@@ -122,11 +122,25 @@ void CheckKeys(const py::dict& d, const std::vector<std::string>& allowed, const
 
 }  // namespace
 
+// Finger k >= 1's streams (no object pose) as a Streams dict and back.
+py::dict FingerStreamsDict(const pushgraph::push::FingerStreams& f) {
+  Streams s;
+  s.finger_pose = f.finger_pose;
+  s.contact_point = f.contact_point;
+  s.force = f.force;
+  py::dict d = StreamsDict(s);
+  PyDict_DelItemString(d.ptr(), "object_pose");
+  return d;
+}
+
+pushgraph::push::FingerStreams FingerStreamsFrom(const py::handle& object, const std::string& where) {
+  if (py::isinstance<py::dict>(object) && py::reinterpret_borrow<py::dict>(object).contains("object_pose"))
+    throw py::value_error(where + ": a finger's streams have no 'object_pose' (finger_pose, contact_point, force)");
+  const Streams s = StreamsFrom(object, where);
+  return {s.finger_pose, s.contact_point, s.force};
+}
+
 py::dict TrajectoryToDict(const Trajectory& t) {
-  // The dict carries one finger; a multi-finger push would lose its other fingers silently.
-  if (!t.extra_fingers.empty())
-    throw py::value_error("trajectory with " + std::to_string(pushgraph::push::FingerCount(t)) +
-                          " fingers: the Python binding carries one finger (several fingers are not exposed yet)");
   py::dict d;
   py::dict object, finger;
   object["shape"] = t.object.shape;
@@ -139,6 +153,19 @@ py::dict TrajectoryToDict(const Trajectory& t) {
   d["finger"] = finger;
   d["measured"] = StreamsDict(t.measured);
   d["ground_truth"] = t.ground_truth ? py::object(StreamsDict(*t.ground_truth)) : py::none();
+  if (!t.extra_fingers.empty()) {
+    // Fingers 1, 2, ... of a push with several fingers, each with its own streams.
+    py::list fingers;
+    for (const pushgraph::push::ExtraFinger& e : t.extra_fingers) {
+      py::dict f;
+      f["shape"] = e.finger.shape;
+      f["mu_contact"] = e.finger.mu_contact;
+      f["measured"] = FingerStreamsDict(e.measured);
+      f["ground_truth"] = e.ground_truth ? py::object(FingerStreamsDict(*e.ground_truth)) : py::none();
+      fingers.append(f);
+    }
+    d["fingers"] = fingers;
+  }
   if (t.measurement_sigmas) {
     const MeasurementSigmas& s = *t.measurement_sigmas;
     py::dict m;
@@ -158,7 +185,7 @@ py::dict TrajectoryToDict(const Trajectory& t) {
 Trajectory TrajectoryFromDict(const py::handle& object) {
   if (!py::isinstance<py::dict>(object)) throw py::type_error("trajectory: expected a dict (see pushgraph.load_trajectory)");
   const py::dict d = py::reinterpret_borrow<py::dict>(object);
-  CheckKeys(d, {"object", "finger", "measured", "ground_truth", "measurement_sigmas"}, "trajectory");
+  CheckKeys(d, {"object", "finger", "measured", "ground_truth", "measurement_sigmas", "fingers"}, "trajectory");
   Trajectory t;
   for (const char* part : {"object", "finger"}) {
     if (!d.contains(part) || !py::isinstance<py::dict>(d[part])) {
@@ -183,6 +210,29 @@ Trajectory TrajectoryFromDict(const py::handle& object) {
   t.measured = StreamsFrom(d["measured"], "trajectory['measured']");
   if (d.contains("ground_truth") && !d["ground_truth"].is_none()) {
     t.ground_truth = StreamsFrom(d["ground_truth"], "trajectory['ground_truth']");
+  }
+  if (d.contains("fingers") && !d["fingers"].is_none()) {
+    if (!py::isinstance<py::list>(d["fingers"]))
+      throw py::type_error("trajectory['fingers']: expected a list of finger dicts (fingers 1, 2, ...)");
+    const py::list fingers = d["fingers"];
+    for (std::size_t k = 0; k < fingers.size(); ++k) {
+      const std::string at = "trajectory['fingers'][" + std::to_string(k) + "]";
+      if (!py::isinstance<py::dict>(fingers[k])) throw py::type_error(at + ": expected a dict with a 'shape'");
+      const py::dict f = fingers[k];
+      CheckKeys(f, {"shape", "mu_contact", "measured", "ground_truth"}, at);
+      pushgraph::push::ExtraFinger e;
+      try {
+        e.finger.shape = f["shape"].cast<geometry::Shape>();
+      } catch (const py::cast_error&) {
+        throw py::type_error(at + "['shape']: expected a pushgraph.Shape");
+      }
+      e.finger.mu_contact = Number(f, "mu_contact", at, 0.0);
+      if (!f.contains("measured")) throw py::value_error(at + ": missing 'measured'");
+      e.measured = FingerStreamsFrom(f["measured"], at + "['measured']");
+      if (f.contains("ground_truth") && !f["ground_truth"].is_none())
+        e.ground_truth = FingerStreamsFrom(f["ground_truth"], at + "['ground_truth']");
+      t.extra_fingers.push_back(std::move(e));
+    }
   }
   if (d.contains("measurement_sigmas") && !d["measurement_sigmas"].is_none()) {
     if (!py::isinstance<py::dict>(d["measurement_sigmas"])) throw py::type_error("trajectory['measurement_sigmas']: expected a dict");
@@ -219,6 +269,8 @@ A pushgraph-trajectory-1 JSON file as a dict:
  'measured': {'object_pose': {'t': (N,), 'pose': (N, 3)}, 'finger_pose': {...},
               'contact_point': {'t', 'point': (N, 2)}, 'force': {'t', 'force': (N, 2)}},
  'ground_truth': the same streams or None, 'measurement_sigmas': dict or None}.
+A push with several fingers also has 'fingers': [{'shape', 'mu_contact', 'measured': {'finger_pose',
+'contact_point', 'force'}, 'ground_truth': ... or None}, ...] (fingers 1, 2, ...; 'finger' is finger 0).
 Raises IoError naming the file and the field.)doc");
   m.def(
       "save_trajectory", [](const py::handle& t, const std::string& path) { io::SaveTrajectoryJson(TrajectoryFromDict(t), path); },

@@ -153,3 +153,32 @@ def test_simulate_along_waypoints_with_chosen_noise_and_an_occlusion(notched_blo
         pg.simulate(notched_block, finger, noise="none", sigmas={"force": 0.1})
     with pytest.raises(pg.PushError):
         pg.simulate(notched_block, finger, waypoints=[[0.0, 0.0]])
+
+
+def test_two_fingers_round_trip_and_estimate(tmp_path):
+    # A two-finger push made by the tool (two 4 mm disks 4 cm apart), read, written back and
+    # estimated from Python: finger 1's pose and contact come back, the same as the tool's.
+    (tmp_path / "left.json").write_text('{"polygons": [{"outer": [[0, 0.02]]}], "radius": 0.004}')
+    (tmp_path / "right.json").write_text('{"polygons": [{"outer": [[0, -0.02]]}], "radius": 0.004}')
+    path, out = tmp_path / "two.json", tmp_path / "two_result.json"
+    subprocess.run([TOOL, "simulate", "-o", str(path), "--fingers", str(tmp_path / "left.json"),
+                    str(tmp_path / "right.json"), "--offset", "0", "--push-angle", "0"], check=True, capture_output=True)
+    push = pg.load_trajectory(str(path))
+    assert len(push["fingers"]) == 1 and "object_pose" not in push["fingers"][0]["measured"]
+    again_path = tmp_path / "again.json"
+    pg.save_trajectory(push, str(again_path))
+    again = pg.load_trajectory(str(again_path))
+    f, g = push["fingers"][0]["measured"], again["fingers"][0]["measured"]
+    for stream, value in [("finger_pose", "pose"), ("contact_point", "point"), ("force", "force")]:
+        np.testing.assert_array_equal(g[stream][value], f[stream][value])
+    r = pg.estimate(push, model="qs")
+    assert r["finger1_pose"].shape == r["object_pose"].shape and np.isfinite(r["finger1_pose"]).all()
+    touching = np.isfinite(r["second_contact"][:, 0])
+    assert touching.sum() > 100 and np.isfinite(r["contact_forces"][touching, 1]).all()
+    subprocess.run([TOOL, "estimate", str(path), "--model", "qs", "-o", str(out)], check=True, capture_output=True)
+    states = json.loads(out.read_text())["states"]
+    np.testing.assert_array_equal(r["finger1_pose"], [s["fingers"][0]["pose"] for s in states])
+    assert r["metrics"]["object_position_rms"] < r["metrics"]["measured_object_position_rms"]
+    bad = dict(push, fingers=[dict(push["fingers"][0], measured=dict(f, object_pose=push["measured"]["object_pose"]))])
+    with pytest.raises(ValueError, match=r"trajectory\['fingers'\]\[0\]\['measured'\]: a finger's streams have no 'object_pose'"):
+        pg.estimate(bad)
