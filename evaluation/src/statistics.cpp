@@ -164,17 +164,16 @@ void AccumulateRaw(const push::Trajectory& traj, const std::string& prefix, Stat
     Eigen::Vector3d g;
     if (push::TruthPoseAt(gt.finger_pose, s.t, &g)) sink.Error(prefix + "/finger_position", std::hypot(s.pose.x - g.x(), s.pose.y - g.y()));
   }
-  for (const push::PointSample& s : m.contact_point) {
-    Vec2 v;
-    if (push::TruthContactNear(gt.contact_point, s.t, s.point, &v)) sink.Error(prefix + "/contact", (s.point - v).norm());
-  }
-  for (const push::ExtraFinger& f : traj.extra_fingers) {
-    if (!f.ground_truth) continue;
-    for (const push::PointSample& s : f.measured.contact_point) {
+  // Every finger's contact rows, each against its finger's nearest true contact.
+  auto contacts = [&](const std::vector<push::PointSample>& measured, const std::vector<push::PointSample>& truth) {
+    for (const push::PointSample& s : measured) {
       Vec2 v;
-      if (push::TruthContactNear(f.ground_truth->contact_point, s.t, s.point, &v)) sink.Error(prefix + "/contact", (s.point - v).norm());
+      if (push::TruthContactNear(truth, s.t, s.point, &v)) sink.Error(prefix + "/contact", (s.point - v).norm());
     }
-  }
+  };
+  contacts(m.contact_point, gt.contact_point);
+  for (const push::ExtraFinger& f : traj.extra_fingers)
+    if (f.ground_truth) contacts(f.measured.contact_point, f.ground_truth->contact_point);
   for (const push::ForceSample& s : m.force) {
     Vec2 v;
     if (!push::TruthForceAt(gt.force, s.t, &v)) continue;

@@ -124,10 +124,8 @@ int GraphBuilder::AppendSteps(double until) {
   for (std::size_t i = first_new; i < steps_.size(); ++i) {
     Step& s = steps_[i];
     if (s.contact2 < 0) continue;
-    const auto& c = traj_.measured.contact_point;
-    int rows = 0;
-    for (int r = s.contact; r < static_cast<int>(c.size()) && c[r].t == c[s.contact].t; ++r) ++rows;
-    if (rows <= 2) continue;
+    const auto [first, last] = ContactRowsAt(s.contact);
+    if (last - first + 1 <= 2) continue;
     ++steps_with_more_contacts_;
     const auto [a, b] = FarthestContactRows(s.contact);
     s.contact = a;
@@ -152,24 +150,18 @@ int GraphBuilder::AppendSteps(double until) {
       const push::FingerStreams& b = traj_.extra_fingers[0].measured;
       s.in_contact_b = touching(b.contact_point, b.force, s.t);
     }
-    if (streams_.contact_point) {
-      int k = -1;
-      s.in_contact = NearestGap(m.contact_point, s.t, &k) <= cfg_.contact_max_gap;
+    s.in_contact = touching(m.contact_point, m.force, s.t);
+    if (s.in_contact && streams_.contact_point) {
       // Two contacts while the nearest contact time has two rows.
-      const auto& c = m.contact_point;
-      s.two_contacts = s.in_contact && k >= 0 &&
-                       ((k > 0 && c[k - 1].t == c[k].t) || (k + 1 < static_cast<int>(c.size()) && c[k + 1].t == c[k].t));
+      int k = -1;
+      NearestGap(m.contact_point, s.t, &k);
+      const auto [first, last] = ContactRowsAt(k);
+      s.two_contacts = last > first;
       if (s.two_contacts && model_ == Model::kYu) {
         // The baseline models one contact, as published: it keeps the first of the two.
         s.two_contacts = false;
         ++second_contacts_ignored_;
       }
-    } else if (streams_.force) {
-      int k = -1;
-      const double gap = NearestGap(m.force, s.t, &k);
-      s.in_contact = k >= 0 && gap <= cfg_.contact_max_gap && m.force[k].force.norm() >= cfg_.contact_force_threshold;
-    } else {
-      s.in_contact = true;
     }
   }
   vars_.resize(steps_.size());
@@ -532,14 +524,20 @@ bool GraphBuilder::FacingWalls(int i, double tolerance, Vec2 points[2]) const {
   return false;
 }
 
+std::array<long long, 2> GraphBuilder::FixedFeatureKeys(bool on_features, const ContactFeature features[2]) {
+  // Vertices are not kept as fixed features (AddKinematicFactors).
+  std::array<long long, 2> keys{-1, -1};
+  for (int k = 0; k < 2 && on_features; ++k)
+    if (!features[k].vertex) keys[k] = FeatureKey(features[k]);
+  return keys;
+}
+
 std::array<long long, 2> GraphBuilder::FeatureChoice(int i) const {
   const Step& s = steps_[i];
-  if (!s.in_contact) return {-1, -1};
-  if (!s.two_contacts) return {-1, -1};
+  if (!s.in_contact || !s.two_contacts) return {-1, -1};
   ContactFeature f[2];
-  if (!TwoContactFeatures(i, f)) return {-1, -1};
-  // Vertices are not kept as fixed features (AddKinematicFactors).
-  return {f[0].vertex ? -1 : FeatureKey(f[0]), f[1].vertex ? -1 : FeatureKey(f[1])};
+  const bool on_features = TwoContactFeatures(i, f);
+  return FixedFeatureKeys(on_features, f);
 }
 
 int GraphBuilder::FeatureChoicesChanged() const {
@@ -549,17 +547,29 @@ int GraphBuilder::FeatureChoicesChanged() const {
   return changed;
 }
 
-std::pair<int, int> GraphBuilder::FarthestContactRows(int k) const {
+std::pair<int, int> GraphBuilder::ContactRowsAt(int k) const {
   const auto& c = traj_.measured.contact_point;
   int first = k, last = k;
   while (first > 0 && c[first - 1].t == c[k].t) --first;
   while (last + 1 < static_cast<int>(c.size()) && c[last + 1].t == c[k].t) ++last;
+  return {first, last};
+}
+
+std::pair<int, int> GraphBuilder::FarthestContactRows(int k) const {
+  const auto& c = traj_.measured.contact_point;
+  const auto [first, last] = ContactRowsAt(k);
   std::pair<int, int> best{first, std::min(first + 1, last)};
   double farthest = -1.0;
   for (int a = first; a <= last; ++a)
     for (int b = a + 1; b <= last; ++b)
       if (const double d = (c[a].point - c[b].point).squaredNorm(); d > farthest) farthest = d, best = {a, b};
   return best;
+}
+
+Vec2 GraphBuilder::SecondFingerNearestObjectPoint(int i) const {
+  // The object point nearest finger 1's shape (its reference point may lie off the shape).
+  const StepVars& v = vars_[i];
+  return querier_b_->Query(Pose2{v.x[0], v.x[1], v.x[2]}, Pose2{v.e2[0], v.e2[1], v.e2[2]}).object_point;
 }
 
 void GraphBuilder::InitializeSecondFinger(int i, double limit) {
@@ -582,8 +592,7 @@ void GraphBuilder::InitializeSecondFinger(int i, double limit) {
   } else if (prev_touching) {
     c = Vec2(prev->p2[0], prev->p2[1]);
   } else {
-    // The object point nearest this finger's shape (its reference point may lie off the shape).
-    c = querier_b_->Query(Pose2{v.x[0], v.x[1], v.x[2]}, Pose2{v.e2[0], v.e2[1], v.e2[2]}).object_point;
+    c = SecondFingerNearestObjectPoint(i);
   }
   v.p2[0] = c.x();
   v.p2[1] = c.y();
@@ -669,7 +678,7 @@ int GraphBuilder::SmoothInitialMotion(int max_iterations, double function_tolera
     for (int i = first; i < n; ++i) {
       if (!steps_[i].in_contact_b) continue;
       StepVars& v = vars_[i];
-      const Vec2 c = querier_b_->Query(Pose2{v.x[0], v.x[1], v.x[2]}, Pose2{v.e2[0], v.e2[1], v.e2[2]}).object_point;
+      const Vec2 c = SecondFingerNearestObjectPoint(i);
       v.p2[0] = c.x();
       v.p2[1] = c.y();
     }
@@ -753,14 +762,14 @@ void GraphBuilder::AddKinematicFactors(ceres::Problem& problem, int i) {
           {v.x, v.p2}, {0});
       ContactFeature features[2];
       const bool on_features = TwoContactFeatures(i, features);
-      feature_choices_[i] = FeatureChoice(i);
+      feature_choices_[i] = FixedFeatureKeys(on_features, features);
       double* points[2] = {v.p, v.p2};
       for (int k = 0; k < 2; ++k) {
-        // An object vertex is kept as a feature only when it is the only one near: pinned to a
-        // corner at the start, a contact that is really on the adjacent edge (a flat pusher's end
-        // near the corner) holds the object shifted along that edge, and the corner is then the
-        // nearest feature at the solution too. Near others, the local witness follows p.
-        const bool fixed = on_features && !features[k].vertex;
+        // An object vertex is never a fixed feature: pinned to a corner at the start, a contact
+        // that is really on the adjacent edge (a flat pusher's end near the corner) holds the
+        // object shifted along that edge, and the corner is then the nearest feature at the
+        // solution too. The local witness follows p instead.
+        const bool fixed = feature_choices_[i][k] >= 0;
         ceres::CostFunction* cost =
             fixed ? static_cast<ceres::CostFunction*>(new FeatureWitnessFactor(
                         traj_.object.shape, features[k].edge, features[k].vertex, traj_.finger.shape,

@@ -273,14 +273,21 @@ class GraphBuilder {
   /// Step i's fixed contact features at the current values, as keys (-1: none, the nearest pair
   /// or the local witness): what AddKinematicFactors gives its contact-on-finger factors.
   std::array<long long, 2> FeatureChoice(int i) const;
+  /// The keys of the features the contact factors hold fixed (edges; a vertex, or none: -1).
+  static std::array<long long, 2> FixedFeatureKeys(bool on_features, const ContactFeature features[2]);
+  /// A non-negative key of a feature (EdgeId's ring is -1 for the outer boundary).
   static long long FeatureKey(const ContactFeature& f) {
-    return ((static_cast<long long>(f.edge.polygon) * 4096 + f.edge.ring) * 1048576 + f.edge.index) * 2 + f.vertex;
+    return ((static_cast<long long>(f.edge.polygon) * 4096 + f.edge.ring + 1) * 1048576 + f.edge.index) * 2 + f.vertex;
   }
   std::vector<std::array<long long, 2>> feature_choices_;  ///< per step, as last added
   /// Querier (the given one, else a new one), quasi-static geometry, friction (both constructors).
   void SetUpShapes(std::shared_ptr<const geometry::ShapePairQuerier> querier);
+  /// The first and last contact rows at row k's time.
+  std::pair<int, int> ContactRowsAt(int k) const;
   /// Of the contact rows at row k's time, the two farthest apart (k's own pair when two).
   std::pair<int, int> FarthestContactRows(int k) const;
+  /// The object point nearest finger 1's shape at step i's current values.
+  Vec2 SecondFingerNearestObjectPoint(int i) const;
   /// Finger 1's initial pose, contact and force at step i (two-finger pushes).
   void InitializeSecondFinger(int i, double limit);
   /// Finger 1's M, C, S, touching and V factors at step i.

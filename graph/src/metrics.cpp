@@ -61,49 +61,36 @@ std::map<std::string, double> ComputeMetrics(const push::Trajectory& traj,
       if (s.finger_pose_cov) nees_finger.Add(Nees(*e, *s.finger_pose_cov));
     }
     Vec2 v;
-    if (!traj.extra_fingers.empty()) {
-      // Several fingers: every finger's pose, and each contact and force against its own
-      // finger's truth (the finger metrics pool the fingers).
-      const auto truth_of = [&](int k) -> const push::FingerStreams* {
-        if (k < 1 || k > static_cast<int>(traj.extra_fingers.size())) return nullptr;
-        const auto& g = traj.extra_fingers[k - 1].ground_truth;
-        return g ? &*g : nullptr;
-      };
-      for (const FingerPoseEstimate& f : s.other_fingers) {
-        const push::FingerStreams* g = truth_of(f.finger);
-        if (g == nullptr) continue;
-        if (const auto e = PoseErrorAt(g->finger_pose, s.t, f.pose)) {
-          finger.Add(*e);
-          if (f.pose_cov) nees_finger.Add(Nees(*e, *f.pose_cov));
-        }
+    // Finger k >= 1's truth (null when absent).
+    const auto truth_of = [&](int k) -> const push::FingerStreams* {
+      if (k < 1 || k > static_cast<int>(traj.extra_fingers.size())) return nullptr;
+      const auto& g = traj.extra_fingers[k - 1].ground_truth;
+      return g ? &*g : nullptr;
+    };
+    // Every other finger's pose (two-finger pushes; the finger metrics pool the fingers).
+    for (const FingerPoseEstimate& f : s.other_fingers) {
+      const push::FingerStreams* g = truth_of(f.finger);
+      if (g == nullptr) continue;
+      if (const auto e = PoseErrorAt(g->finger_pose, s.t, f.pose)) {
+        finger.Add(*e);
+        if (f.pose_cov) nees_finger.Add(Nees(*e, *f.pose_cov));
       }
-      for (const ContactEstimate& c : s.contacts) {
-        const push::FingerStreams* g = truth_of(c.finger);
-        if (c.finger != 0 && g == nullptr) continue;
-        const std::vector<push::PointSample>& points = c.finger == 0 ? gt.contact_point : g->contact_point;
-        if (push::TruthContactNear(points, s.t, c.point, &v)) {
-          contact.Add((c.point - v).squaredNorm());
-          if (c.point_cov) nees_contact.Add(Nees(Vec2(c.point - v), *c.point_cov));
-        }
-        const std::vector<push::ForceSample>& forces = c.finger == 0 ? gt.force : g->force;
-        if (c.force && push::TruthForceAt(forces, s.t, &v)) {
-          force.Add((*c.force - v).squaredNorm());
-          if (c.force_cov) nees_force.Add(Nees(Vec2(*c.force - v), *c.force_cov));
-        }
-      }
-      continue;
     }
-    if (!s.contacts.empty()) {
-      // Several contacts: each against the nearest true one at this time.
-      for (const ContactEstimate& c : s.contacts) {
-        if (!push::TruthContactNear(gt.contact_point, s.t, c.point, &v)) continue;
+    // Every contact against its finger's nearest true contact at this time; other fingers' forces
+    // against theirs (finger 0's is `force`, below).
+    std::vector<ContactEstimate> contacts = s.contacts;
+    if (contacts.empty() && s.contact) contacts.push_back({0, *s.contact, std::nullopt, s.contact_cov, std::nullopt});
+    for (const ContactEstimate& c : contacts) {
+      const push::FingerStreams* g = truth_of(c.finger);
+      if (c.finger != 0 && g == nullptr) continue;
+      if (push::TruthContactNear(c.finger == 0 ? gt.contact_point : g->contact_point, s.t, c.point, &v)) {
         contact.Add((c.point - v).squaredNorm());
         if (c.point_cov) nees_contact.Add(Nees(Vec2(c.point - v), *c.point_cov));
       }
-    } else if (s.contact && push::TruthContactNear(gt.contact_point, s.t, *s.contact, &v)) {
-      const Vec2 e = *s.contact - v;
-      contact.Add(e.squaredNorm());
-      if (s.contact_cov) nees_contact.Add(Nees(e, *s.contact_cov));
+      if (c.finger != 0 && c.force && push::TruthForceAt(g->force, s.t, &v)) {
+        force.Add((*c.force - v).squaredNorm());
+        if (c.force_cov) nees_force.Add(Nees(Vec2(*c.force - v), *c.force_cov));
+      }
     }
     if (s.force && push::TruthForceAt(gt.force, s.t, &v)) {
       const Vec2 e = *s.force - v;

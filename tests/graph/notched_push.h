@@ -2,10 +2,14 @@
 // The multi-contact tests' push: the notched block (0.5 kg, mu 0.3) and noise of 2 mm, 0.02 rad
 // and 0.2 N on every stream, light enough that the contact geometry, not the noise, decides.
 #include <pushgraph/geometry/shape.h>
+#include <pushgraph/graph/estimator.h>
 #include <pushgraph/push/noise.h>
 #include <pushgraph/push/simulator.h>
 
 #include <string>
+#include <vector>
+
+#include "test_scale.h"
 
 namespace pushgraph::graph::testing {
 
@@ -22,6 +26,13 @@ inline push::PushPlan NotchedBlockPlan(std::uint64_t seed) {
   plan.noise.force.position.sigma = 0.2;
   plan.seed = seed;
   return plan;
+}
+
+/// The graphs a multi-contact test runs: CP, SDF and QS; scaled down (the sanitizer stage) QS
+/// only, the model with every factor.
+inline std::vector<Model> ModelsToRun() {
+  if (pushgraph::testing::TestScale() < 1.0) return {Model::kQs};
+  return {Model::kCp, Model::kSdf, Model::kQs};
 }
 
 }  // namespace pushgraph::graph::testing

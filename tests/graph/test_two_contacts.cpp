@@ -12,7 +12,6 @@
 
 #include "graph/notched_push.h"
 #include "graph/online_feed.h"
-#include "test_scale.h"
 
 #include <gtest/gtest.h>
 
@@ -89,10 +88,7 @@ TEST(TwoContacts, AWedgedFingerIsEstimatedWithBothContacts) {
   ASSERT_TRUE(push::HasRepeatedTimes(t.measured.contact_point));
   const push::Trajectory one = FirstContactOnly(t);
   EstimatorConfig config = ApplyMeasurementSigmas(EstimatorConfig{}, *t.measurement_sigmas);
-  // Scaled down (the sanitizer stage): QS only, the model with every factor.
-  const std::vector<Model> models =
-      pushgraph::testing::TestScale() < 1.0 ? std::vector<Model>{Model::kQs} : std::vector<Model>{Model::kCp, Model::kSdf, Model::kQs};
-  for (const Model model : models) {
+  for (const Model model : testing::ModelsToRun()) {
     for (const auto solver : {EstimatorConfig::Solver::kCeres, EstimatorConfig::Solver::kChain}) {
       config.solver = solver;
       const EstimationResult r = Estimate(t, model, Mode::kBatch, config);

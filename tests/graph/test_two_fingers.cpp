@@ -13,7 +13,6 @@
 #include <nlohmann/json.hpp>
 
 #include "graph/notched_push.h"
-#include "test_scale.h"
 
 #include <gtest/gtest.h>
 
@@ -85,10 +84,7 @@ TEST(TwoFingers, BothFingersAreEstimatedWithTheirContactsAndForces) {
   const push::Trajectory t = TwoFingerPush(3);
   ASSERT_EQ(push::FingerCount(t), 2);
   EstimatorConfig config = ApplyMeasurementSigmas(EstimatorConfig{}, *t.measurement_sigmas);
-  // Scaled down (the sanitizer stage): QS only, the model with every factor.
-  const std::vector<Model> models =
-      pushgraph::testing::TestScale() < 1.0 ? std::vector<Model>{Model::kQs} : std::vector<Model>{Model::kCp, Model::kSdf, Model::kQs};
-  for (const Model model : models) {
+  for (const Model model : testing::ModelsToRun()) {
     for (const auto solver : {EstimatorConfig::Solver::kCeres, EstimatorConfig::Solver::kChain}) {
       config.solver = solver;
       const EstimationResult r = Estimate(t, model, Mode::kBatch, config);
@@ -113,7 +109,9 @@ TEST(TwoFingers, BothFingersAreEstimatedWithTheirContactsAndForces) {
         for (const ContactEstimate& c : s.contacts) {
           (c.finger == 1 ? of1 : of0) += 1;
           EXPECT_TRUE(c.point_cov.has_value());
-          if (ModelHasForce(model)) EXPECT_TRUE(c.force && c.force_cov);
+          if (ModelHasForce(model)) {
+            EXPECT_TRUE(c.force && c.force_cov);
+          }
         }
         EXPECT_LE(of1, 1);
         EXPECT_EQ(of0, s.contact ? 1 : 0);
