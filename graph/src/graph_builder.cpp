@@ -77,6 +77,9 @@ GraphBuilder::GraphBuilder(const push::Trajectory& trajectory, Model model,
   ValidateConfig(cfg_);
   if (traj_.object.shape.empty()) throw GraphError("trajectory: object.shape is missing or empty");
   if (traj_.finger.shape.empty()) throw GraphError("trajectory: finger.shape is missing or empty");
+  ValidateFingers(traj_);
+  two_fingers_ = !traj_.extra_fingers.empty() && model_ != Model::kYu;
+  fingers_ignored_ = !traj_.extra_fingers.empty() && model_ == Model::kYu;
   SetUpShapes(nullptr);
 }
 
@@ -674,7 +677,7 @@ int GraphBuilder::SmoothInitialMotion(int max_iterations, double function_tolera
       v.p[1] = q.closest_point.y();
     }
   }
-  if (two_fingers_ && traj_.extra_fingers[0].measured.contact_point.empty()) {
+  if (two_fingers_ && !streams_.contact_point) {  // finger 1 has no tactile sensor either
     for (int i = first; i < n; ++i) {
       if (!steps_[i].in_contact_b) continue;
       StepVars& v = vars_[i];

@@ -359,6 +359,8 @@ Diagnostics Diagnose(const push::Trajectory& trajectory, Model model, const Esti
 /// stream, sample and value): missing shapes or streams, NaN, unsupported magnitudes, unsorted
 /// samples, clock jumps within or between streams.
 void ValidateTrajectory(const push::Trajectory& trajectory);
+/// The finger count (at most two) and every finger's shape; ValidateTrajectory's first checks.
+void ValidateFingers(const push::Trajectory& trajectory);
 /// The 95th percentile of `values` (non-empty).
 double Percentile95(std::vector<double> values);
 /// A force sample above this is a sensor fault (docs/estimation.md, Input checks): 50 times the

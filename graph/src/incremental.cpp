@@ -494,9 +494,11 @@ struct OnlineEstimator::Impl {
   double last_update_t = -INFINITY;
   double newest_t = -INFINITY;
   double first_t = INFINITY;
-  double last_seen[4] = {-INFINITY, -INFINITY, -INFINITY, -INFINITY};  // per stream, dropped samples included
-  bool repeated_contact = false;  // the newest contact sample is the second at its time
-  std::size_t seen[4] = {0, 0, 0, 0};
+  // Streams: 0 object pose; finger 0's pose, contact point, force (1-3); finger 1's (4-6).
+  static constexpr int kStreams = 7;
+  double last_seen[kStreams] = {-INFINITY, -INFINITY, -INFINITY, -INFINITY, -INFINITY, -INFINITY, -INFINITY};  // dropped samples included
+  bool repeated_contact = false;  // finger 0's newest contact sample is the second at its time
+  std::size_t seen[kStreams] = {0, 0, 0, 0, 0, 0, 0};
   int dropped_late = 0;
   // Force sensor faults (the batch rule, Estimate's DropForceSpikes): a force above 50 times the
   // larger of the recent forces' 95th percentile and mu m g (and above 1 N) is left out.
@@ -507,14 +509,18 @@ struct OnlineEstimator::Impl {
   int dropped_faults = 0;
   std::string first_fault;
   bool finished = false;
-  bool declared[4] = {true, true, false, false};
+  bool declared[kStreams] = {true, true, false, false, false, false, false};
+  bool two_fingers = false;
   double max_latency = 0.2;
   static constexpr std::size_t kRecentPeriods = 64;  // object periods the schedule looks at
   double object_period = 0.0;  // median of the newest kRecentPeriods; updated per object sample
 
   static const push::Trajectory& Empty(const push::Trajectory& setup) {
     const auto& m = setup.measured;
-    if (!m.object_pose.empty() || !m.finger_pose.empty() || !m.contact_point.empty() || !m.force.empty()) {
+    bool empty = m.object_pose.empty() && m.finger_pose.empty() && m.contact_point.empty() && m.force.empty();
+    for (const push::ExtraFinger& f : setup.extra_fingers)
+      empty = empty && f.measured.finger_pose.empty() && f.measured.contact_point.empty() && f.measured.force.empty();
+    if (!empty) {
       throw GraphError("OnlineEstimator: the setup trajectory must have empty streams (measurements arrive through Add*)");
     }
     return setup;
@@ -523,6 +529,11 @@ struct OnlineEstimator::Impl {
       : traj(Empty(setup)), smoother(traj, model, cfg, &streams) {
     declared[2] = streams.contact_point;
     declared[3] = streams.force;
+    // A second finger (the setup's extra_fingers[0]) has the same kinds of sensors as the first.
+    two_fingers = !traj.extra_fingers.empty();
+    declared[4] = two_fingers;
+    declared[5] = two_fingers && streams.contact_point;
+    declared[6] = two_fingers && streams.force;
     if (!(streams.max_latency >= 0.0) || !std::isfinite(streams.max_latency)) {
       throw GraphError("OnlineStreams::max_latency must be finite and >= 0 (s)");
     }
@@ -532,21 +543,37 @@ struct OnlineEstimator::Impl {
   // Throws for a sample that is not finite or not after its stream's previous one; returns
   // false (and counts it) for one at or before the last update: it would belong to steps
   // already solved, so it is dropped.
-  bool Accept(int stream, const char* name, std::size_t index, double t, bool finite) {
+  // The stream of `finger`'s pose (kind 0), contact point (1) or force (2); throws for a finger
+  // the setup does not have.
+  int FingerStream(int finger, int kind, const char* call) const {
+    if (finger == 0) return 1 + kind;
+    if (finger == 1 && two_fingers) return 4 + kind;
+    throw GraphError("OnlineEstimator::" + std::string(call) + ": finger " + std::to_string(finger) +
+                     " is out of range: the setup has " + (two_fingers ? "fingers 0 and 1" : "finger 0 only") +
+                     " (a second finger is the setup's extra_fingers[0])");
+  }
+
+  bool Accept(int stream, const char* name, double t, bool finite) {
+    const std::size_t index = seen[stream];
     auto where = [&] {
-      return "OnlineEstimator: streams." + std::string(name) + "[" + std::to_string(index) + "] at t = " + Precise(t);
+      return "OnlineEstimator: streams." + std::string(stream >= 4 ? "fingers[1]." : "") + name + "[" +
+             std::to_string(index) + "] at t = " + Precise(t);
     };
     if (finished) throw GraphError(where() + " arrived after Finish()");
     if (!declared[stream]) {
       throw GraphError(where() + ": the stream was not declared in OnlineStreams (it decides contact gating and the load factor)");
     }
     if (!std::isfinite(t) || !finite) throw GraphError(where() + " is not finite");
-    // A second contact point at the same time is a second contact (a finger wedged in a notch).
-    const bool second_contact = stream == 2 && t == last_seen[stream] && !repeated_contact;
+    // A second contact point at the same time is a second contact (a finger wedged in a notch);
+    // with two fingers, each has one (the estimator models two contacts in all).
+    const bool contact = stream == 2 || stream == 5;
+    const bool second_contact = stream == 2 && !two_fingers && t == last_seen[stream] && !repeated_contact;
     if (!(t > last_seen[stream]) && !second_contact) {
       throw GraphError(where() + " is not after the previous sample (t = " + Precise(last_seen[stream]) + ")" +
-                       (stream == 2 && t == last_seen[stream] ? ": at most two contacts at one time"
-                                                              : ": each stream must arrive in time order"));
+                       (contact && t == last_seen[stream]
+                            ? (two_fingers ? ": two contacts in all, one per finger, in a two-finger push"
+                                           : ": at most two contacts at one time")
+                            : ": each stream must arrive in time order"));
     }
     if (stream == 2) repeated_contact = second_contact;
     // A clock jump (the batch estimator's bound: 10 s or 1000 object periods): the smoother's
@@ -599,6 +626,11 @@ struct OnlineEstimator::Impl {
     collect(m.finger_pose);
     collect(m.contact_point);
     collect(m.force);
+    for (const push::ExtraFinger& f : traj.extra_fingers) {
+      collect(f.measured.finger_pose);
+      collect(f.measured.contact_point);
+      collect(f.measured.force);
+    }
     std::sort(times.begin(), times.end());
     const int distinct = static_cast<int>(std::unique(times.begin(), times.end()) - times.begin());
     return std::min(distinct, cap);
@@ -620,25 +652,34 @@ OnlineEstimator::OnlineEstimator(const push::Trajectory& setup, Model model, con
 OnlineEstimator::~OnlineEstimator() = default;
 
 bool OnlineEstimator::AddObjectPose(double t, const geometry::Pose2& pose) {
-  if (!impl_->Accept(0, "object_pose", impl_->seen[0], t, pose.vector().allFinite())) return false;
+  if (!impl_->Accept(0, "object_pose", t, pose.vector().allFinite())) return false;
   impl_->traj.measured.object_pose.push_back({t, pose});
   impl_->object_period = MedianObjectPeriod(impl_->traj.measured.object_pose, Impl::kRecentPeriods);
   return true;
 }
-bool OnlineEstimator::AddFingerPose(double t, const geometry::Pose2& pose) {
-  if (!impl_->Accept(1, "finger_pose", impl_->seen[1], t, pose.vector().allFinite())) return false;
-  impl_->traj.measured.finger_pose.push_back({t, pose});
-  return true;
-}
-bool OnlineEstimator::AddContactPoint(double t, const geometry::Vec2& point) {
-  if (!impl_->Accept(2, "contact_point", impl_->seen[2], t, point.allFinite())) return false;
-  impl_->traj.measured.contact_point.push_back({t, point});
-  return true;
-}
-bool OnlineEstimator::AddForce(double t, const geometry::Vec2& force) {
+bool OnlineEstimator::AddFingerPose(double t, const geometry::Pose2& pose) { return AddFingerPose(t, 0, pose); }
+bool OnlineEstimator::AddContactPoint(double t, const geometry::Vec2& point) { return AddContactPoint(t, 0, point); }
+bool OnlineEstimator::AddForce(double t, const geometry::Vec2& force) { return AddForce(t, 0, force); }
+
+bool OnlineEstimator::AddFingerPose(double t, int finger, const geometry::Pose2& pose) {
   Impl& m = *impl_;
-  const std::size_t index = m.seen[3];
-  if (!m.Accept(3, "force", m.seen[3], t, force.allFinite())) return false;
+  const int stream = m.FingerStream(finger, 0, "AddFingerPose");
+  if (!m.Accept(stream, "finger_pose", t, pose.vector().allFinite())) return false;
+  (finger == 0 ? m.traj.measured.finger_pose : m.traj.extra_fingers[0].measured.finger_pose).push_back({t, pose});
+  return true;
+}
+bool OnlineEstimator::AddContactPoint(double t, int finger, const geometry::Vec2& point) {
+  Impl& m = *impl_;
+  const int stream = m.FingerStream(finger, 1, "AddContactPoint");
+  if (!m.Accept(stream, "contact_point", t, point.allFinite())) return false;
+  (finger == 0 ? m.traj.measured.contact_point : m.traj.extra_fingers[0].measured.contact_point).push_back({t, point});
+  return true;
+}
+bool OnlineEstimator::AddForce(double t, int finger, const geometry::Vec2& force) {
+  Impl& m = *impl_;
+  const int stream = m.FingerStream(finger, 2, "AddForce");
+  const std::size_t index = m.seen[stream];
+  if (!m.Accept(stream, "force", t, force.allFinite())) return false;
   const double magnitude = force.norm();
   const bool known_object = m.traj.object.mass > 0.0 && m.traj.object.mu_surface > 0.0;
   if (m.recent_force.size() >= 8) {
@@ -651,14 +692,15 @@ bool OnlineEstimator::AddForce(double t, const geometry::Vec2& force) {
   if (judged && magnitude > bound) {
     if (m.dropped_faults++ == 0) {
       char text[200];
-      std::snprintf(text, sizeof text, "force[%zu] at t = %.9g s, |f| = %.3g N (bound %.3g N)", index, t, magnitude, bound);
+      std::snprintf(text, sizeof text, "%sforce[%zu] at t = %.9g s, |f| = %.3g N (bound %.3g N)",
+                    finger == 0 ? "" : "fingers[1].", index, t, magnitude, bound);
       m.first_fault = text;
     }
     return false;
   }
   m.recent_force.push_back(magnitude);
   if (m.recent_force.size() > Impl::kRecentForces) m.recent_force.pop_front();
-  m.traj.measured.force.push_back({t, force});
+  (finger == 0 ? m.traj.measured.force : m.traj.extra_fingers[0].measured.force).push_back({t, force});
   return true;
 }
 int OnlineEstimator::DroppedLateSamples() const { return impl_->dropped_late; }
@@ -697,6 +739,11 @@ double OnlineEstimator::Update(double until) {
     }
     if (meas.finger_pose.empty() || meas.finger_pose.front().t > until) {
       throw GraphError("OnlineEstimator::Update: no finger pose measurement (streams.finger_pose) up to t = " + Precise(until));
+    }
+    const auto* second = m.two_fingers ? &m.traj.extra_fingers[0].measured.finger_pose : nullptr;
+    if (second != nullptr && (second->empty() || second->front().t > until)) {
+      throw GraphError("OnlineEstimator::Update: no pose measurement of finger 1 (streams.fingers[1].finger_pose) up to t = " +
+                       Precise(until));
     }
   }
   // Samples within 1e-9 s after `until` join its step now (as batch merges them), so no later

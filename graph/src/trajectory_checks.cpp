@@ -95,9 +95,7 @@ double ForceFaultBound(double force_p95, const push::ObjectDescription& object) 
   return std::max(50.0 * scale, 1.0);
 }
 
-void ValidateTrajectory(const push::Trajectory& traj) {
-  if (traj.object.shape.empty()) throw GraphError("trajectory: object.shape is missing or empty");
-  if (traj.finger.shape.empty()) throw GraphError("trajectory: finger.shape is missing or empty");
+void ValidateFingers(const push::Trajectory& traj) {
   // The factor graphs model one finger with up to two contacts, or two fingers with one each.
   if (traj.extra_fingers.size() > 1)
     throw GraphError("trajectory: " + std::to_string(push::FingerCount(traj)) +
@@ -105,6 +103,12 @@ void ValidateTrajectory(const push::Trajectory& traj) {
   for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k)
     if (traj.extra_fingers[k].finger.shape.empty())
       throw GraphError("trajectory: fingers[" + std::to_string(k + 1) + "].shape is missing or empty");
+}
+
+void ValidateTrajectory(const push::Trajectory& traj) {
+  if (traj.object.shape.empty()) throw GraphError("trajectory: object.shape is missing or empty");
+  if (traj.finger.shape.empty()) throw GraphError("trajectory: finger.shape is missing or empty");
+  ValidateFingers(traj);
   const auto& m = traj.measured;
   for (std::size_t i = 0; i < m.object_pose.size(); ++i) {
     CheckFinite(std::isfinite(m.object_pose[i].t) && m.object_pose[i].pose.vector().allFinite(), "object_pose", i);

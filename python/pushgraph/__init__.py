@@ -19,6 +19,7 @@ whole API.
 """
 import json as _json
 import math as _math
+import operator as _operator
 import os as _os
 
 from . import _pushgraph
@@ -103,6 +104,15 @@ def evaluate(inputs=(), protocols="all", simulate=0, sim_object=None, sim_finger
                                 _os.fspath(mesh_dir), _config_json(estimator_config))
 
 
+def _finger_index(finger):
+    if isinstance(finger, bool):
+        raise TypeError("finger: expected an integer index (0 or 1), got %r" % (finger,))
+    try:
+        return _operator.index(finger)
+    except TypeError:
+        raise TypeError("finger: expected an integer index (0 or 1), got %r" % (finger,)) from None
+
+
 class OnlineEstimator:
     """The fixed-lag smoother for a running robot, fed one sample at a time.
 
@@ -116,6 +126,8 @@ class OnlineEstimator:
     contact_point, force: which sensors will report (they decide contact gating and the
     limit-surface load factor). Each add_* returns False when the sample came too late (at or
     before the last update) and was dropped; samples out of order or not finite raise GraphError.
+    A two-finger push: setup["fingers"] holds finger 1 (its streams empty); its samples come with
+    finger=1 (each finger's sensors are the kinds declared), and latest_state() has finger1_pose.
     """
 
     def __init__(self, setup, model="qs", config=None, contact_point=False, force=True, max_latency=0.2):
@@ -127,14 +139,14 @@ class OnlineEstimator:
     def add_object_pose(self, t, pose):
         return self._core.add_object_pose(float(t), pose)
 
-    def add_finger_pose(self, t, pose):
-        return self._core.add_finger_pose(float(t), pose)
+    def add_finger_pose(self, t, pose, finger=0):
+        return self._core.add_finger_pose(float(t), pose, _finger_index(finger))
 
-    def add_contact_point(self, t, point):
-        return self._core.add_contact_point(float(t), point)
+    def add_contact_point(self, t, point, finger=0):
+        return self._core.add_contact_point(float(t), point, _finger_index(finger))
 
-    def add_force(self, t, force):
-        return self._core.add_force(float(t), force)
+    def add_force(self, t, force, finger=0):
+        return self._core.add_force(float(t), force, _finger_index(finger))
 
     def update_due(self):
         return self._core.update_due()
@@ -144,7 +156,8 @@ class OnlineEstimator:
         return self._core.update(float(until))
 
     def latest_state(self):
-        """The newest state: dict with t, object_pose, finger_pose, contact and force (None when absent)."""
+        """The newest state: dict with t, object_pose, finger_pose, contact and force (None when absent);
+        finger1_pose too in a two-finger push."""
         return self._core.latest_state()
 
     @property

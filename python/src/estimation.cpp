@@ -37,6 +37,10 @@ py::dict StateToDict(const StateEstimate& s) {
   d["finger_pose"] = py::make_tuple(s.finger_pose.x, s.finger_pose.y, s.finger_pose.theta);
   d["contact"] = s.contact ? py::object(py::make_tuple(s.contact->x(), s.contact->y())) : py::none();
   d["force"] = s.force ? py::object(py::make_tuple(s.force->x(), s.force->y())) : py::none();
+  if (!s.other_fingers.empty()) {  // a two-finger push: finger 1's pose
+    const geometry::Pose2& e = s.other_fingers[0].pose;
+    d["finger1_pose"] = py::make_tuple(e.x, e.y, e.theta);
+  }
   return d;
 }
 
@@ -172,10 +176,16 @@ void RegisterEstimation(py::module_& m) {
       .def("add_object_pose",
            [](Online& o, double t, const py::handle& pose) { return o.estimator->AddObjectPose(t, ToPose(pose, "pose")); })
       .def("add_finger_pose",
-           [](Online& o, double t, const py::handle& pose) { return o.estimator->AddFingerPose(t, ToPose(pose, "pose")); })
+           [](Online& o, double t, const py::handle& pose, int finger) {
+             return o.estimator->AddFingerPose(t, finger, ToPose(pose, "pose"));
+           })
       .def("add_contact_point",
-           [](Online& o, double t, const py::handle& p) { return o.estimator->AddContactPoint(t, ToVec2(p, "point")); })
-      .def("add_force", [](Online& o, double t, const py::handle& f) { return o.estimator->AddForce(t, ToVec2(f, "force")); })
+           [](Online& o, double t, const py::handle& p, int finger) {
+             return o.estimator->AddContactPoint(t, finger, ToVec2(p, "point"));
+           })
+      .def("add_force", [](Online& o, double t, const py::handle& f, int finger) {
+        return o.estimator->AddForce(t, finger, ToVec2(f, "force"));
+      })
       .def("update_due", [](const Online& o) { return o.estimator->UpdateDue(); })
       .def("update",
            [](Online& o, double until) {

@@ -182,3 +182,52 @@ def test_two_fingers_round_trip_and_estimate(tmp_path):
     bad = dict(push, fingers=[dict(push["fingers"][0], measured=dict(f, object_pose=push["measured"]["object_pose"]))])
     with pytest.raises(ValueError, match=r"trajectory\['fingers'\]\[0\]\['measured'\]: a finger's streams have no 'object_pose'"):
         pg.estimate(bad)
+
+
+def test_two_fingers_online_from_python(tmp_path):
+    # The same push fed sample by sample with each finger's index: finger 1's pose is in every
+    # newest state, and the result has finger 1 as estimate() gives it.
+    (tmp_path / "left.json").write_text('{"polygons": [{"outer": [[0, 0.02]]}], "radius": 0.004}')
+    (tmp_path / "right.json").write_text('{"polygons": [{"outer": [[0, -0.02]]}], "radius": 0.004}')
+    path = tmp_path / "two.json"
+    subprocess.run([TOOL, "simulate", "-o", str(path), "--fingers", str(tmp_path / "left.json"),
+                    str(tmp_path / "right.json"), "--offset", "0", "--push-angle", "0"], check=True, capture_output=True)
+    push = pg.load_trajectory(str(path))
+    finger1 = push["fingers"][0]
+    setup = {"object": push["object"], "finger": push["finger"], "measured": {},
+             "measurement_sigmas": push["measurement_sigmas"],
+             "fingers": [{"shape": finger1["shape"], "mu_contact": finger1["mu_contact"], "measured": {}}]}
+    has_contact = "contact_point" in push["measured"]
+    online = pg.OnlineEstimator(setup, model="qs", contact_point=has_contact, force=True)
+    add = {"object_pose": online.add_object_pose, "finger_pose": online.add_finger_pose,
+           "contact_point": online.add_contact_point, "force": online.add_force}
+    samples = []
+    for finger, streams in [(0, push["measured"]), (1, finger1["measured"])]:
+        for stream, value in [("object_pose", "pose"), ("finger_pose", "pose"), ("contact_point", "point"), ("force", "force")]:
+            if stream not in streams or (finger == 1 and stream == "object_pose"):
+                continue
+            for t, v in zip(streams[stream]["t"], streams[stream][value]):
+                samples.append((t, finger, stream, v))
+    samples.sort(key=lambda s: (s[0], s[1]))
+    updates = 0
+    for k, (t, finger, stream, v) in enumerate(samples):
+        if stream == "object_pose":
+            add[stream](t, v)
+        else:
+            add[stream](t, v, finger=np.int64(finger))
+        if (k + 1 == len(samples) or samples[k + 1][0] > t) and online.update_due():
+            online.update()
+            updates += 1
+            assert len(online.latest_state()["finger1_pose"]) == 3
+    with pytest.raises(pg.GraphError, match="finger 2 is out of range"):
+        online.add_force(samples[-1][0] + 1.0, (0.1, 0.0), finger=2)
+    with pytest.raises(TypeError, match="finger: expected an integer"):
+        online.add_force(samples[-1][0] + 1.0, (0.1, 0.0), finger=1.0)
+    r = online.finish()
+    assert updates > 3
+    assert r["finger1_pose"].shape == r["object_pose"].shape and np.isfinite(r["finger1_pose"]).all()
+    assert np.isfinite(r["second_contact"][:, 0]).sum() > 100
+    # The replay of the recording at the same update times (every 5 object samples).
+    replay = pg.estimate(push, model="qs", mode="incremental")
+    np.testing.assert_allclose(r["object_pose"], replay["object_pose"], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(r["finger1_pose"], replay["finger1_pose"], rtol=0, atol=1e-9)
