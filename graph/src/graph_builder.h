@@ -111,6 +111,10 @@ class GraphBuilder {
   SolveOutcome Solve(ceres::Problem& problem, int max_iterations, double function_tolerance, const char* what) const;
   /// Names a residual block this builder added: "quasi_static factor at step 17 (t = 0.068 s)".
   std::string Describe(ceres::ResidualBlockId id) const;
+  /// Drops a removed residual block's record (the fixed-lag smoother's marginalization): Ceres
+  /// reuses the memory of removed blocks, so a stale record would misname a new block, and the
+  /// records of a long online run would grow without bound.
+  void ForgetResidualBlock(ceres::ResidualBlockId id) { origin_.erase(id); }
   /// Adds a residual block, records its type when RecordFactorTypes is on, and, for a factor
   /// that places the object's shape (`object_pose_blocks` non-empty) while the shape frame is a
   /// variable, wraps it in ShapeFrameFactor with those blocks composed with F.

@@ -118,7 +118,9 @@ struct FixedLagSmoother {
   SolverStats stats;
   double total_update_time = 0.0;
   double last_cost = 0.0;
-  std::vector<StepConditional> conditionals;  // in the order the steps were marginalized
+  // In the order the steps were marginalized; a deque: appending never moves the older ones (a
+  // vector's doubling at 32768 steps moved them all in one update: 4.3 ms).
+  std::deque<StepConditional> conditionals;
 
   // online == nullptr: every step of the recorded `t` exists from the start.
   FixedLagSmoother(const push::Trajectory& t, Model model, const EstimatorConfig& c,
@@ -218,7 +220,10 @@ struct FixedLagSmoother {
     // Remove the step: its residual blocks in the order above first (RemoveParameterBlock would
     // remove them in hash-set order, and fast removal moves the problem's last block into each
     // freed place, so the problem's order, and Ceres' sums, would depend on heap addresses).
-    for (ceres::ResidualBlockId id : rbs) problem->RemoveResidualBlock(id);
+    for (ceres::ResidualBlockId id : rbs) {
+      builder.ForgetResidualBlock(id);
+      problem->RemoveResidualBlock(id);
+    }
     for (double* p : removed) problem->RemoveParameterBlock(p);
     const int sep_dim = dim - removed_dim;
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> er(H.topLeftCorner(removed_dim, removed_dim));
@@ -293,9 +298,11 @@ struct FixedLagSmoother {
       ++next_step;
     }
     if (next_step == first_new) return 0.0;
+    const auto stage_start = std::chrono::steady_clock::now();
     // The new steps staged as in the batch solver (the window's older steps held fixed).
     stats.iterations += builder.StageSteps(*problem, first_new, next_step, cfg.incremental_max_iterations,
                                            cfg.function_tolerance, "incremental update, new steps");
+    const auto solve_start = std::chrono::steady_clock::now();
     const internal::SolveOutcome summary =
         builder.Solve(*problem, cfg.incremental_max_iterations, cfg.function_tolerance, "incremental update, window");
     stats.iterations += summary.iterations;
@@ -316,7 +323,10 @@ struct FixedLagSmoother {
     for (int i : leaving) Marginalize(i);
     if (internal::SolverLogLevel() >= 1) {
       const auto now = std::chrono::steady_clock::now();
-      std::cerr << "pushgraph incremental update: record " << leaving.size() << " steps "
+      auto seconds = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
+      std::cerr << "pushgraph incremental update: new steps initialized " << seconds(start, stage_start)
+                << " s, staged " << seconds(stage_start, solve_start) << " s, window solved "
+                << seconds(solve_start, record_start) << " s, record " << leaving.size() << " steps "
                 << std::chrono::duration<double>(marginalize_start - record_start).count() << " s, marginalize "
                 << std::chrono::duration<double>(now - marginalize_start).count() << " s, whole update "
                 << std::chrono::duration<double>(now - start).count() << " s\n";
