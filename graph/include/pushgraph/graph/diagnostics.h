@@ -54,7 +54,9 @@ struct Diagnostics {
   double penetration_share = 0.0;
   double penetration_tolerance = 1e-3;  ///< m: twice the default sigma of S
   /// The measured contact gap (m): median and median absolute deviation of the separation of
-  /// each measured finger pose (in contact) from the object at its estimated pose.
+  /// each measured finger pose (in contact) from the object at its estimated pose, to first
+  /// order about the estimated finger (along its contact normal: unbiased where the finger sits
+  /// between two walls, where the nearer wall's distance is not).
   double measured_gap_median = 0.0, measured_gap_mad = 0.0;
   int measured_samples = 0;
   double measured_noise = 0.0;  ///< 1.4826 MAD: the per-sample noise of that separation
