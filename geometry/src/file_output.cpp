@@ -13,13 +13,54 @@
 
 namespace pushgraph::geometry {
 
-std::string WriteFileAtomically(const std::string& path, const std::string& content) {
+namespace {
+
+std::string Failure(const std::string& path, const std::string& what, int error) {
+  return path + ": cannot write (" + what + (error != 0 ? std::string(": ") + std::strerror(error) : "") + ")";
+}
+
+// A FIFO, a character device (/dev/null, a terminal) or a socket cannot be replaced by a
+// renamed file without destroying it (as root, renaming over /dev/null replaces the device):
+// the text is written into it, as a shell redirection would.
+std::string WriteThrough(const std::string& path, const std::string& content) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+  if (fd < 0) return Failure(path, "cannot open", errno);
+  for (std::size_t written = 0; written < content.size();) {
+    const ssize_t n = ::write(fd, content.data() + written, content.size() - written);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      const int error = errno;
+      ::close(fd);
+      return Failure(path, "write failed", error);
+    }
+    written += static_cast<std::size_t>(n);
+  }
+  if (::close(fd) != 0) return Failure(path, "close failed", errno);
+  return "";
+}
+
+std::string WriteFile(const std::string& path, const std::string& content, int links_followed);
+
+// A symbolic link: the file it names is replaced (atomically, when it is a regular file), the
+// link stays, as a shell redirection through it would.
+std::string WriteThroughLink(const std::string& path, const std::string& content, int links_followed) {
   namespace fs = std::filesystem;
-  const auto failure = [&](const std::string& what, int error) {
-    return path + ": cannot write (" + what + (error != 0 ? std::string(": ") + std::strerror(error) : "") + ")";
-  };
+  if (links_followed >= 40) return Failure(path, "too many levels of symbolic links", ELOOP);
   std::error_code ec;
+  fs::path pointed = fs::read_symlink(path, ec);
+  if (ec) return Failure(path, "cannot read the symbolic link", ec.value());
+  if (pointed.is_relative()) pointed = fs::path(path).parent_path() / pointed;
+  return WriteFile(pointed.string(), content, links_followed + 1);
+}
+
+std::string WriteFile(const std::string& path, const std::string& content, int links_followed) {
+  namespace fs = std::filesystem;
+  const auto failure = [&](const std::string& what, int error) { return Failure(path, what, error); };
+  std::error_code ec;
+  const fs::file_status own = fs::symlink_status(path, ec);
+  if (!ec && fs::is_symlink(own)) return WriteThroughLink(path, content, links_followed);
   if (fs::is_directory(path, ec)) return path + ": is a directory, not a file to write";
+  if (!ec && fs::exists(own) && !fs::is_regular_file(own)) return WriteThrough(path, content);
   // The temporary file sits beside the target (same file system, so the rename is atomic).
   const fs::path target(path);
   const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
@@ -67,6 +108,12 @@ std::string WriteFileAtomically(const std::string& path, const std::string& cont
     return failure("rename into place failed", error);
   }
   return "";
+}
+
+}  // namespace
+
+std::string WriteFileAtomically(const std::string& path, const std::string& content) {
+  return WriteFile(path, content, 0);
 }
 
 }  // namespace pushgraph::geometry

@@ -10,6 +10,7 @@
 #include <thread>
 #include <vector>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 namespace pushgraph::geometry {
@@ -61,6 +62,37 @@ TEST_F(FileOutput, FailuresNameThePathAndKeepTheOldFile) {
   const std::string onto_folder = WriteFileAtomically(dir_.string(), "x");
   EXPECT_NE(onto_folder.find("is a directory"), std::string::npos) << onto_folder;
   EXPECT_EQ(FilesIn(), 0);
+}
+
+// A symbolic link is written through (its file replaced, the link kept, a relative or dangling
+// link too, a loop refused by name); a FIFO (as /dev/null, a device) is written into, not replaced.
+TEST_F(FileOutput, LinksAndSpecialFilesAreWrittenThroughNotReplaced) {
+  const fs::path target = dir_ / "target.json", link = dir_ / "link.json";
+  std::ofstream(target) << "old";
+  fs::create_symlink("target.json", link);  // relative to the link's folder
+  EXPECT_EQ(WriteFileAtomically(link.string(), "new"), "");
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(link)));
+  EXPECT_EQ(Read(target), "new");
+  const fs::path dangling = dir_ / "dangling.json";
+  fs::create_symlink(dir_ / "made_by_the_write.json", dangling);
+  EXPECT_EQ(WriteFileAtomically(dangling.string(), "made"), "");
+  EXPECT_EQ(Read(dir_ / "made_by_the_write.json"), "made");
+  const fs::path loop_a = dir_ / "loop_a", loop_b = dir_ / "loop_b";
+  fs::create_symlink(loop_b, loop_a);
+  fs::create_symlink(loop_a, loop_b);
+  const std::string loop = WriteFileAtomically(loop_a.string(), "x");
+  EXPECT_NE(loop.find("symbolic links"), std::string::npos) << loop;
+
+  // (A FIFO stands for /dev/null here: the same code path, and a regression would not replace
+  // the machine's /dev/null when the tests run as root.)
+  const fs::path fifo = dir_ / "fifo.json";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::string received;
+  std::thread reader([&] { received = Read(fifo); });
+  EXPECT_EQ(WriteFileAtomically(fifo.string(), "through the pipe"), "");
+  reader.join();
+  EXPECT_EQ(received, "through the pipe");
+  EXPECT_TRUE(fs::is_fifo(fifo));
 }
 
 TEST_F(FileOutput, ConcurrentWritersLeaveOneWholeFile) {
