@@ -314,8 +314,43 @@ Trajectory LoadTrajectoryJson(const std::string& path, std::vector<std::string>*
   return ParseTrajectoryJson(buffer.str(), path, notes);
 }
 
+namespace {
+// JSON has no NaN or infinity (a writer would put null, which no reader takes back): a
+// non-finite sample is refused by its stream and row before anything is written.
+void RequireFiniteRows(const std::vector<push::PoseSample>& pose, const std::vector<push::PointSample>& point,
+                       const std::vector<push::ForceSample>& force, const std::string& where) {
+  auto fail = [&](const char* stream, std::size_t i) {
+    throw IoError("trajectory JSON: " + where + stream + "[" + std::to_string(i) +
+                  "] is not finite (JSON has no NaN or infinity: the row would be written as null, which no reader "
+                  "takes back); drop the sample instead");
+  };
+  for (std::size_t i = 0; i < pose.size(); ++i)
+    if (!std::isfinite(pose[i].t) || !pose[i].pose.vector().allFinite()) fail("finger_pose", i);
+  for (std::size_t i = 0; i < point.size(); ++i)
+    if (!std::isfinite(point[i].t) || !point[i].point.allFinite()) fail("contact_point", i);
+  for (std::size_t i = 0; i < force.size(); ++i)
+    if (!std::isfinite(force[i].t) || !force[i].force.allFinite()) fail("force", i);
+}
+void RequireFiniteStreams(const Streams& s, const std::vector<push::ExtraFinger>& extra, bool truth) {
+  const std::string base = truth ? "ground_truth." : "streams.";
+  for (std::size_t i = 0; i < s.object_pose.size(); ++i)
+    if (!std::isfinite(s.object_pose[i].t) || !s.object_pose[i].pose.vector().allFinite())
+      throw IoError("trajectory JSON: " + base + "object_pose[" + std::to_string(i) +
+                    "] is not finite (JSON has no NaN or infinity: the row would be written as null, which no reader "
+                    "takes back); drop the sample instead");
+  RequireFiniteRows(s.finger_pose, s.contact_point, s.force, base);
+  for (std::size_t k = 0; k < extra.size(); ++k) {
+    const push::FingerStreams* f = truth ? (extra[k].ground_truth ? &*extra[k].ground_truth : nullptr) : &extra[k].measured;
+    if (f != nullptr)
+      RequireFiniteRows(f->finger_pose, f->contact_point, f->force, base + "fingers[" + std::to_string(k + 1) + "].");
+  }
+}
+}  // namespace
+
 // One stream row per line: readable, diff-friendly and still plain JSON.
 std::string TrajectoryToJson(const Trajectory& t, int indent) {
+  RequireFiniteStreams(t.measured, t.extra_fingers, false);
+  if (t.ground_truth) RequireFiniteStreams(*t.ground_truth, t.extra_fingers, true);
   // The format holds what the estimator reads: uniform pressure under standard gravity.
   if (t.object.pressure.kind != limit_surface::PressureKind::kUniform)
     throw IoError("trajectory JSON: object.pressure must be uniform (the format has no other)");

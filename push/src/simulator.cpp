@@ -46,8 +46,9 @@ void ValidatePlan(const PushPlan& p) {
   for (std::size_t i = 0; i < fingers.size(); ++i)
     for (std::size_t j = i + 1; j < fingers.size(); ++j) {
       const double sd = geometry::ShapePairQuerier(fingers[i]->shape, fingers[j]->shape).Query({}, {}).signed_distance;
-      Require(sd > 0.0, "fingers " + std::to_string(i) + " and " + std::to_string(j) +
-                            " overlap each other (separation " + std::to_string(sd) + " m at the pusher's pose)");
+      // Touching each other is allowed (they move together); inside each other is not.
+      Require(sd >= 0.0, "fingers " + std::to_string(i) + " and " + std::to_string(j) +
+                             " overlap each other (" + std::to_string(-1e3 * sd) + " mm inside each other at the pusher's pose)");
     }
 }
 

@@ -105,7 +105,8 @@ def evaluate(inputs=(), protocols="all", simulate=0, sim_object=None, sim_finger
 
 
 def _finger_index(finger):
-    if isinstance(finger, bool):
+    # bool and numpy.bool_ are not indices (numpy.bool_ passes operator.index).
+    if isinstance(finger, bool) or type(finger).__name__ in ("bool_", "bool"):
         raise TypeError("finger: expected an integer index (0 or 1), got %r" % (finger,))
     try:
         return _operator.index(finger)

@@ -200,6 +200,20 @@ TEST(TwoFingers, IncrementalTheBaselineAndTheResultFile) {
   for (const StateEstimate& s : yu.states) EXPECT_TRUE(s.other_fingers.empty());
 }
 
+// Fingers inside each other in their measured poses (a wrong shape or pose stream) are refused
+// by name, not estimated with the blame on the sensors.
+TEST(TwoFingers, FingersInsideEachOtherAreRefused) {
+  push::Trajectory t = TwoFingerPush(10);
+  t.extra_fingers[0].finger.shape = t.finger.shape;  // both at finger 0's place
+  try {
+    Estimate(t, Model::kQs, Mode::kBatch);
+    FAIL() << "accepted";
+  } catch (const GraphError& e) {
+    EXPECT_NE(std::string(e.what()).find("fingers 0 and 1 overlap each other in their measured poses"), std::string::npos)
+        << e.what();
+  }
+}
+
 // Written and read back through the file format, the push estimates the same.
 TEST(TwoFingers, TheTrajectoryFileRoundTripsIntoTheEstimator) {
   const push::Trajectory t = TwoFingerPush(6);
@@ -223,7 +237,8 @@ TEST(TwoFingers, AThirdContactIsRefusedByName) {
     Estimate(t, Model::kQs, Mode::kBatch);
     FAIL() << "accepted";
   } catch (const GraphError& e) {
-    EXPECT_NE(std::string(e.what()).find("finger 1 repeat a time"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("fingers[1].contact_point[6] repeats the time"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("one per finger"), std::string::npos) << e.what();
   }
 }
 

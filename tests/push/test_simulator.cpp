@@ -510,6 +510,9 @@ TEST_F(SimulateCli, SeveralFingersAndContactsAreWrittenAndDrawn) {
   const Trajectory t = io::LoadTrajectoryJson(two);
   ASSERT_EQ(FingerCount(t), 2);
   EXPECT_FALSE(t.extra_fingers[0].measured.force.empty());
+  // The summary counts the rows of every finger, as the file holds them.
+  std::size_t contact_rows = t.measured.contact_point.size() + t.extra_fingers[0].measured.contact_point.size();
+  EXPECT_NE(r.out.find("\"contact_point\": " + std::to_string(contact_rows)), std::string::npos) << r.out;
   std::ifstream svg_in(two_svg);
   std::stringstream svg;
   svg << svg_in.rdbuf();
@@ -528,6 +531,14 @@ TEST_F(SimulateCli, SeveralFingersAndContactsAreWrittenAndDrawn) {
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find("overlap each other"), std::string::npos) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  // Fingers that touch each other (8 mm apart, radius 4 mm) are two fingers, not an overlap.
+  const std::string touching = (dir_ / "touching.json").string();
+  std::ofstream(touching) << R"({"polygons": [{"outer": [[0, -0.008]]}], "radius": 0.004})";
+  const std::string middle = (dir_ / "middle.json").string();
+  std::ofstream(middle) << R"({"polygons": [{"outer": [[0, 0]]}], "radius": 0.004})";
+  r = RunTool("-o " + (dir_ / "touching_out.json").string() + " --fingers " + middle + " " + touching +
+              " --push-angle 0 --offset 0 --distance 0.01");
+  EXPECT_EQ(r.status, 0) << r.err;
 }
 
 TEST_F(SimulateCli, EveryFlagInHelpIsDocumented) {

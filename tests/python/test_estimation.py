@@ -171,6 +171,11 @@ def test_two_fingers_round_trip_and_estimate(tmp_path):
     f, g = push["fingers"][0]["measured"], again["fingers"][0]["measured"]
     for stream, value in [("finger_pose", "pose"), ("contact_point", "point"), ("force", "force")]:
         np.testing.assert_array_equal(g[stream][value], f[stream][value])
+    nan_force = {**push, "fingers": [{**push["fingers"][0], "measured": {**f, "force": {**f["force"], "force": f["force"]["force"].copy()}}}]}
+    nan_force["fingers"][0]["measured"]["force"]["force"][11, 1] = np.nan
+    with pytest.raises(OSError, match=r"fingers\[1\]\.force\[11\] is not finite"):
+        pg.save_trajectory(nan_force, str(tmp_path / "nan.json"))
+    assert not (tmp_path / "nan.json").exists()
     r = pg.estimate(push, model="qs")
     assert r["finger1_pose"].shape == r["object_pose"].shape and np.isfinite(r["finger1_pose"]).all()
     touching = np.isfinite(r["second_contact"][:, 0])
@@ -221,8 +226,9 @@ def test_two_fingers_online_from_python(tmp_path):
             assert len(online.latest_state()["finger1_pose"]) == 3
     with pytest.raises(pg.GraphError, match="finger 2 is out of range"):
         online.add_force(samples[-1][0] + 1.0, (0.1, 0.0), finger=2)
-    with pytest.raises(TypeError, match="finger: expected an integer"):
-        online.add_force(samples[-1][0] + 1.0, (0.1, 0.0), finger=1.0)
+    for bad in (1.0, True, np.bool_(True)):
+        with pytest.raises(TypeError, match="finger: expected an integer"):
+            online.add_force(samples[-1][0] + 1.0, (0.1, 0.0), finger=bad)
     r = online.finish()
     assert updates > 3
     assert r["finger1_pose"].shape == r["object_pose"].shape and np.isfinite(r["finger1_pose"]).all()

@@ -196,10 +196,18 @@ void Run(const SimulateOptions& o) {
   for (const push::SimulationState& state : result.states)
     if (state.contacts) most_contacts = std::max(most_contacts, state.contacts->contacts.size());
   if (plan.multi_contact || !plan.extra_fingers.empty()) out["max_simultaneous_contacts"] = most_contacts;
+  // Rows in the file: every finger's (fingers 1, 2, ... too), as the file holds them.
+  std::size_t finger_rows = trajectory.measured.finger_pose.size(), contact_rows = trajectory.measured.contact_point.size(),
+              force_rows = trajectory.measured.force.size();
+  for (const push::ExtraFinger& f : trajectory.extra_fingers) {
+    finger_rows += f.measured.finger_pose.size();
+    contact_rows += f.measured.contact_point.size();
+    force_rows += f.measured.force.size();
+  }
   out["samples"] = {{"object_pose", trajectory.measured.object_pose.size()},
-                    {"finger_pose", trajectory.measured.finger_pose.size()},
-                    {"contact_point", trajectory.measured.contact_point.size()},
-                    {"force", trajectory.measured.force.size()}};
+                    {"finger_pose", finger_rows},
+                    {"contact_point", contact_rows},
+                    {"force", force_rows}};
   std::cout << DumpJson(out) << "\n";
 }
 
