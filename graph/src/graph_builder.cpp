@@ -1015,6 +1015,32 @@ void GraphBuilder::DropUnobservableForces(EstimationResult& result) const {
   if (fingers_ignored_)
     result.warnings.push_back("the Yu-Rodriguez baseline models one finger: finger 1 of this two-finger push was left out "
                               "(its pose, contacts and forces are not estimated)");
+  if (two_fingers_) {
+    // A finger without the sensor the other has: said, not left silent.
+    const push::FingerStreams& b = traj_.extra_fingers[0].measured;
+    const auto& m = traj_.measured;
+    for (int finger : {0, 1}) {
+      const auto& contact = finger == 0 ? m.contact_point : b.contact_point;
+      const auto& force = finger == 0 ? m.force : b.force;
+      if (streams_.contact_point && contact.empty()) {
+        const auto pushing = std::count_if(force.begin(), force.end(), [&](const push::ForceSample& f) {
+          return f.force.norm() >= cfg_.contact_force_threshold;
+        });
+        if (pushing > 0) {
+          char text[240];
+          std::snprintf(text, sizeof text,
+                        "finger %d has no contact rows while the other finger has: it is taken as never touching, and its "
+                        "%d force rows of at least %.3g N were left out",
+                        finger, static_cast<int>(pushing), cfg_.contact_force_threshold);
+          result.warnings.push_back(text);
+        }
+      }
+      if (streams_.force && force.empty() && ModelHasForce(model_))
+        result.warnings.push_back("finger " + std::to_string(finger) + " has no force rows while the other finger has: its "
+                                  "force comes from the motion alone (the quasi-static factor fixes the direction of the "
+                                  "summed wrench), so its size is weakly determined");
+    }
+  }
   if (ForceScaleObservable()) return;
   for (StateEstimate& s : result.states) {
     s.force.reset();

@@ -232,6 +232,26 @@ TEST(TwoFingers, AShapeOffAlongThePushIsAligned) {
   EXPECT_LT(r.metrics.at("object_position_rms"), 1.5 * reference.metrics.at("object_position_rms"));
 }
 
+// A finger without the sensor the other finger has is said in the warnings, not left silent:
+// without contact rows it never touches (its forces are left out), without force rows its force
+// is only what the motion says.
+TEST(TwoFingers, AFingerWithoutTheOthersSensorIsSaid) {
+  const push::Trajectory full = TwoFingerPush(12);
+  EstimatorConfig config = ApplyMeasurementSigmas(EstimatorConfig{}, *full.measurement_sigmas);
+  config.covariance = false;
+  auto said = [](const EstimationResult& r, const std::string& needle) {
+    return std::any_of(r.warnings.begin(), r.warnings.end(),
+                       [&](const std::string& w) { return w.find(needle) != std::string::npos; });
+  };
+  EXPECT_FALSE(said(Estimate(full, Model::kQs, Mode::kBatch, config), "finger 1 has no"));
+  push::Trajectory t = full;
+  t.extra_fingers[0].measured.contact_point.clear();
+  EXPECT_TRUE(said(Estimate(t, Model::kQs, Mode::kBatch, config), "finger 1 has no contact rows"));
+  t = full;
+  t.extra_fingers[0].measured.force.clear();
+  EXPECT_TRUE(said(Estimate(t, Model::kQs, Mode::kBatch, config), "finger 1 has no force rows"));
+}
+
 // Written and read back through the file format, the push estimates the same.
 TEST(TwoFingers, TheTrajectoryFileRoundTripsIntoTheEstimator) {
   const push::Trajectory t = TwoFingerPush(6);
