@@ -25,6 +25,16 @@ Json Matrix(const M& m) {
 Json Pose(const geometry::Pose2& p) { return Json::array({p.x, p.y, p.theta}); }
 Json Vec(const geometry::Vec2& v) { return Json::array({v.x(), v.y()}); }
 
+// Fingers 1, 2, ...: their measured contact gaps, as finger 0's "measured_contact_gap".
+Json OtherFingerGaps(const graph::Diagnostics& d) {
+  Json out = Json::array();
+  for (std::size_t k = 0; k < d.other_finger_gaps.size(); ++k) {
+    const graph::MeasuredContactGap& g = d.other_finger_gaps[k];
+    out.push_back({{"finger", k + 1}, {"median", g.median}, {"mad", g.mad}, {"samples", g.samples}});
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string ResultToJson(const graph::EstimationResult& r, int indent) {
@@ -148,6 +158,7 @@ std::string ResultToJson(const graph::EstimationResult& r, int indent) {
                         {"penetration_tolerance", d.penetration_tolerance},
                         {"measured_contact_gap",
                          {{"median", d.measured_gap_median}, {"mad", d.measured_gap_mad}, {"samples", d.measured_samples}}},
+                        {"measured_contact_gap_other_fingers", OtherFingerGaps(d)},
                         {"sensor_faults", std::move(faults)},
                         {"causes", d.causes}};
   }
@@ -158,7 +169,9 @@ std::string ResultToJson(const graph::EstimationResult& r, int indent) {
     for (const auto& [k, v] : r.metrics) m[k] = v;
     j["metrics"] = std::move(m);
   }
-  return j.dump(indent);
+  // Warnings and notes quote file names, which need not be UTF-8 (a Latin-1 path): such bytes
+  // become U+FFFD rather than failing the whole result.
+  return j.dump(indent, ' ', false, Json::error_handler_t::replace);
 }
 
 void SaveResultJson(const graph::EstimationResult& result, const std::string& path) {

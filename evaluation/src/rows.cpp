@@ -31,7 +31,7 @@ nlohmann::json RowJson(const EvaluationRow& r) {
 }  // namespace
 
 void AppendRow(const std::string& path, const EvaluationRow& row) {
-  const std::string line = RowJson(row).dump() + "\n";
+  const std::string line = RowJson(row).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
   FILE* f = std::fopen(path.c_str(), "a");
   if (f == nullptr) throw EvaluationError(path + ": cannot append a row");
   const bool ok = std::fwrite(line.data(), 1, line.size(), f) == line.size() && std::fflush(f) == 0 && ::fsync(fileno(f)) == 0;
@@ -46,8 +46,8 @@ void WriteRows(const std::string& path, const RowsHeader& header, const std::vec
                       {"shards", header.shards},
                       {"items_total", header.items_total},
                       {"settings", nlohmann::json::parse(header.settings_json)}};
-  out << h.dump() << "\n";
-  for (const EvaluationRow& r : rows) out << RowJson(r).dump() << "\n";
+  out << h.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
+  for (const EvaluationRow& r : rows) out << RowJson(r).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
   if (const std::string error = geometry::WriteFileAtomically(path, out.str()); !error.empty()) throw EvaluationError(error);
 }
 

@@ -182,27 +182,43 @@ Diagnostics Diagnose(const push::Trajectory& traj, Model model, const EstimatorC
   // the nearer wall's where the finger sits between two, as wedged in a notch: biased inward by
   // about half the noise, 1.1 mm at 2 mm and 3.0 mm at 5 mm on the notched block's V, which
   // named a correct probe radius wrong.)
-  {
+  // Each finger's (finger 1 of a two-finger push with its own shape and pose samples).
+  auto measured_gap = [&](int finger, MeasuredContactGap* out) {
+    const geometry::ShapePairQuerier* querier = finger == 0 ? &builder.querier() : builder.second_finger_querier();
+    if (querier == nullptr) return;
+    const auto& poses = finger == 0 ? traj.measured.finger_pose : traj.extra_fingers[0].measured.finger_pose;
     std::vector<double> mg;
-    const auto& fingers = traj.measured.finger_pose;
     for (int i = 0; i < n; ++i) {
       const Step& step = builder.steps()[i];
-      if (!step.in_contact || step.finger < 0) continue;
+      const bool touching = finger == 0 ? step.in_contact : step.in_contact_b;
+      const int sample = finger == 0 ? step.finger : step.finger_b;
+      if (!touching || sample < 0) continue;
+      if (finger == 1 && result.states[i].other_fingers.empty()) continue;
       const Pose2 placed = geometry::Compose(result.states[i].object_pose, F);
-      const Pose2& estimated = result.states[i].finger_pose;
+      const Pose2& estimated = finger == 0 ? result.states[i].finger_pose : result.states[i].other_fingers[0].pose;
       geometry::ShapePairJacobians J;
-      const double sd = builder.querier().Query(placed, estimated, &J).signed_distance;
-      Eigen::Vector3d delta = fingers[step.finger].pose.vector() - estimated.vector();
+      const double sd = querier->Query(placed, estimated, &J).signed_distance;
+      Eigen::Vector3d delta = poses[sample].pose.vector() - estimated.vector();
       delta.z() = geometry::WrapAngle(delta.z());
       mg.push_back(sd + J.J_sd_finger_pose.dot(delta));
     }
-    d.measured_samples = static_cast<int>(mg.size());
-    if (!mg.empty()) {
-      d.measured_gap_median = Median(mg);
-      std::vector<double> dev;
-      for (double g : mg) dev.push_back(std::abs(g - d.measured_gap_median));
-      d.measured_gap_mad = Median(dev);
-      d.measured_noise = 1.4826 * d.measured_gap_mad;
+    out->samples = static_cast<int>(mg.size());
+    if (mg.empty()) return;
+    out->median = Median(mg);
+    std::vector<double> dev;
+    for (double g : mg) dev.push_back(std::abs(g - out->median));
+    out->mad = Median(dev);
+  };
+  {
+    MeasuredContactGap gap;
+    measured_gap(0, &gap);
+    d.measured_samples = gap.samples;
+    d.measured_gap_median = gap.median;
+    d.measured_gap_mad = gap.mad;
+    d.measured_noise = 1.4826 * gap.mad;
+    if (!traj.extra_fingers.empty()) {
+      d.other_finger_gaps.emplace_back();
+      measured_gap(1, &d.other_finger_gaps.back());
     }
   }
 
@@ -262,14 +278,17 @@ Diagnostics Diagnose(const push::Trajectory& traj, Model model, const EstimatorC
     d.causes.push_back(fault.kind == "frozen" ? "frozen sensor: " + fault.detail : "spiking sensor: " + fault.detail);
   }
   // Beyond 1 mm and three standard errors of the median (1.25 sigma / sqrt(n)).
-  const double median_error = 1.25 * d.measured_noise / std::sqrt(std::max(1, d.measured_samples));
-  if (d.measured_samples >= 20 && std::abs(d.measured_gap_median) > std::max(1e-3, 3.0 * median_error)) {
-    d.causes.push_back(Format("wrong probe radius or object size: during contact the measured finger stays %.1f mm %s the "
-                              "object's surface (median over %d samples); a finger radius %.1f mm %s would touch",
-                              std::abs(d.measured_gap_median) * 1e3, d.measured_gap_median > 0 ? "off" : "inside",
-                              d.measured_samples, std::abs(d.measured_gap_median) * 1e3,
-                              d.measured_gap_median > 0 ? "larger" : "smaller"));
-  }
+  auto wrong_size = [&](const char* finger, double median, double mad, int samples) {
+    const double median_error = 1.25 * 1.4826 * mad / std::sqrt(std::max(1, samples));
+    if (samples < 20 || std::abs(median) <= std::max(1e-3, 3.0 * median_error)) return;
+    const std::string whose = std::string(finger) == "finger" ? "a finger" : std::string(finger) + "'s";
+    d.causes.push_back(Format("wrong probe radius or object size: during contact the measured %s stays %.1f mm %s the "
+                              "object's surface (median over %d samples); %s radius %.1f mm %s would touch",
+                              finger, std::abs(median) * 1e3, median > 0 ? "off" : "inside", samples, whose.c_str(),
+                              std::abs(median) * 1e3, median > 0 ? "larger" : "smaller"));
+  };
+  wrong_size("finger", d.measured_gap_median, d.measured_gap_mad, d.measured_samples);
+  for (const MeasuredContactGap& g : d.other_finger_gaps) wrong_size("finger 1", g.median, g.mad, g.samples);
   if (d.penetration_share > 0.2) {
     d.causes.push_back(Format("the finger is inside the object in %.0f%% of the steps (by more than %.1f mm): shape frame, "
                               "units, probe radius, or a finger touching two walls at once (several contacts)?",

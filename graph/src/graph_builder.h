@@ -244,6 +244,8 @@ class GraphBuilder {
   void SetSharedParameters(std::optional<double> c, std::optional<double> mu);
   void SetFrame(const Pose2& frame) { frame_[0] = frame.x; frame_[1] = frame.y; frame_[2] = frame.theta; }
   const geometry::ShapePairQuerier& querier() const { return *querier_; }
+  /// Object and finger 1 of a two-finger push (null otherwise).
+  const geometry::ShapePairQuerier* second_finger_querier() const { return querier_b_.get(); }
   /// The estimate of step i (no covariances).
   StateEstimate State(int i) const;
 

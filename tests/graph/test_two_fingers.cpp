@@ -252,6 +252,28 @@ TEST(TwoFingers, AFingerWithoutTheOthersSensorIsSaid) {
   EXPECT_TRUE(said(Estimate(t, Model::kQs, Mode::kBatch, config), "finger 1 has no force rows"));
 }
 
+// The self-diagnosis measures each finger's contact gap with its own shape: finger 1 given twice
+// its radius is named (finger 0's gap alone said nothing), the right radii are not.
+TEST(TwoFingers, AWrongRadiusOfFingerOneIsNamed) {
+  const push::Trajectory truth = TwoFingerPush(13, 0.0);
+  const EstimatorConfig config = ApplyMeasurementSigmas(EstimatorConfig{}, *truth.measurement_sigmas);
+  auto named = [](const EstimationResult& r) {
+    for (const std::string& c : r.diagnostics->causes)
+      if (c.find("measured finger 1 stays") != std::string::npos) return true;
+    return false;
+  };
+  const EstimationResult right = Estimate(truth, Model::kQs, Mode::kBatch, config);
+  ASSERT_TRUE(right.diagnostics && right.diagnostics->other_finger_gaps.size() == 1);
+  EXPECT_FALSE(named(right));
+  push::Trajectory t = truth;
+  t.extra_fingers[0].finger.shape = t.extra_fingers[0].finger.shape.WithRadius(0.008);
+  const EstimationResult wrong = Estimate(t, Model::kQs, Mode::kBatch, config);
+  std::printf("[two fingers] finger 1 radius 8 mm (true 4): its measured gap %.2f mm over %d samples (right radius %.2f mm)\n",
+              1e3 * wrong.diagnostics->other_finger_gaps[0].median, wrong.diagnostics->other_finger_gaps[0].samples,
+              1e3 * right.diagnostics->other_finger_gaps[0].median);
+  EXPECT_TRUE(named(wrong));
+}
+
 // Written and read back through the file format, the push estimates the same.
 TEST(TwoFingers, TheTrajectoryFileRoundTripsIntoTheEstimator) {
   const push::Trajectory t = TwoFingerPush(6);

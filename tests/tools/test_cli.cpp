@@ -138,6 +138,19 @@ TEST_F(CliTest, DirectoriesAsInputFilesAreNamedAsSuch) {
   }
 }
 
+// File names need not be UTF-8 (a Latin-1 "caf\xe9.json"): the tool's JSON summary quotes them
+// with U+FFFD instead of failing ("invalid UTF-8 byte") after the work was done.
+TEST_F(CliTest, FileNamesThatAreNotUtf8AreWrittenAndQuoted) {
+  const std::string dir = fs::path(Write("o.json", kSquareWithHole)).parent_path().string();
+  const std::string push = dir + "/caf\xe9.json", result = dir + "/r\xe9sultat.json";
+  ToolRun r = Exec("simulate -o '" + push + "' --distance 0.01");
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = Exec("estimate '" + push + "' -o '" + result + "' --model cp");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(result));
+  EXPECT_NE(r.out.find("\xef\xbf\xbd"), std::string::npos) << r.out;  // U+FFFD in the summary's output path
+}
+
 TEST_F(CliTest, PenetrationBadPoseIsOneClearLine) {
   const std::string object = Write("o.json", kSquareWithHole);
   const std::string finger = Write("f.json", R"({"polygons":[{"outer":[[0,0]]}],"radius":0.1})");

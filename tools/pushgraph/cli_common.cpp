@@ -87,7 +87,8 @@ void CheckOutputsAreNew(const std::vector<NamedPath>& inputs, const std::vector<
 
 std::string DumpJson(const nlohmann::json& value, int indent) {
   // nlohmann prints the shortest round-trip representation, which is exact.
-  return value.dump(indent);
+  // Paths in it need not be UTF-8 (a Latin-1 file name): such bytes become U+FFFD, not an error.
+  return value.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 std::vector<std::string> JoinNegativeValues(const std::vector<std::string>& args,

@@ -41,6 +41,12 @@ struct SensorFault {
   std::string detail;  ///< one sentence with the numbers
 };
 
+/// A finger's measured contact gap (m): median and median absolute deviation over its samples.
+struct MeasuredContactGap {
+  double median = 0.0, mad = 0.0;
+  int samples = 0;
+};
+
 struct Diagnostics {
   std::vector<FactorStatistics> factors;
   /// Expected values from the marginal covariances (leverages); false: dof (m - n) / m, the
@@ -60,6 +66,8 @@ struct Diagnostics {
   double measured_gap_median = 0.0, measured_gap_mad = 0.0;
   int measured_samples = 0;
   double measured_noise = 0.0;  ///< 1.4826 MAD: the per-sample noise of that separation
+  /// The same of finger 1 of a two-finger push (its own shape and pose samples); empty otherwise.
+  std::vector<MeasuredContactGap> other_finger_gaps;
   std::vector<SensorFault> faults;
   /// Probable causes when something is far off, one sentence each (also in the warnings).
   std::vector<std::string> causes;
