@@ -109,9 +109,12 @@ def _finger_index(finger):
     if isinstance(finger, bool) or type(finger).__name__ in ("bool_", "bool"):
         raise TypeError("finger: expected an integer index (0 or 1), got %r" % (finger,))
     try:
-        return _operator.index(finger)
+        index = _operator.index(finger)
     except TypeError:
         raise TypeError("finger: expected an integer index (0 or 1), got %r" % (finger,)) from None
+    if not -2**31 <= index < 2**31:  # beyond C++'s int: out of range like any other index
+        raise GraphError("finger %d is out of range: the setup has fingers 0 and 1 at most" % index)
+    return index
 
 
 class OnlineEstimator:

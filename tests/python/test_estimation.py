@@ -224,8 +224,9 @@ def test_two_fingers_online_from_python(tmp_path):
             online.update()
             updates += 1
             assert len(online.latest_state()["finger1_pose"]) == 3
-    with pytest.raises(pg.GraphError, match="finger 2 is out of range"):
-        online.add_force(samples[-1][0] + 1.0, (0.1, 0.0), finger=2)
+    for far in (2, 10**30):
+        with pytest.raises(pg.GraphError, match="finger %d is out of range" % far):
+            online.add_force(samples[-1][0] + 1.0, (0.1, 0.0), finger=far)
     for bad in (1.0, True, np.bool_(True)):
         with pytest.raises(TypeError, match="finger: expected an integer"):
             online.add_force(samples[-1][0] + 1.0, (0.1, 0.0), finger=bad)
