@@ -188,6 +188,13 @@ std::shared_ptr<const geometry::ShapePairQuerier> GraphBuilder::MakeQuerier(cons
 
 void GraphBuilder::SetUpShapes(std::shared_ptr<const geometry::ShapePairQuerier> querier) {
   querier_ = querier ? std::move(querier) : MakeQuerier(traj_, cfg_);
+  object_outer_ = traj_.object.shape;
+  std::vector<geometry::Polygon> outer;
+  for (const geometry::Polygon& polygon : traj_.object.shape.polygons()) {
+    object_has_holes_ = object_has_holes_ || !polygon.holes.empty();
+    outer.push_back({polygon.outer, {}});
+  }
+  if (object_has_holes_) object_outer_ = geometry::Shape::FromPolygons(outer, traj_.object.shape.radius());
   finger_has_faces_ = !(traj_.finger.shape.is_degenerate_core() && traj_.finger.shape.num_vertices() <= 1);
   if (two_fingers_) querier_b_ = MakeQuerier(traj_, traj_.extra_fingers[0].finger.shape, cfg_);
   if (ModelHasForce(model_)) qs_ = QuasiStaticGeometryFor(traj_, cfg_);
@@ -569,6 +576,14 @@ std::pair<int, int> GraphBuilder::FarthestContactRows(int k) const {
   return best;
 }
 
+const geometry::Shape& GraphBuilder::ContactBoundary(int i, int finger) const {
+  if (!object_has_holes_) return traj_.object.shape;
+  const StepVars& v = vars_[i];
+  const double* e = finger == 0 ? v.e : v.e2;
+  const Vec2 local = geometry::InverseAct(Pose2{v.x[0], v.x[1], v.x[2]}, Vec2(e[0], e[1]));
+  return geometry::QueryPoint(object_outer_, local).signed_distance < 0.0 ? traj_.object.shape : object_outer_;
+}
+
 Vec2 GraphBuilder::SecondFingerNearestObjectPoint(int i) const {
   // The object point nearest finger 1's shape (its reference point may lie off the shape).
   const StepVars& v = vars_[i];
@@ -751,8 +766,8 @@ void GraphBuilder::AddKinematicFactors(ceres::Problem& problem, int i) {
           MakeLoss(cfg_.contact_loss), {v.p});
     }
     // C: contact point on both boundaries, finger touching the object.
-    Add(problem, FactorType::kContactOnObject, new BoundaryPointFactor(traj_.object.shape, cfg_.contact_object_sigma), nullptr,
-        {v.x, v.p}, {0});
+    Add(problem, FactorType::kContactOnObject, new BoundaryPointFactor(ContactBoundary(i, 0), cfg_.contact_object_sigma),
+        nullptr, {v.x, v.p}, {0});
     if (s.two_contacts) {
       // Two contacts: each point on the object's boundary and at its own wall's touching pair
       // (the shape-pair witness is the single nearest pair, one of the two: it would pull both
@@ -761,8 +776,8 @@ void GraphBuilder::AddKinematicFactors(ceres::Problem& problem, int i) {
         Add(problem, FactorType::kContactPoint, new VectorMeasurementFactor(m.contact_point[s.contact2].point, cfg_.measurement.contact),
             MakeLoss(cfg_.contact_loss), {v.p2});
       }
-      Add(problem, FactorType::kContactOnObject, new BoundaryPointFactor(traj_.object.shape, cfg_.contact_object_sigma), nullptr,
-          {v.x, v.p2}, {0});
+      Add(problem, FactorType::kContactOnObject, new BoundaryPointFactor(ContactBoundary(i, 0), cfg_.contact_object_sigma),
+          nullptr, {v.x, v.p2}, {0});
       ContactFeature features[2];
       const bool on_features = TwoContactFeatures(i, features);
       feature_choices_[i] = FixedFeatureKeys(on_features, features);
@@ -833,8 +848,8 @@ void GraphBuilder::AddSecondFingerKinematicFactors(ceres::Problem& problem, int 
       Add(problem, FactorType::kContactPoint, new VectorMeasurementFactor(b.contact_point[s.contact_b].point, cfg_.measurement.contact),
           MakeLoss(cfg_.contact_loss), {v.p2});
     }
-    Add(problem, FactorType::kContactOnObject, new BoundaryPointFactor(traj_.object.shape, cfg_.contact_object_sigma), nullptr,
-        {v.x, v.p2}, {0});
+    Add(problem, FactorType::kContactOnObject, new BoundaryPointFactor(ContactBoundary(i, 1), cfg_.contact_object_sigma),
+        nullptr, {v.x, v.p2}, {0});
     if (cfg_.contact_finger == EstimatorConfig::ContactFinger::kWitness) {
       Add(problem, FactorType::kContactOnFinger, new ContactWitnessFactor(querier_b_, cfg_.contact_finger_sigma), nullptr,
           {v.x, v.e2, v.p2}, {0});

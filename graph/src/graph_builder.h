@@ -312,6 +312,15 @@ class GraphBuilder {
   bool two_fingers_ = false;  ///< finger 1 estimated (a two-finger push, not the baseline)
   bool finger_has_faces_ = false;  ///< finger 0's core is more than a point (not a disk)
   std::shared_ptr<const geometry::ShapePairQuerier> querier_b_;  ///< object and finger 1
+  /// The object without its holes: the boundary a finger outside the object touches. C's "p on
+  /// the object's boundary" measures p against it (ContactBoundary), not against the nearest
+  /// ring: a noisy contact row pulled p onto a hole's edge 2 cm inside the pushed face.
+  geometry::Shape object_outer_;
+  bool object_has_holes_ = false;
+  /// The shape whose boundary a contact of `finger` (0 or 1) at step i lies on: the outer
+  /// boundary while the finger's reference point is outside the hole-free object (as it is when
+  /// it pushes from outside), the whole shape when it is inside a hole.
+  const geometry::Shape& ContactBoundary(int i, int finger) const;
   bool fingers_ignored_ = false;  ///< the baseline left finger 1 out
   int steps_with_more_contacts_ = 0;  ///< steps with 3+ contact rows, modelled by their farthest two
   QuasiStaticGeometry qs_;
