@@ -148,7 +148,15 @@ push::Trajectory LoadEstimationInput(const std::string& path, const InputOverrid
   if (kind == InputKind::kTrajectory) {
     push::Trajectory t = io::LoadTrajectoryJson(path, notes);
     if (given.object_shape) t.object.shape = *given.object_shape;
-    if (given.finger_shape) t.finger.shape = *given.finger_shape;
+    if (given.finger_shape) {
+      t.finger.shape = *given.finger_shape;
+      // Said, not silent: the file's other fingers keep their own shapes.
+      if (notes != nullptr && !t.extra_fingers.empty())
+        notes->push_back("--finger replaces finger 0's shape only; the file's finger" +
+                         std::string(t.extra_fingers.size() > 1 ? "s 1 to " + std::to_string(t.extra_fingers.size())
+                                                                : " 1") +
+                         " keep" + std::string(t.extra_fingers.size() > 1 ? "" : "s") + " the file's shape");
+    }
     if (given.mass) t.object.mass = *given.mass;
     if (given.mu_surface) t.object.mu_surface = *given.mu_surface;
     return t;

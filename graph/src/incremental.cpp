@@ -560,7 +560,8 @@ struct OnlineEstimator::Impl {
     if (finger == 1 && two_fingers) return 4 + kind;
     throw GraphError("OnlineEstimator::" + std::string(call) + ": finger " + std::to_string(finger) +
                      " is out of range: the setup has " + (two_fingers ? "fingers 0 and 1" : "finger 0 only") +
-                     " (a second finger is the setup's extra_fingers[0])");
+                     " (a second finger is the setup's second finger: Trajectory::extra_fingers[0] in C++, "
+                     "setup[\"fingers\"][0] in Python)");
   }
 
   bool Accept(int stream, const char* name, double t, bool finite) {
@@ -571,7 +572,8 @@ struct OnlineEstimator::Impl {
     };
     if (finished) throw GraphError(where() + " arrived after Finish()");
     if (!declared[stream]) {
-      throw GraphError(where() + ": the stream was not declared in OnlineStreams (it decides contact gating and the load factor)");
+      throw GraphError(where() + ": the stream was not declared (OnlineStreams in C++, the contact_point= and force= "
+                       "arguments in Python): it decides contact gating and the load factor");
     }
     if (!std::isfinite(t) || !finite) throw GraphError(where() + " is not finite");
     // A second contact point at the same time is a second contact (a finger wedged in a notch);

@@ -174,6 +174,19 @@ TEST_F(CliTest, TheDefaultPushUnderThePapersNoiseBeatsTheRawData) {
   }
 }
 
+// --finger on a two-finger trajectory file replaces finger 0's shape only, and says so.
+TEST_F(CliTest, FingerOptionOnATwoFingerFileSaysWhatItReplaces) {
+  const std::string left = Write("left.json", R"({"polygons": [{"outer": [[0, 0.02]]}], "radius": 0.004})");
+  const std::string right = Write("right.json", R"({"polygons": [{"outer": [[0, -0.02]]}], "radius": 0.004})");
+  const std::string dir = fs::path(left).parent_path().string();
+  ToolRun r = Exec("simulate -o " + dir + "/two.json --fingers " + left + " " + right +
+                   " --offset 0 --push-angle 0 --distance 0.01");
+  ASSERT_EQ(r.status, 0) << r.err;
+  r = Exec("estimate " + dir + "/two.json --finger " + left + " --model cp -o " + dir + "/two_result.json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("--finger replaces finger 0's shape only"), std::string::npos) << r.err;
+}
+
 TEST_F(CliTest, PenetrationBadPoseIsOneClearLine) {
   const std::string object = Write("o.json", kSquareWithHole);
   const std::string finger = Write("f.json", R"({"polygons":[{"outer":[[0,0]]}],"radius":0.1})");
