@@ -1,6 +1,8 @@
 // Helpers shared by the evaluation's source files (internal.h).
 #include "internal.h"
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 
 namespace pushgraph::evaluation::internal {
@@ -10,6 +12,10 @@ std::uint64_t SplitMix(std::uint64_t x) {
   x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
   x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
   return x ^ (x >> 31);
+}
+
+std::string DumpJson(const nlohmann::json& value, int indent) {
+  return value.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 std::uint64_t Fnv1a(const std::string& s) {

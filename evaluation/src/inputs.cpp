@@ -152,10 +152,7 @@ push::Trajectory LoadEstimationInput(const std::string& path, const InputOverrid
       t.finger.shape = *given.finger_shape;
       // Said, not silent: the file's other fingers keep their own shapes.
       if (notes != nullptr && !t.extra_fingers.empty())
-        notes->push_back("--finger replaces finger 0's shape only; the file's finger" +
-                         std::string(t.extra_fingers.size() > 1 ? "s 1 to " + std::to_string(t.extra_fingers.size())
-                                                                : " 1") +
-                         " keep" + std::string(t.extra_fingers.size() > 1 ? "" : "s") + " the file's shape");
+        notes->push_back("--finger replaces finger 0's shape only; the file's other fingers keep their shapes");
     }
     if (given.mass) t.object.mass = *given.mass;
     if (given.mu_surface) t.object.mu_surface = *given.mu_surface;

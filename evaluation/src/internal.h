@@ -5,6 +5,8 @@
 #include <pushgraph/graph/estimator.h>
 #include <pushgraph/push/trajectory.h>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include <cstdint>
 #include <map>
 #include <string>
@@ -16,6 +18,10 @@ namespace pushgraph::evaluation::internal {
 std::uint64_t SplitMix(std::uint64_t x);
 /// FNV-1a hash of a name: an item's seed does not depend on its position in the list.
 std::uint64_t Fnv1a(const std::string& s);
+
+/// JSON text of `value` (indent < 0: one line). File names in it need not be UTF-8 (a Latin-1
+/// path): such bytes become U+FFFD instead of failing the whole output.
+std::string DumpJson(const nlohmann::json& value, int indent = -1);
 
 /// Whether `protocol` is among `protocols`.
 bool HasProtocol(const std::vector<Protocol>& protocols, Protocol protocol);

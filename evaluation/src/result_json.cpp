@@ -4,6 +4,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "internal.h"
+
 #include <fstream>
 
 namespace pushgraph::evaluation {
@@ -169,9 +171,7 @@ std::string ResultToJson(const graph::EstimationResult& r, int indent) {
     for (const auto& [k, v] : r.metrics) m[k] = v;
     j["metrics"] = std::move(m);
   }
-  // Warnings and notes quote file names, which need not be UTF-8 (a Latin-1 path): such bytes
-  // become U+FFFD rather than failing the whole result.
-  return j.dump(indent, ' ', false, Json::error_handler_t::replace);
+  return internal::DumpJson(j, indent);  // warnings quote file names, which need not be UTF-8
 }
 
 void SaveResultJson(const graph::EstimationResult& result, const std::string& path) {

@@ -5,6 +5,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "internal.h"
+
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -31,7 +33,7 @@ nlohmann::json RowJson(const EvaluationRow& r) {
 }  // namespace
 
 void AppendRow(const std::string& path, const EvaluationRow& row) {
-  const std::string line = RowJson(row).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+  const std::string line = internal::DumpJson(RowJson(row)) + "\n";
   FILE* f = std::fopen(path.c_str(), "a");
   if (f == nullptr) throw EvaluationError(path + ": cannot append a row");
   const bool ok = std::fwrite(line.data(), 1, line.size(), f) == line.size() && std::fflush(f) == 0 && ::fsync(fileno(f)) == 0;
@@ -46,8 +48,8 @@ void WriteRows(const std::string& path, const RowsHeader& header, const std::vec
                       {"shards", header.shards},
                       {"items_total", header.items_total},
                       {"settings", nlohmann::json::parse(header.settings_json)}};
-  out << h.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
-  for (const EvaluationRow& r : rows) out << RowJson(r).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
+  out << internal::DumpJson(h) << "\n";
+  for (const EvaluationRow& r : rows) out << internal::DumpJson(RowJson(r)) << "\n";
   if (const std::string error = geometry::WriteFileAtomically(path, out.str()); !error.empty()) throw EvaluationError(error);
 }
 

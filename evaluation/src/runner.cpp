@@ -136,7 +136,7 @@ std::string EvaluationOptions::SettingsJson() const {
                    {"mu_surface", simulation.object.mu_surface}, {"mu_contact", simulation.finger.mu_contact}};
   if (multi_contact_simulation.count > 0)
     j["simulate_multi_contact"] = {{"count", multi_contact_simulation.count}, {"name", multi_contact_simulation.name}};
-  return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  return internal::DumpJson(j);
 }
 
 

@@ -185,10 +185,7 @@ bool ChainSolver::Impl::Evaluate(std::vector<double>& h, Eigen::VectorXd& g, dou
     const Residual& r = residuals[k];
     // The cost functions are separate heap objects, each read once an iteration: without this,
     // the load of the next one's size was a third of this loop's own time (a cache miss).
-    if (k + 2 < residuals.size()) {
-      PrefetchForRead(residuals[k + 2].cost);
-      PrefetchForRead(residuals[k + 2].params.data());
-    }
+    if (k + 2 < residuals.size()) PrefetchForRead(residuals[k + 2].cost);
     if (r.constant) continue;
     const int m = r.cost->num_residuals();
     jacobians.assign(r.params.size(), nullptr);

@@ -278,17 +278,21 @@ Diagnostics Diagnose(const push::Trajectory& traj, Model model, const EstimatorC
     d.causes.push_back(fault.kind == "frozen" ? "frozen sensor: " + fault.detail : "spiking sensor: " + fault.detail);
   }
   // Beyond 1 mm and three standard errors of the median (1.25 sigma / sqrt(n)).
-  auto wrong_size = [&](const char* finger, double median, double mad, int samples) {
+  auto wrong_size = [&](int finger, double median, double mad, int samples) {
     const double median_error = 1.25 * 1.4826 * mad / std::sqrt(std::max(1, samples));
     if (samples < 20 || std::abs(median) <= std::max(1e-3, 3.0 * median_error)) return;
-    const std::string whose = std::string(finger) == "finger" ? "a finger" : std::string(finger) + "'s";
+    const std::string who = finger == 0 ? "finger" : "finger " + std::to_string(finger);
+    const std::string whose = finger == 0 ? "a finger" : who + "'s";
     d.causes.push_back(Format("wrong probe radius or object size: during contact the measured %s stays %.1f mm %s the "
                               "object's surface (median over %d samples); %s radius %.1f mm %s would touch",
-                              finger, std::abs(median) * 1e3, median > 0 ? "off" : "inside", samples, whose.c_str(),
+                              who.c_str(), std::abs(median) * 1e3, median > 0 ? "off" : "inside", samples, whose.c_str(),
                               std::abs(median) * 1e3, median > 0 ? "larger" : "smaller"));
   };
-  wrong_size("finger", d.measured_gap_median, d.measured_gap_mad, d.measured_samples);
-  for (const MeasuredContactGap& g : d.other_finger_gaps) wrong_size("finger 1", g.median, g.mad, g.samples);
+  wrong_size(0, d.measured_gap_median, d.measured_gap_mad, d.measured_samples);
+  for (std::size_t k = 0; k < d.other_finger_gaps.size(); ++k) {
+    const MeasuredContactGap& g = d.other_finger_gaps[k];
+    wrong_size(static_cast<int>(k) + 1, g.median, g.mad, g.samples);
+  }
   if (d.penetration_share > 0.2) {
     d.causes.push_back(Format("the finger is inside the object in %.0f%% of the steps (by more than %.1f mm): shape frame, "
                               "units, probe radius, or a finger touching two walls at once (several contacts)?",
