@@ -75,7 +75,7 @@ std::string TrajectorySvg(const push::Trajectory& trajectory, const graph::Estim
   for (std::size_t i : marked) {
     estimated_footprints.push_back(WorldRings(trajectory.object.shape, states[i].object_pose));
     finger_shapes.push_back(WorldRings(trajectory.finger.shape, states[i].finger_pose));
-    // Every other finger (two-finger pushes) at its own estimated pose.
+    // Every other finger (pushes with several) at its own estimated pose.
     for (const graph::FingerPoseEstimate& f : states[i].other_fingers)
       if (f.finger >= 1 && f.finger <= static_cast<int>(trajectory.extra_fingers.size()))
         finger_shapes.push_back(WorldRings(trajectory.extra_fingers[f.finger - 1].finger.shape, f.pose));
@@ -120,7 +120,7 @@ std::string TrajectorySvg(const push::Trajectory& trajectory, const graph::Estim
     const double tolerance = 0.5 * std::max(1e-9, (states.back().t - states.front().t) / std::max<double>(1, n - 1));
     for (std::size_t i : marked) {
       const graph::StateEstimate& s = states[i];
-      // Each contact's own force where a step has several (two contacts, two fingers).
+      // Each contact's own force where a step has several (two contacts, several fingers).
       for (const graph::ContactEstimate& c : s.contacts)
         if (c.force) arrows_estimated.push_back({c.point, *c.force});
       if (s.contacts.empty() && s.force && s.contact) arrows_estimated.push_back({*s.contact, *s.force});

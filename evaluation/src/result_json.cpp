@@ -69,7 +69,7 @@ std::string ResultToJson(const graph::EstimationResult& r, int indent) {
     }
     if (!s.contacts.empty()) {
       // Two contacts of finger 0: each with its point, force and covariances ("force" above is
-      // their sum); two fingers: every contact, with its finger ("force" is finger 0's own).
+      // their sum); several fingers: every contact, with its finger ("force" is finger 0's own).
       Json contacts = Json::array();
       for (const graph::ContactEstimate& c : s.contacts) {
         Json e;

@@ -61,15 +61,24 @@ std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder, c
       // Name the state, then try the QR on J (it copes with worse conditioning than J^T J).
       marginals_error = marginals.error();
       const double* bad = marginals.failed_block();
-      const char* names[] = {"object pose", "finger pose", "contact point", "force", "second contact point",
-                             "second contact force", "finger 1 pose"};
       for (int i = 0; bad != nullptr && i < static_cast<int>(builder.steps().size()); ++i) {
         const StepVars& v = builder.vars()[i];
-        const double* blocks[] = {v.x, v.e, v.p, v.f, v.p2, v.f2, v.e2};
-        for (int q = 0; q < 7; ++q) {
-          if (blocks[q] != bad) continue;
+        std::vector<std::pair<const double*, std::string>> blocks{
+            {v.x, "object pose"}, {v.e, "finger pose"}, {v.p, "contact point"}, {v.f, "force"},
+            {v.p2, builder.several_fingers() ? "finger 1 contact point" : "second contact point"},
+            {v.f2, builder.several_fingers() ? "finger 1 force" : "second contact force"}};
+        for (int k = 1; k < builder.num_fingers(); ++k) {
+          const std::string finger = "finger " + std::to_string(k);
+          blocks.emplace_back(builder.FingerPose(i, k), finger + " pose");
+          if (k >= 2) {
+            blocks.emplace_back(builder.FingerContact(i, k), finger + " contact point");
+            blocks.emplace_back(builder.FingerForce(i, k), finger + " force");
+          }
+        }
+        for (const auto& [block, name] : blocks) {
+          if (block != bad) continue;
           marginals_error += " [step " + std::to_string(i) + ", t = " + std::to_string(builder.steps()[i].t) +
-                             ", " + names[q] + "]";
+                             ", " + name + "]";
         }
       }
       if (bad != nullptr && bad == builder.c_block()) marginals_error += " [c]";
@@ -118,17 +127,18 @@ std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder, c
       get(v.f, c2.data());
       s.force_cov = Eigen::Matrix2d(c2);
     }
-    if (builder.two_fingers()) {
-      // Finger 1's pose; each finger's contact and force (their own: each finger has a sensor).
-      if (!s.other_fingers.empty() && get(v.e2, c3.data())) s.other_fingers[0].pose_cov = Eigen::Matrix3d(c3);
+    if (builder.several_fingers()) {
+      // Every finger's pose; each finger's contact and force (their own: each finger has a sensor).
+      for (FingerPoseEstimate& f : s.other_fingers)
+        if (get(builder.FingerPose(i, f.finger), c3.data())) f.pose_cov = Eigen::Matrix3d(c3);
       for (ContactEstimate& c : s.contacts) {
         if (c.finger == 0) {
           c.point_cov = s.contact_cov;
           c.force_cov = s.force_cov;
           continue;
         }
-        if (get(v.p2, c2.data())) c.point_cov = Eigen::Matrix2d(c2);
-        if (builder.HasSecondForceVars(i) && get(v.f2, c2.data())) c.force_cov = Eigen::Matrix2d(c2);
+        if (get(builder.FingerContact(i, c.finger), c2.data())) c.point_cov = Eigen::Matrix2d(c2);
+        if (c.force && get(builder.FingerForce(i, c.finger), c2.data())) c.force_cov = Eigen::Matrix2d(c2);
       }
     } else if (builder.HasSecondContact(i) && s.contacts.size() == 2) {
       // Each contact's own; the net force's would need the cross-covariance of f and f2.

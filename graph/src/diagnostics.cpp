@@ -182,20 +182,20 @@ Diagnostics Diagnose(const push::Trajectory& traj, Model model, const EstimatorC
   // the nearer wall's where the finger sits between two, as wedged in a notch: biased inward by
   // about half the noise, 1.1 mm at 2 mm and 3.0 mm at 5 mm on the notched block's V, which
   // named a correct probe radius wrong.)
-  // Each finger's (finger 1 of a two-finger push with its own shape and pose samples).
+  // Each finger's (fingers 1, 2, ... of a push with several, with their own shapes and pose samples).
   auto measured_gap = [&](int finger, MeasuredContactGap* out) {
-    const geometry::ShapePairQuerier* querier = finger == 0 ? &builder.querier() : builder.second_finger_querier();
-    if (querier == nullptr) return;
-    const auto& poses = finger == 0 ? traj.measured.finger_pose : traj.extra_fingers[0].measured.finger_pose;
+    if (finger >= builder.num_fingers()) return;
+    const geometry::ShapePairQuerier* querier = &builder.finger_querier(finger);
+    const auto& poses = builder.FingerPoseRows(finger);
     std::vector<double> mg;
     for (int i = 0; i < n; ++i) {
       const Step& step = builder.steps()[i];
-      const bool touching = finger == 0 ? step.in_contact : step.in_contact_b;
-      const int sample = finger == 0 ? step.finger : step.finger_b;
+      const bool touching = builder.FingerTouches(i, finger);
+      const int sample = finger == 0 ? step.finger : step.others[finger - 1].finger;
       if (!touching || sample < 0) continue;
-      if (finger == 1 && result.states[i].other_fingers.empty()) continue;
+      if (finger >= 1 && static_cast<int>(result.states[i].other_fingers.size()) < finger) continue;
       const Pose2 placed = geometry::Compose(result.states[i].object_pose, F);
-      const Pose2& estimated = finger == 0 ? result.states[i].finger_pose : result.states[i].other_fingers[0].pose;
+      const Pose2& estimated = finger == 0 ? result.states[i].finger_pose : result.states[i].other_fingers[finger - 1].pose;
       geometry::ShapePairJacobians J;
       const double sd = querier->Query(placed, estimated, &J).signed_distance;
       Eigen::Vector3d delta = poses[sample].pose.vector() - estimated.vector();
@@ -216,9 +216,9 @@ Diagnostics Diagnose(const push::Trajectory& traj, Model model, const EstimatorC
     d.measured_gap_median = gap.median;
     d.measured_gap_mad = gap.mad;
     d.measured_noise = 1.4826 * gap.mad;
-    if (!traj.extra_fingers.empty()) {
+    for (std::size_t k = 1; k <= traj.extra_fingers.size(); ++k) {
       d.other_finger_gaps.emplace_back();
-      measured_gap(1, &d.other_finger_gaps.back());
+      measured_gap(static_cast<int>(k), &d.other_finger_gaps.back());
     }
   }
 

@@ -650,7 +650,7 @@ namespace {
 // d r / d f_max; with J_c: d r / d c.
 bool EvaluateLoad(const QuasiStaticGeometry& geometry, double f_max, double eps_v, double eps_f, double w,
                   const QuasiStaticTerms& t, double* residuals, double** jacobians, double* J_fmax, double* J_c,
-                  const TwoContactTerms* second = nullptr) {
+                  const TwoContactTerms* second = nullptr, Eigen::RowVector3d* J_r_g_out = nullptr) {
   if (!(f_max > 0.0)) return false;
   const double v2 = t.V.squaredNorm(), e2 = eps_v * eps_v;
   const double sv = v2 / (v2 + e2);
@@ -666,6 +666,7 @@ bool EvaluateLoad(const QuasiStaticGeometry& geometry, double f_max, double eps_
   if (jacobians[3] != nullptr) Eigen::Map<Eigen::RowVector2d>{jacobians[3]} = J_r_g * t.J_g_f;
   if (second != nullptr && jacobians[4] != nullptr) Eigen::Map<Eigen::RowVector2d>{jacobians[4]} = J_r_g * second->J_g_p2;
   if (second != nullptr && jacobians[5] != nullptr) Eigen::Map<Eigen::RowVector2d>{jacobians[5]} = J_r_g * second->J_g_f2;
+  if (J_r_g_out != nullptr) *J_r_g_out = J_r_g;
   if (J_fmax != nullptr) *J_fmax = -w * sv * b / (f_max * f_max);
   // V'_z = c omega and g'_z = tau / c: dV'/dc = (0, 0, V'_z / c), dg'/dc = (0, 0, -g'_z / c).
   if (J_c != nullptr) *J_c = J_r_V(2) * (t.V.z() / geometry.c) - J_r_g(2) * (t.g.z() / geometry.c);
@@ -688,6 +689,94 @@ bool LimitSurfaceLoadTwoContactFactor::Evaluate(double const* const* parameters,
                                                 double** jacobians) const {
   const TwoContactTerms tc = ComputeTwoContactTerms(geometry_, parameters);
   return EvaluateLoad(geometry_, f_max_, eps_v_, eps_f_, w_, tc.t, residuals, jacobians, nullptr, nullptr, &tc);
+}
+
+namespace {
+// The terms of any number of contacts: V' and its Jacobians from the first, g' the sum (in
+// contact order, as ComputeTwoContactTerms adds its two), each contact's J_g_p and J_g_f.
+struct MultiContactTerms {
+  QuasiStaticTerms t;
+  std::vector<Eigen::Matrix<double, 3, 2>> J_g_p, J_g_f;
+};
+MultiContactTerms ComputeMultiContactTerms(const QuasiStaticGeometry& geometry, int contacts,
+                                           double const* const* parameters) {
+  const Pose2 x_prev = PoseFrom(parameters[0]), x = PoseFrom(parameters[1]);
+  MultiContactTerms out;
+  for (int k = 0; k < contacts; ++k) {
+    const double* p = parameters[2 + 2 * k];
+    const double* f = parameters[3 + 2 * k];
+    const QuasiStaticTerms c = ComputeQuasiStaticTerms(geometry, x_prev, x, Vec2(p[0], p[1]), Vec2(f[0], f[1]));
+    if (k == 0) {
+      out.t = c;
+    } else {
+      out.t.g += c.g;
+      out.t.J_g_x += c.J_g_x;
+    }
+    out.J_g_p.push_back(c.J_g_p);
+    out.J_g_f.push_back(c.J_g_f);
+  }
+  return out;
+}
+
+void SetMultiContactSizes(std::vector<int32_t>* sizes, int contacts, const char* what) {
+  if (contacts < 1) throw GraphError(std::string(what) + ": needs at least one contact");
+  sizes->assign({3, 3});
+  for (int k = 0; k < contacts; ++k) sizes->insert(sizes->end(), {2, 2});
+}
+}  // namespace
+
+QuasiStaticMultiContactFactor::QuasiStaticMultiContactFactor(const QuasiStaticGeometry& geometry, int contacts,
+                                                             double eps_velocity, double eps_force, double sigma)
+    : geometry_(geometry), contacts_(contacts), eps_v_(eps_velocity), eps_f_(eps_force),
+      w_(CheckedWeight(sigma, "quasi-static")) {
+  CheckGeometry(geometry_);
+  CheckEps(eps_v_, eps_f_, "quasi-static");
+  set_num_residuals(3);
+  SetMultiContactSizes(mutable_parameter_block_sizes(), contacts, "quasi-static factor");
+}
+
+bool QuasiStaticMultiContactFactor::Evaluate(double const* const* parameters, double* residuals,
+                                             double** jacobians) const {
+  const MultiContactTerms mc = ComputeMultiContactTerms(geometry_, contacts_, parameters);
+  Eigen::Matrix3d J_r_V, J_r_g;
+  const bool jac = jacobians != nullptr;
+  Eigen::Map<Eigen::Vector3d>{residuals} =
+      NormalizedCross(mc.t, eps_v_, eps_f_, w_, jac ? &J_r_V : nullptr, jac ? &J_r_g : nullptr);
+  if (!jac) return true;
+  if (jacobians[0] != nullptr) Eigen::Map<RowMat33>{jacobians[0]} = J_r_V * mc.t.J_V_xprev;
+  if (jacobians[1] != nullptr) Eigen::Map<RowMat33>{jacobians[1]} = J_r_V * mc.t.J_V_x + J_r_g * mc.t.J_g_x;
+  for (int k = 0; k < contacts_; ++k) {
+    if (jacobians[2 + 2 * k] != nullptr) Eigen::Map<RowMat32>{jacobians[2 + 2 * k]} = J_r_g * mc.J_g_p[k];
+    if (jacobians[3 + 2 * k] != nullptr) Eigen::Map<RowMat32>{jacobians[3 + 2 * k]} = J_r_g * mc.J_g_f[k];
+  }
+  return true;
+}
+
+LimitSurfaceLoadMultiContactFactor::LimitSurfaceLoadMultiContactFactor(const QuasiStaticGeometry& geometry,
+                                                                       int contacts, double f_max,
+                                                                       double eps_velocity, double eps_force,
+                                                                       double sigma)
+    : geometry_(geometry), contacts_(contacts), f_max_(f_max), eps_v_(eps_velocity), eps_f_(eps_force),
+      w_(CheckedLoadWeight(geometry, f_max, eps_velocity, eps_force, sigma)) {
+  set_num_residuals(1);
+  SetMultiContactSizes(mutable_parameter_block_sizes(), contacts, "limit-surface load factor");
+}
+
+bool LimitSurfaceLoadMultiContactFactor::Evaluate(double const* const* parameters, double* residuals,
+                                                  double** jacobians) const {
+  const MultiContactTerms mc = ComputeMultiContactTerms(geometry_, contacts_, parameters);
+  Eigen::RowVector3d J_r_g;
+  // The first contact's blocks through EvaluateLoad, every other's from d r / d g'.
+  double* first[4] = {nullptr, nullptr, nullptr, nullptr};
+  for (int k = 0; jacobians != nullptr && k < 4; ++k) first[k] = jacobians[k];
+  if (!EvaluateLoad(geometry_, f_max_, eps_v_, eps_f_, w_, mc.t, residuals, jacobians != nullptr ? first : nullptr,
+                    nullptr, nullptr, nullptr, &J_r_g))
+    return false;
+  for (int k = 1; jacobians != nullptr && k < contacts_; ++k) {
+    if (jacobians[2 + 2 * k] != nullptr) Eigen::Map<Eigen::RowVector2d>{jacobians[2 + 2 * k]} = J_r_g * mc.J_g_p[k];
+    if (jacobians[3 + 2 * k] != nullptr) Eigen::Map<Eigen::RowVector2d>{jacobians[3 + 2 * k]} = J_r_g * mc.J_g_f[k];
+  }
+  return true;
 }
 
 bool LimitSurfaceLoadFactor::Evaluate(double const* const* parameters, double* residuals,

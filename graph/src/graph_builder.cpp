@@ -63,10 +63,11 @@ GraphBuilder::GraphBuilder(const push::Trajectory& trajectory, Model model, cons
     streams_.contact_point = streams_.contact_point || !f.measured.contact_point.empty();
     streams_.force = streams_.force || !f.measured.force.empty();
   }
-  // A second finger: estimated by CP, SDF and QS; the baseline (one contact, as published)
-  // leaves it out and says so.
-  two_fingers_ = !traj_.extra_fingers.empty() && model_ != Model::kYu;
+  // Several fingers: estimated by CP, SDF and QS; the baseline (one contact, as published)
+  // leaves fingers 1, 2, ... out and says so.
+  other_fingers_ = model_ == Model::kYu ? 0 : static_cast<int>(traj_.extra_fingers.size());
   fingers_ignored_ = !traj_.extra_fingers.empty() && model_ == Model::kYu;
+  used_.assign(4 + 3 * other_fingers_, 0);
   AppendSteps(INFINITY);
   SetUpShapes(std::move(querier));
 }
@@ -78,8 +79,9 @@ GraphBuilder::GraphBuilder(const push::Trajectory& trajectory, Model model,
   if (traj_.object.shape.empty()) throw GraphError("trajectory: object.shape is missing or empty");
   if (traj_.finger.shape.empty()) throw GraphError("trajectory: finger.shape is missing or empty");
   ValidateFingers(traj_);
-  two_fingers_ = !traj_.extra_fingers.empty() && model_ != Model::kYu;
+  other_fingers_ = model_ == Model::kYu ? 0 : static_cast<int>(traj_.extra_fingers.size());
   fingers_ignored_ = !traj_.extra_fingers.empty() && model_ == Model::kYu;
+  used_.assign(4 + 3 * other_fingers_, 0);
   SetUpShapes(nullptr);
 }
 
@@ -95,11 +97,10 @@ int GraphBuilder::AppendSteps(double until) {
   take(m.finger_pose, 1);
   take(m.contact_point, 2);
   take(m.force, 3);
-  if (two_fingers_) {
-    const push::FingerStreams& b = traj_.extra_fingers[0].measured;
-    take(b.finger_pose, 4);
-    take(b.contact_point, 5);
-    take(b.force, 6);
+  for (int k = 1; k <= other_fingers_; ++k) {
+    take(FingerPoseRows(k), 3 * k + 1);
+    take(ContactRows(k), 3 * k + 2);
+    take(ForceRows(k), 3 * k + 3);
   }
   std::sort(events.begin(), events.end());
   const std::size_t first_new = steps_.size();
@@ -108,6 +109,7 @@ int GraphBuilder::AppendSteps(double until) {
     if (steps_.size() == first_new || t - steps_.back().t > 1e-9) {
       steps_.push_back(Step{});
       steps_.back().t = t;
+      steps_.back().others.resize(other_fingers_);
     }
     Step& s = steps_.back();
     if (stream == 2 && s.contact >= 0) {
@@ -116,8 +118,14 @@ int GraphBuilder::AppendSteps(double until) {
       if (s.contact2 < 0) s.contact2 = index;
       continue;
     }
-    int* slots[] = {&s.object, &s.finger, &s.contact, &s.force, &s.finger_b, &s.contact_b, &s.force_b};
-    *slots[stream] = index;
+    if (stream < 4) {
+      int* slots[] = {&s.object, &s.finger, &s.contact, &s.force};
+      *slots[stream] = index;
+    } else {
+      Step::OtherFinger& o = s.others[(stream - 1) / 3 - 1];
+      int* slots[] = {&o.finger, &o.contact, &o.force};
+      *slots[(stream - 1) % 3] = index;
+    }
   }
   // Three or more contact rows at one time (a flat pusher face along a face broken by a notch):
   // the two farthest apart. For contacts along one straight finger face, which share its normal,
@@ -149,10 +157,7 @@ int GraphBuilder::AppendSteps(double until) {
   };
   for (std::size_t i = first_new; i < steps_.size(); ++i) {
     Step& s = steps_[i];
-    if (two_fingers_) {
-      const push::FingerStreams& b = traj_.extra_fingers[0].measured;
-      s.in_contact_b = touching(b.contact_point, b.force, s.t);
-    }
+    for (int k = 1; k <= other_fingers_; ++k) s.others[k - 1].in_contact = touching(ContactRows(k), ForceRows(k), s.t);
     s.in_contact = touching(m.contact_point, m.force, s.t);
     if (s.in_contact && streams_.contact_point) {
       // Two contacts while the nearest contact time has two rows.
@@ -168,6 +173,7 @@ int GraphBuilder::AppendSteps(double until) {
     }
   }
   vars_.resize(steps_.size());
+  if (other_fingers_ > 1) more_vars_.resize(steps_.size() * (other_fingers_ - 1));
   return static_cast<int>(steps_.size() - first_new);
 }
 
@@ -196,7 +202,7 @@ void GraphBuilder::SetUpShapes(std::shared_ptr<const geometry::ShapePairQuerier>
   }
   if (object_has_holes_) object_outer_ = geometry::Shape::FromPolygons(outer, traj_.object.shape.radius());
   finger_has_faces_ = !(traj_.finger.shape.is_degenerate_core() && traj_.finger.shape.num_vertices() <= 1);
-  if (two_fingers_) querier_b_ = MakeQuerier(traj_, traj_.extra_fingers[0].finger.shape, cfg_);
+  for (int k = 1; k <= other_fingers_; ++k) other_queriers_.push_back(MakeQuerier(traj_, FingerShape(k), cfg_));
   if (ModelHasForce(model_)) qs_ = QuasiStaticGeometryFor(traj_, cfg_);
   if (traj_.object.mass > 0.0 && traj_.object.mu_surface > 0.0) {
     mu_surface_ = traj_.object.mu_surface;
@@ -376,7 +382,7 @@ void GraphBuilder::Initialize(int i, double limit) {
     continuous(v.x, prev->x);
     continuous(v.e, prev->e);
   }
-  if (two_fingers_) InitializeSecondFinger(i, limit);
+  for (int k = 1; k <= other_fingers_; ++k) InitializeOtherFinger(i, k, limit);
   if (s.in_contact) {
     if (s.contact >= 0) {
       const Vec2 c = m.contact_point[s.contact].point;
@@ -478,7 +484,7 @@ bool GraphBuilder::BetweenWalls(int i) const {
 }
 
 int GraphBuilder::DetectSecondContacts(int first, int last) {
-  if (streams_.contact_point || model_ == Model::kYu || two_fingers_ || !(cfg_.second_contact_tolerance > 0.0)) return 0;
+  if (streams_.contact_point || model_ == Model::kYu || other_fingers_ > 0 || !(cfg_.second_contact_tolerance > 0.0)) return 0;
   int changed = 0;
   for (int i = first; i < last; ++i) {
     Step& s = steps_[i];
@@ -579,54 +585,58 @@ std::pair<int, int> GraphBuilder::FarthestContactRows(int k) const {
 const geometry::Shape& GraphBuilder::ContactBoundary(int i, int finger) const {
   if (!object_has_holes_) return traj_.object.shape;
   const StepVars& v = vars_[i];
-  const double* e = finger == 0 ? v.e : v.e2;
+  const double* e = FingerPose(i, finger);
   const Vec2 local = geometry::InverseAct(Pose2{v.x[0], v.x[1], v.x[2]}, Vec2(e[0], e[1]));
   return geometry::QueryPoint(object_outer_, local).signed_distance < 0.0 ? traj_.object.shape : object_outer_;
 }
 
-Vec2 GraphBuilder::SecondFingerNearestObjectPoint(int i) const {
-  // The object point nearest finger 1's shape (its reference point may lie off the shape).
+Vec2 GraphBuilder::FingerNearestObjectPoint(int i, int k) const {
+  // The object point nearest finger k's shape (its reference point may lie off the shape).
   const StepVars& v = vars_[i];
-  return querier_b_->Query(Pose2{v.x[0], v.x[1], v.x[2]}, Pose2{v.e2[0], v.e2[1], v.e2[2]}).object_point;
+  const double* e = FingerPose(i, k);
+  return finger_querier(k).Query(Pose2{v.x[0], v.x[1], v.x[2]}, Pose2{e[0], e[1], e[2]}).object_point;
 }
 
-void GraphBuilder::InitializeSecondFinger(int i, double limit) {
+void GraphBuilder::InitializeOtherFinger(int i, int k, double limit) {
   const bool causal = std::isfinite(limit);
-  const push::FingerStreams& b = traj_.extra_fingers[0].measured;
-  const Step& s = steps_[i];
-  StepVars& v = vars_[i];
-  const StepVars* prev = i > 0 ? &vars_[i - 1] : nullptr;
-  const Pose2 e = s.finger_b >= 0 ? b.finger_pose[s.finger_b].pose : InterpolatePose(b.finger_pose, s.t, limit);
-  v.e2[0] = e.x;
-  v.e2[1] = e.y;
-  v.e2[2] = prev != nullptr ? prev->e2[2] + geometry::WrapAngle(e.theta - prev->e2[2]) : e.theta;
-  if (!s.in_contact_b) return;
-  const bool prev_touching = causal && prev != nullptr && steps_[i - 1].in_contact_b;
+  const Step::OtherFinger& s = steps_[i].others[k - 1];
+  const std::vector<push::PoseSample>& poses = FingerPoseRows(k);
+  const std::vector<push::PointSample>& contacts = ContactRows(k);
+  const std::vector<push::ForceSample>& forces = ForceRows(k);
+  const StepVars& v = vars_[i];
+  double* pose = FingerPose(i, k);
+  const double* prev_pose = i > 0 ? FingerPose(i - 1, k) : nullptr;
+  const Pose2 e = s.finger >= 0 ? poses[s.finger].pose : InterpolatePose(poses, steps_[i].t, limit);
+  pose[0] = e.x;
+  pose[1] = e.y;
+  pose[2] = prev_pose != nullptr ? prev_pose[2] + geometry::WrapAngle(e.theta - prev_pose[2]) : e.theta;
+  if (!s.in_contact) return;
+  const bool prev_touching = causal && i > 0 && FingerTouches(i - 1, k);
   Vec2 c;
-  if (s.contact_b >= 0) {
-    c = b.contact_point[s.contact_b].point;
-  } else if (!b.contact_point.empty() && !causal) {
-    c = push::StreamValueClamped(b.contact_point, s.t, [](const push::PointSample& a) { return Vec2(a.point); });
+  if (s.contact >= 0) {
+    c = contacts[s.contact].point;
+  } else if (!contacts.empty() && !causal) {
+    c = push::StreamValueClamped(contacts, steps_[i].t, [](const push::PointSample& a) { return Vec2(a.point); });
   } else if (prev_touching) {
-    c = Vec2(prev->p2[0], prev->p2[1]);
+    c = Vec2(FingerContact(i - 1, k)[0], FingerContact(i - 1, k)[1]);
   } else {
-    c = SecondFingerNearestObjectPoint(i);
+    c = FingerNearestObjectPoint(i, k);
   }
-  v.p2[0] = c.x();
-  v.p2[1] = c.y();
+  FingerContact(i, k)[0] = c.x();
+  FingerContact(i, k)[1] = c.y();
   Vec2 f;
-  if (s.force_b >= 0) {
-    f = b.force[s.force_b].force;
-  } else if (!b.force.empty() && !causal) {
-    f = push::StreamValueClamped(b.force, s.t, [](const push::ForceSample& a) { return Vec2(a.force); });
+  if (s.force >= 0) {
+    f = forces[s.force].force;
+  } else if (!forces.empty() && !causal) {
+    f = push::StreamValueClamped(forces, steps_[i].t, [](const push::ForceSample& a) { return Vec2(a.force); });
   } else if (prev_touching) {
-    f = Vec2(prev->f2[0], prev->f2[1]);
+    f = Vec2(FingerForce(i - 1, k)[0], FingerForce(i - 1, k)[1]);
   } else {
     const Vec2 d = Vec2(v.x[0], v.x[1]) - c;
     f = d.norm() > 0 ? Vec2(0.1 * d.normalized()) : Vec2(0.1, 0.0);
   }
-  v.f2[0] = f.x();
-  v.f2[1] = f.y();
+  FingerForce(i, k)[0] = f.x();
+  FingerForce(i, k)[1] = f.y();
 }
 
 void GraphBuilder::InitializeSecondContact(int i, bool causal) {
@@ -675,11 +685,12 @@ int GraphBuilder::SmoothInitialMotion(int max_iterations, double function_tolera
   for (int i = std::max(0, first - 2); i < n; ++i) {
     if (!problem.HasParameterBlock(vars_[i].x)) problem.AddParameterBlock(vars_[i].x, 3);
     if (!problem.HasParameterBlock(vars_[i].e)) problem.AddParameterBlock(vars_[i].e, 3);
-    if (two_fingers_ && !problem.HasParameterBlock(vars_[i].e2)) problem.AddParameterBlock(vars_[i].e2, 3);
+    for (int k = 1; k <= other_fingers_; ++k)
+      if (!problem.HasParameterBlock(FingerPose(i, k))) problem.AddParameterBlock(FingerPose(i, k), 3);
     if (i < first) {
       problem.SetParameterBlockConstant(vars_[i].x);
       problem.SetParameterBlockConstant(vars_[i].e);
-      if (two_fingers_) problem.SetParameterBlockConstant(vars_[i].e2);
+      for (int k = 1; k <= other_fingers_; ++k) problem.SetParameterBlockConstant(FingerPose(i, k));
     }
   }
   const SolveOutcome outcome = Solve(problem, max_iterations, function_tolerance, "motion-only initialization");
@@ -692,13 +703,12 @@ int GraphBuilder::SmoothInitialMotion(int max_iterations, double function_tolera
       v.p[1] = q.closest_point.y();
     }
   }
-  if (two_fingers_ && !streams_.contact_point) {  // finger 1 has no tactile sensor either
+  for (int k = 1; k <= other_fingers_ && !streams_.contact_point; ++k) {  // no finger has a tactile sensor
     for (int i = first; i < n; ++i) {
-      if (!steps_[i].in_contact_b) continue;
-      StepVars& v = vars_[i];
-      const Vec2 c = SecondFingerNearestObjectPoint(i);
-      v.p2[0] = c.x();
-      v.p2[1] = c.y();
+      if (!FingerTouches(i, k)) continue;
+      const Vec2 c = FingerNearestObjectPoint(i, k);
+      FingerContact(i, k)[0] = c.x();
+      FingerContact(i, k)[1] = c.y();
     }
   }
   return outcome.iterations;
@@ -740,14 +750,20 @@ void GraphBuilder::AddFactors(ceres::Problem& problem, int i, int parts) {
   if (parts & kKinematic) {
     problem.AddParameterBlock(v.x, 3);
     problem.AddParameterBlock(v.e, 3);
-    if (two_fingers_) problem.AddParameterBlock(v.e2, 3);
+    for (int k = 1; k <= other_fingers_; ++k) problem.AddParameterBlock(FingerPose(i, k), 3);
     if (s.in_contact) problem.AddParameterBlock(v.p, 2);
     if (HasSecondContact(i)) problem.AddParameterBlock(v.p2, 2);
+    for (int k = 2; k <= other_fingers_; ++k)
+      if (FingerTouches(i, k)) problem.AddParameterBlock(FingerContact(i, k), 2);
     AddKinematicFactors(problem, i);
   }
-  if ((parts & kDynamic) && (HasForceVars(i) || HasSecondForceVars(i))) {
+  bool more_forces = false;
+  for (int k = 2; k <= other_fingers_; ++k) more_forces = more_forces || (FingerTouches(i, k) && ModelHasForce(model_));
+  if ((parts & kDynamic) && (HasForceVars(i) || HasSecondForceVars(i) || more_forces)) {
     if (HasForceVars(i)) problem.AddParameterBlock(v.f, 2);
     if (HasSecondForceVars(i)) problem.AddParameterBlock(v.f2, 2);
+    for (int k = 2; k <= other_fingers_; ++k)
+      if (FingerTouches(i, k)) problem.AddParameterBlock(FingerForce(i, k), 2);
     AddDynamicFactors(problem, i);
   }
 }
@@ -833,35 +849,36 @@ void GraphBuilder::AddKinematicFactors(ceres::Problem& problem, int i) {
   } else {
     AddConstantVelocityFactors(problem, i);
   }
-  if (two_fingers_) AddSecondFingerKinematicFactors(problem, i);
+  for (int k = 1; k <= other_fingers_; ++k) AddOtherFingerKinematicFactors(problem, i, k);
 }
 
-void GraphBuilder::AddSecondFingerKinematicFactors(ceres::Problem& problem, int i) {
-  // Finger 1's own M, C, S and touching, with its own shape (querier_b_), its contact p2.
+void GraphBuilder::AddOtherFingerKinematicFactors(ceres::Problem& problem, int i, int k) {
+  // Finger k's own M of its contact, C, S and touching, with its own shape and querier.
   adding_step_ = i;
-  const push::FingerStreams& b = traj_.extra_fingers[0].measured;
-  const geometry::Shape& shape = traj_.extra_fingers[0].finger.shape;
-  const Step& s = steps_[i];
+  const Step::OtherFinger& s = steps_[i].others[k - 1];
+  const std::shared_ptr<const geometry::ShapePairQuerier>& querier = other_queriers_[k - 1];
   StepVars& v = vars_[i];
-  if (s.in_contact_b) {
-    if (s.contact_b >= 0) {
-      Add(problem, FactorType::kContactPoint, new VectorMeasurementFactor(b.contact_point[s.contact_b].point, cfg_.measurement.contact),
-          MakeLoss(cfg_.contact_loss), {v.p2});
+  double* e = FingerPose(i, k);
+  double* p = FingerContact(i, k);
+  if (s.in_contact) {
+    if (s.contact >= 0) {
+      Add(problem, FactorType::kContactPoint, new VectorMeasurementFactor(ContactRows(k)[s.contact].point, cfg_.measurement.contact),
+          MakeLoss(cfg_.contact_loss), {p});
     }
-    Add(problem, FactorType::kContactOnObject, new BoundaryPointFactor(ContactBoundary(i, 1), cfg_.contact_object_sigma),
-        nullptr, {v.x, v.p2}, {0});
+    Add(problem, FactorType::kContactOnObject, new BoundaryPointFactor(ContactBoundary(i, k), cfg_.contact_object_sigma),
+        nullptr, {v.x, p}, {0});
     if (cfg_.contact_finger == EstimatorConfig::ContactFinger::kWitness) {
-      Add(problem, FactorType::kContactOnFinger, new ContactWitnessFactor(querier_b_, cfg_.contact_finger_sigma), nullptr,
-          {v.x, v.e2, v.p2}, {0});
+      Add(problem, FactorType::kContactOnFinger, new ContactWitnessFactor(querier, cfg_.contact_finger_sigma), nullptr,
+          {v.x, e, p}, {0});
     } else {
-      Add(problem, FactorType::kContactOnFinger, new BoundaryPointFactor(shape, cfg_.contact_finger_sigma), nullptr, {v.e2, v.p2});
+      Add(problem, FactorType::kContactOnFinger, new BoundaryPointFactor(FingerShape(k), cfg_.contact_finger_sigma), nullptr, {e, p});
     }
     if (model_ == Model::kQs) {
-      Add(problem, FactorType::kTouching, new TouchingFactor(querier_b_, cfg_.touching_sigma), nullptr, {v.x, v.e2}, {0});
+      Add(problem, FactorType::kTouching, new TouchingFactor(querier, cfg_.touching_sigma), nullptr, {v.x, e}, {0});
     }
   }
   if (model_ == Model::kSdf || model_ == Model::kQs) {
-    Add(problem, FactorType::kIntersection, new IntersectionFactor(querier_b_, cfg_.intersection_sigma), nullptr, {v.x, v.e2}, {0});
+    Add(problem, FactorType::kIntersection, new IntersectionFactor(querier, cfg_.intersection_sigma), nullptr, {v.x, e}, {0});
   }
 }
 
@@ -880,11 +897,12 @@ void GraphBuilder::AddPoseMeasurementFactors(ceres::Problem& problem, int i) {
         new PoseMeasurementFactor(m.finger_pose[s.finger].pose, cfg_.measurement.finger_trans, cfg_.measurement.finger_rot),
         MakeLoss(cfg_.finger_pose_loss), {v.e});
   }
-  if (two_fingers_ && s.finger_b >= 0) {
+  for (int k = 1; k <= other_fingers_; ++k) {
+    if (s.others[k - 1].finger < 0) continue;
     Add(problem, FactorType::kFingerPose,
-        new PoseMeasurementFactor(traj_.extra_fingers[0].measured.finger_pose[s.finger_b].pose, cfg_.measurement.finger_trans,
+        new PoseMeasurementFactor(FingerPoseRows(k)[s.others[k - 1].finger].pose, cfg_.measurement.finger_trans,
                                   cfg_.measurement.finger_rot),
-        MakeLoss(cfg_.finger_pose_loss), {v.e2});
+        MakeLoss(cfg_.finger_pose_loss), {FingerPose(i, k)});
   }
 }
 
@@ -898,9 +916,9 @@ void GraphBuilder::AddConstantVelocityFactors(ceres::Problem& problem, int i) {
       {vars_[i - 2].x, vars_[i - 1].x, vars_[i].x});
   Add(problem, FactorType::kConstantVelocity, new ConstantVelocityFactor(dt1, dt2, st, sr), nullptr,
       {vars_[i - 2].e, vars_[i - 1].e, vars_[i].e});
-  if (two_fingers_) {
+  for (int k = 1; k <= other_fingers_; ++k) {
     Add(problem, FactorType::kConstantVelocity, new ConstantVelocityFactor(dt1, dt2, st, sr), nullptr,
-        {vars_[i - 2].e2, vars_[i - 1].e2, vars_[i].e2});
+        {FingerPose(i - 2, k), FingerPose(i - 1, k), FingerPose(i, k)});
   }
 }
 
@@ -909,61 +927,91 @@ void GraphBuilder::AddDynamicFactors(ceres::Problem& problem, int i) {
   const auto& m = traj_.measured;
   const Step& s = steps_[i];
   StepVars& v = vars_[i];
-  const bool has1 = HasForceVars(i), has2 = HasSecondForceVars(i);
+  const bool has1 = HasForceVars(i);
   const bool wedged = has1 && s.two_contacts;  // both contacts finger 0's
-  // Force: measurement, weak prior, continuity.
+  // The step's contacts with a force: finger 0's one or two, then one of each other finger
+  // that touches, each with its finger (whose friction and previous step it takes).
+  struct Contact {
+    double* p;
+    double* f;
+    int finger;
+    bool previous;  // the same contact had a force at step i - 1
+  };
+  std::vector<Contact> contacts;
+  if (has1) contacts.push_back({v.p, v.f, 0, i >= 1 && HasForceVars(i - 1)});
+  if (wedged) contacts.push_back({v.p2, v.f2, 0, i >= 1 && HasSecondForceVars(i - 1)});
+  for (int k = 1; k <= other_fingers_ && ModelHasForce(model_); ++k) {
+    if (!FingerTouches(i, k)) continue;
+    // Finger 1's force is f2 as finger 0's second one is (the two never share a push).
+    const bool previous = i >= 1 && (k == 1 ? HasSecondForceVars(i - 1) : FingerTouches(i - 1, k));
+    contacts.push_back({FingerContact(i, k), FingerForce(i, k), k, previous});
+  }
+  // Force: each finger's sensor (a wedged finger's measures the sum of its two contacts).
   if (has1 && s.force >= 0 && wedged) {
-    // The finger's sensor measures the sum of its contacts' forces.
     Add(problem, FactorType::kForce, new VectorSumMeasurementFactor(m.force[s.force].force, cfg_.measurement.force),
         MakeLoss(cfg_.force_loss), {v.f, v.f2});
   } else if (has1 && s.force >= 0) {
     Add(problem, FactorType::kForce, new VectorMeasurementFactor(m.force[s.force].force, cfg_.measurement.force),
         MakeLoss(cfg_.force_loss), {v.f});
   }
-  if (has2 && two_fingers_ && s.force_b >= 0) {
-    // Finger 1's own sensor.
+  for (const Contact& c : contacts) {
+    if (c.finger == 0 || s.others[c.finger - 1].force < 0) continue;
     Add(problem, FactorType::kForce,
-        new VectorMeasurementFactor(traj_.extra_fingers[0].measured.force[s.force_b].force, cfg_.measurement.force),
-        MakeLoss(cfg_.force_loss), {v.f2});
+        new VectorMeasurementFactor(ForceRows(c.finger)[s.others[c.finger - 1].force].force, cfg_.measurement.force),
+        MakeLoss(cfg_.force_loss), {c.f});
   }
-  if (has1) Add(problem, FactorType::kForcePrior, new VectorMeasurementFactor(Vec2::Zero(), cfg_.force_prior_sigma), nullptr, {v.f});
-  if (has2) Add(problem, FactorType::kForcePrior, new VectorMeasurementFactor(Vec2::Zero(), cfg_.force_prior_sigma), nullptr, {v.f2});
-  if (has1 && has2) {
-    // Each force in its friction cone (sigma a tenth of the force sensor's): with two contacts
-    // of one finger only their sum is measured, and the cone keeps the split physical.
-    const double mu1 = traj_.finger.mu_contact;
-    const double mu2 = two_fingers_ ? traj_.extra_fingers[0].finger.mu_contact : mu1;
-    for (const auto& [point, force, mu] : {std::tuple{v.p, v.f, mu1}, std::tuple{v.p2, v.f2, mu2}})
-      Add(problem, FactorType::kForcePrior, new FrictionConeFactor(traj_.object.shape, mu, 0.1 * cfg_.measurement.force),
-          nullptr, {v.x, point, force}, {0});
-  }
-  if (has1 && i >= 1 && HasForceVars(i - 1)) {
-    Add(problem, FactorType::kForceContinuity, new VectorRandomWalkFactor(s.t - steps_[i - 1].t, cfg_.force_random_walk),
-        nullptr, {vars_[i - 1].f, v.f});
-  }
-  if (has2 && i >= 1 && HasSecondForceVars(i - 1)) {
-    Add(problem, FactorType::kForceContinuity, new VectorRandomWalkFactor(s.t - steps_[i - 1].t, cfg_.force_random_walk),
-        nullptr, {vars_[i - 1].f2, v.f2});
-  }
+  // The weak prior; with several contacts each force in its friction cone (sigma a tenth of
+  // the force sensor's): a wedged finger's sensor measures only the sum, and the cone keeps
+  // the split physical.
+  for (const Contact& c : contacts)
+    Add(problem, FactorType::kForcePrior, new VectorMeasurementFactor(Vec2::Zero(), cfg_.force_prior_sigma), nullptr, {c.f});
+  for (std::size_t k = 0; contacts.size() >= 2 && k < contacts.size(); ++k)
+    Add(problem, FactorType::kForcePrior,
+        new FrictionConeFactor(traj_.object.shape, FingerMu(contacts[k].finger), 0.1 * cfg_.measurement.force), nullptr,
+        {v.x, contacts[k].p, contacts[k].f}, {0});
   if (i < 1) return;
-  if (has1 && has2) {
-    // D and the load of both contacts' summed wrench (c and mu at their given values).
-    QuasiStaticGeometry g = qs_;
-    g.dt = s.t - steps_[i - 1].t;
-    const double rate_scale = std::sqrt(0.01 / g.dt);  // per-10-ms sigmas (config.h)
+  double* previous_f[3] = {vars_[i - 1].f, vars_[i - 1].f2, nullptr};
+  for (std::size_t k = 0; k < contacts.size(); ++k) {
+    if (!contacts[k].previous) continue;
+    double* before = contacts[k].finger >= 2 ? FingerForce(i - 1, contacts[k].finger)
+                                             : previous_f[contacts[k].f == v.f ? 0 : 1];
+    Add(problem, FactorType::kForceContinuity, new VectorRandomWalkFactor(s.t - steps_[i - 1].t, cfg_.force_random_walk),
+        nullptr, {before, contacts[k].f});
+  }
+  if (contacts.size() == 1) {
+    AddOneContactQuasiStatic(problem, i, contacts[0].p, contacts[0].f);
+    return;
+  }
+  // D and the load of every contact's summed wrench (c and mu at their given values).
+  QuasiStaticGeometry g = qs_;
+  g.dt = s.t - steps_[i - 1].t;
+  const double rate_scale = std::sqrt(0.01 / g.dt);  // per-10-ms sigmas (config.h)
+  std::vector<double*> blocks{vars_[i - 1].x, v.x};
+  for (const Contact& c : contacts) {
+    blocks.push_back(c.p);
+    blocks.push_back(c.f);
+  }
+  if (contacts.size() == 2) {
     Add(problem, FactorType::kQuasiStatic,
         new QuasiStaticTwoContactFactor(g, cfg_.eps_velocity, cfg_.eps_force, cfg_.quasi_static_sigma * rate_scale),
-        nullptr, {vars_[i - 1].x, v.x, v.p, v.f, v.p2, v.f2}, {0, 1});
+        nullptr, blocks, {0, 1});
     if (use_load_factor_) {
       Add(problem, FactorType::kLimitSurfaceLoad,
           new LimitSurfaceLoadTwoContactFactor(g, f_max_, cfg_.eps_velocity, cfg_.eps_force,
                                                cfg_.limit_surface_sigma * rate_scale),
-          nullptr, {vars_[i - 1].x, v.x, v.p, v.f, v.p2, v.f2}, {0, 1});
+          nullptr, blocks, {0, 1});
     }
-  } else if (has1) {
-    AddOneContactQuasiStatic(problem, i, v.p, v.f);
-  } else {
-    AddOneContactQuasiStatic(problem, i, v.p2, v.f2);  // finger 1 alone touches
+    return;
+  }
+  const int n = static_cast<int>(contacts.size());
+  Add(problem, FactorType::kQuasiStatic,
+      new QuasiStaticMultiContactFactor(g, n, cfg_.eps_velocity, cfg_.eps_force, cfg_.quasi_static_sigma * rate_scale),
+      nullptr, blocks, {0, 1});
+  if (use_load_factor_) {
+    Add(problem, FactorType::kLimitSurfaceLoad,
+        new LimitSurfaceLoadMultiContactFactor(g, n, f_max_, cfg_.eps_velocity, cfg_.eps_force,
+                                               cfg_.limit_surface_sigma * rate_scale),
+        nullptr, blocks, {0, 1});
   }
 }
 
@@ -1014,7 +1062,12 @@ std::vector<double*> GraphBuilder::Blocks(int i) {
   if (HasForceVars(i)) b.push_back(vars_[i].f);
   if (HasSecondContact(i)) b.push_back(vars_[i].p2);
   if (HasSecondForceVars(i)) b.push_back(vars_[i].f2);
-  if (two_fingers_) b.push_back(vars_[i].e2);
+  if (other_fingers_ > 0) b.push_back(vars_[i].e2);
+  for (int k = 2; k <= other_fingers_; ++k) {
+    b.push_back(FingerPose(i, k));
+    if (FingerTouches(i, k)) b.push_back(FingerContact(i, k));
+    if (FingerTouches(i, k) && ModelHasForce(model_)) b.push_back(FingerForce(i, k));
+  }
   return b;
 }
 
@@ -1028,15 +1081,17 @@ void GraphBuilder::DropUnobservableForces(EstimationResult& result) const {
                               "farthest apart (exact for contacts along one straight finger face, an approximation "
                               "otherwise)");
   if (fingers_ignored_)
-    result.warnings.push_back("the Yu-Rodriguez baseline models one finger: finger 1 of this two-finger push was left out "
-                              "(its pose, contacts and forces are not estimated)");
-  if (two_fingers_) {
-    // A finger without the sensor the other has: said, not left silent.
-    const push::FingerStreams& b = traj_.extra_fingers[0].measured;
-    const auto& m = traj_.measured;
-    for (int finger : {0, 1}) {
-      const auto& contact = finger == 0 ? m.contact_point : b.contact_point;
-      const auto& force = finger == 0 ? m.force : b.force;
+    result.warnings.push_back(traj_.extra_fingers.size() == 1
+                                  ? "the Yu-Rodriguez baseline models one finger: finger 1 of this two-finger push was left "
+                                    "out (its pose, contacts and forces are not estimated)"
+                                  : "the Yu-Rodriguez baseline models one finger: fingers 1 to " +
+                                        std::to_string(traj_.extra_fingers.size()) + " of this push were left out "
+                                        "(their poses, contacts and forces are not estimated)");
+  if (other_fingers_ > 0) {
+    // A finger without the sensor another has: said, not left silent.
+    for (int finger = 0; finger < num_fingers(); ++finger) {
+      const auto& contact = ContactRows(finger);
+      const auto& force = ForceRows(finger);
       if (streams_.contact_point && contact.empty()) {
         const auto pushing = std::count_if(force.begin(), force.end(), [&](const push::ForceSample& f) {
           return f.force.norm() >= cfg_.contact_force_threshold;
@@ -1044,14 +1099,14 @@ void GraphBuilder::DropUnobservableForces(EstimationResult& result) const {
         if (pushing > 0) {
           char text[240];
           std::snprintf(text, sizeof text,
-                        "finger %d has no contact rows while the other finger has: it is taken as never touching, and its "
+                        "finger %d has no contact rows while another finger has: it is taken as never touching, and its "
                         "%d force rows of at least %.3g N were left out",
                         finger, static_cast<int>(pushing), cfg_.contact_force_threshold);
           result.warnings.push_back(text);
         }
       }
       if (streams_.force && force.empty() && ModelHasForce(model_))
-        result.warnings.push_back("finger " + std::to_string(finger) + " has no force rows while the other finger has: its "
+        result.warnings.push_back("finger " + std::to_string(finger) + " has no force rows while another finger has: its "
                                   "force comes from the motion alone (the quasi-static factor fixes the direction of the "
                                   "summed wrench), so its size is weakly determined");
     }
@@ -1076,7 +1131,7 @@ void GraphBuilder::DropUnobservableForces(EstimationResult& result) const {
 void GraphBuilder::SetState(int i, const StateEstimate& st) {
   StepVars& v = vars_[i];
   // Without a contact stream the estimate, not the rows, said which steps have two contacts.
-  if (!streams_.contact_point && !two_fingers_ && model_ != Model::kYu && steps_[i].in_contact)
+  if (!streams_.contact_point && other_fingers_ == 0 && model_ != Model::kYu && steps_[i].in_contact)
     steps_[i].two_contacts = st.contacts.size() == 2;
   v.x[0] = st.object_pose.x; v.x[1] = st.object_pose.y; v.x[2] = st.object_pose.theta;
   v.e[0] = st.finger_pose.x; v.e[1] = st.finger_pose.y; v.e[2] = st.finger_pose.theta;
@@ -1088,17 +1143,20 @@ void GraphBuilder::SetState(int i, const StateEstimate& st) {
   }
   v.f[0] = st.force ? st.force->x() : 0.0;
   v.f[1] = st.force ? st.force->y() : 0.0;
-  if (two_fingers_) {
-    // Finger 1's pose and its contact (the contacts entry of finger 1).
-    if (!st.other_fingers.empty()) {
-      const Pose2& e = st.other_fingers[0].pose;
-      v.e2[0] = e.x; v.e2[1] = e.y; v.e2[2] = e.theta;
+  if (other_fingers_ > 0) {
+    // Each other finger's pose and its contact (its entry in contacts).
+    for (const FingerPoseEstimate& o : st.other_fingers) {
+      if (o.finger < 1 || o.finger > other_fingers_) continue;
+      double* e = FingerPose(i, o.finger);
+      e[0] = o.pose.x; e[1] = o.pose.y; e[2] = o.pose.theta;
     }
     for (const ContactEstimate& c : st.contacts) {
-      if (c.finger != 1) continue;
-      v.p2[0] = c.point.x(); v.p2[1] = c.point.y();
-      const Vec2 f = c.force.value_or(Vec2::Zero());
-      v.f2[0] = f.x(); v.f2[1] = f.y();
+      if (c.finger < 1 || c.finger > other_fingers_) continue;
+      double* p = FingerContact(i, c.finger);
+      double* f = FingerForce(i, c.finger);
+      p[0] = c.point.x(); p[1] = c.point.y();
+      const Vec2 force = c.force.value_or(Vec2::Zero());
+      f[0] = force.x(); f[1] = force.y();
     }
   } else if (HasSecondContact(i) && st.contacts.size() == 2) {
     v.p2[0] = st.contacts[1].point.x(); v.p2[1] = st.contacts[1].point.y();
@@ -1125,20 +1183,24 @@ StateEstimate GraphBuilder::State(int i) const {
   s.finger_pose = {v.e[0], v.e[1], v.e[2]};
   if (HasContactVars(i)) s.contact = Vec2(v.p[0], v.p[1]);
   if (HasForceVars(i)) s.force = Vec2(v.f[0], v.f[1]);
-  if (two_fingers_) {
-    // Every contact of both fingers; contact and force stay finger 0's own.
-    s.other_fingers.push_back({1, Pose2{v.e2[0], v.e2[1], v.e2[2]}, std::nullopt});
+  if (other_fingers_ > 0) {
+    // Every finger's pose and contact; contact and force stay finger 0's own.
+    for (int k = 1; k <= other_fingers_; ++k) {
+      const double* e = FingerPose(i, k);
+      s.other_fingers.push_back({k, Pose2{e[0], e[1], e[2]}, std::nullopt});
+    }
     if (HasContactVars(i)) {
       ContactEstimate c;
       c.point = Vec2(v.p[0], v.p[1]);
       if (HasForceVars(i)) c.force = Vec2(v.f[0], v.f[1]);
       s.contacts.push_back(c);
     }
-    if (HasSecondContact(i)) {
+    for (int k = 1; k <= other_fingers_; ++k) {
+      if (!FingerTouches(i, k)) continue;
       ContactEstimate c;
-      c.finger = 1;
-      c.point = Vec2(v.p2[0], v.p2[1]);
-      if (HasSecondForceVars(i)) c.force = Vec2(v.f2[0], v.f2[1]);
+      c.finger = k;
+      c.point = Vec2(FingerContact(i, k)[0], FingerContact(i, k)[1]);
+      if (ModelHasForce(model_)) c.force = Vec2(FingerForce(i, k)[0], FingerForce(i, k)[1]);
       s.contacts.push_back(c);
     }
   } else if (HasSecondContact(i)) {

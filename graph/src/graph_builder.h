@@ -59,11 +59,14 @@ struct Step {
   /// rows with the contact variables p and p2 by proximity to the previous step's.
   bool two_contacts = false;
   int contact2 = -1;
-  /// Finger 1 of a two-finger push (Trajectory::extra_fingers[0]): its rows at this time and
-  /// whether it touches. Its contact is the step's second contact (p2, f2): a step has at most
-  /// two contacts in all (two of finger 0, or one of each finger).
-  int finger_b = -1, contact_b = -1, force_b = -1;
-  bool in_contact_b = false;
+  /// Fingers 1, 2, ... of a push with several (Trajectory::extra_fingers): each one's rows at
+  /// this time and whether it touches. Each touches at one point at most; finger 0 has two
+  /// contacts only when it is alone.
+  struct OtherFinger {
+    int finger = -1, contact = -1, force = -1;
+    bool in_contact = false;
+  };
+  std::vector<OtherFinger> others;
 };
 
 /// Parameter blocks of one step (addresses stay fixed: Ceres keeps pointers to them).
@@ -74,7 +77,14 @@ struct StepVars {
   double f[2] = {0, 0};
   double p2[2] = {0, 0};  ///< the second contact (Step::two_contacts, or finger 1's)
   double f2[2] = {0, 0};
-  double e2[3] = {0, 0, 0};  ///< finger 1's pose (two-finger pushes)
+  double e2[3] = {0, 0, 0};  ///< finger 1's pose (pushes with several fingers)
+};
+
+/// Parameter blocks of finger 2, 3, ... at one step (GraphBuilder::FingerPose and friends).
+struct MoreFingerVars {
+  double e[3] = {0, 0, 0};
+  double p[2] = {0, 0};
+  double f[2] = {0, 0};
 };
 
 /// What a residual block is, for the per-type diagnostics (diagnostics.h).
@@ -151,13 +161,24 @@ class GraphBuilder {
   bool HasContactVars(int i) const { return steps_[i].in_contact; }
   bool HasForceVars(int i) const { return steps_[i].in_contact && ModelHasForce(model_); }
   /// Whether step i has the second contact's variables p2 (and, with forces, f2): finger 0's
-  /// second contact, or finger 1's contact in a two-finger push.
+  /// second contact, or finger 1's contact in a push with several fingers.
   bool HasSecondContact(int i) const {
-    return (steps_[i].in_contact && steps_[i].two_contacts) || steps_[i].in_contact_b;
+    return (steps_[i].in_contact && steps_[i].two_contacts) || (other_fingers_ > 0 && steps_[i].others[0].in_contact);
   }
   bool HasSecondForceVars(int i) const { return HasSecondContact(i) && ModelHasForce(model_); }
-  /// A two-finger push: finger 1's pose is a variable of every step and its contact is p2.
-  bool two_fingers() const { return two_fingers_; }
+  /// The fingers estimated: 1, or every finger of a push with several (the baseline keeps one).
+  int num_fingers() const { return 1 + other_fingers_; }
+  /// Several fingers: each one's pose is a variable of every step, its contact one point.
+  bool several_fingers() const { return other_fingers_ > 0; }
+  /// Finger k's pose, contact point and force variables at step i (finger 0: e, p, f; finger 1:
+  /// e2, p2, f2; fingers 2, 3, ...: their own blocks), and whether it touches there.
+  double* FingerPose(int i, int k) { return k == 0 ? vars_[i].e : k == 1 ? vars_[i].e2 : More(i, k).e; }
+  double* FingerContact(int i, int k) { return k == 0 ? vars_[i].p : k == 1 ? vars_[i].p2 : More(i, k).p; }
+  double* FingerForce(int i, int k) { return k == 0 ? vars_[i].f : k == 1 ? vars_[i].f2 : More(i, k).f; }
+  const double* FingerPose(int i, int k) const { return const_cast<GraphBuilder*>(this)->FingerPose(i, k); }
+  const double* FingerContact(int i, int k) const { return const_cast<GraphBuilder*>(this)->FingerContact(i, k); }
+  const double* FingerForce(int i, int k) const { return const_cast<GraphBuilder*>(this)->FingerForce(i, k); }
+  bool FingerTouches(int i, int k) const { return k == 0 ? steps_[i].in_contact : steps_[i].others[k - 1].in_contact; }
 
   /// Initial values of step i from the measurements with time stamps <= limit (interpolated;
   /// the newest held). limit = INFINITY in batch; the update time in incremental mode.
@@ -244,8 +265,22 @@ class GraphBuilder {
   void SetSharedParameters(std::optional<double> c, std::optional<double> mu);
   void SetFrame(const Pose2& frame) { frame_[0] = frame.x; frame_[1] = frame.y; frame_[2] = frame.theta; }
   const geometry::ShapePairQuerier& querier() const { return *querier_; }
-  /// Object and finger 1 of a two-finger push (null otherwise).
-  const geometry::ShapePairQuerier* second_finger_querier() const { return querier_b_.get(); }
+  /// Object and finger k (k < num_fingers(); finger 0: querier()).
+  const geometry::ShapePairQuerier& finger_querier(int k) const { return k == 0 ? *querier_ : *other_queriers_[k - 1]; }
+  /// Finger k's shape and its streams (finger 0: the trajectory's own).
+  const geometry::Shape& FingerShape(int k) const {
+    return k == 0 ? traj_.finger.shape : traj_.extra_fingers[k - 1].finger.shape;
+  }
+  const std::vector<push::PoseSample>& FingerPoseRows(int k) const {
+    return k == 0 ? traj_.measured.finger_pose : traj_.extra_fingers[k - 1].measured.finger_pose;
+  }
+  const std::vector<push::PointSample>& ContactRows(int k) const {
+    return k == 0 ? traj_.measured.contact_point : traj_.extra_fingers[k - 1].measured.contact_point;
+  }
+  const std::vector<push::ForceSample>& ForceRows(int k) const {
+    return k == 0 ? traj_.measured.force : traj_.extra_fingers[k - 1].measured.force;
+  }
+  double FingerMu(int k) const { return k == 0 ? traj_.finger.mu_contact : traj_.extra_fingers[k - 1].finger.mu_contact; }
   /// The estimate of step i (no covariances).
   StateEstimate State(int i) const;
 
@@ -292,12 +327,14 @@ class GraphBuilder {
   std::pair<int, int> ContactRowsAt(int k) const;
   /// Of the contact rows at row k's time, the two farthest apart (k's own pair when two).
   std::pair<int, int> FarthestContactRows(int k) const;
-  /// The object point nearest finger 1's shape at step i's current values.
-  Vec2 SecondFingerNearestObjectPoint(int i) const;
-  /// Finger 1's initial pose, contact and force at step i (two-finger pushes).
-  void InitializeSecondFinger(int i, double limit);
-  /// Finger 1's M, C, S, touching and V factors at step i.
-  void AddSecondFingerKinematicFactors(ceres::Problem& problem, int i);
+  /// The object point nearest finger k's shape at step i's current values.
+  Vec2 FingerNearestObjectPoint(int i, int k) const;
+  /// Finger k's (k >= 1) initial pose, contact and force at step i.
+  void InitializeOtherFinger(int i, int k, double limit);
+  /// Finger k's (k >= 1) M, C, S and touching factors at step i.
+  void AddOtherFingerKinematicFactors(ceres::Problem& problem, int i, int k);
+  /// Finger 2, 3, ...'s blocks at step i.
+  MoreFingerVars& More(int i, int k) { return more_vars_[static_cast<std::size_t>(i) * (other_fingers_ - 1) + (k - 2)]; }
   /// D and the limit-surface load of one contact (p, f) at step i.
   void AddOneContactQuasiStatic(ceres::Problem& problem, int i, double* p, double* f);
 
@@ -307,11 +344,14 @@ class GraphBuilder {
   OnlineStreams streams_;  ///< which streams exist (batch: the non-empty ones)
   std::vector<Step> steps_;
   StableArray<StepVars> vars_;  ///< appending keeps the addresses Ceres holds
-  std::size_t used_[7] = {0, 0, 0, 0, 0, 0, 0};  ///< samples of each stream already in steps (4-6: finger 1's)
+  /// Samples of each stream already in steps: finger 0's object, finger, contact and force
+  /// streams, then finger k's finger, contact and force streams at 3 k + 1 .. 3 k + 3.
+  std::vector<std::size_t> used_;
   std::shared_ptr<const geometry::ShapePairQuerier> querier_;
-  bool two_fingers_ = false;  ///< finger 1 estimated (a two-finger push, not the baseline)
+  int other_fingers_ = 0;  ///< fingers 1, 2, ... estimated (several fingers, not the baseline)
+  StableArray<MoreFingerVars> more_vars_;  ///< fingers 2, 3, ...: other_fingers_ - 1 per step
   bool finger_has_faces_ = false;  ///< finger 0's core is more than a point (not a disk)
-  std::shared_ptr<const geometry::ShapePairQuerier> querier_b_;  ///< object and finger 1
+  std::vector<std::shared_ptr<const geometry::ShapePairQuerier>> other_queriers_;  ///< object and finger k >= 1
   /// The object without its holes: the boundary a finger outside the object touches. C's "p on
   /// the object's boundary" measures p against it (ContactBoundary), not against the nearest
   /// ring: a noisy contact row pulled p onto a hole's edge 2 cm inside the pushed face.
@@ -321,7 +361,7 @@ class GraphBuilder {
   /// boundary while the finger's reference point is outside the hole-free object (as it is when
   /// it pushes from outside), the whole shape when it is inside a hole.
   const geometry::Shape& ContactBoundary(int i, int finger) const;
-  bool fingers_ignored_ = false;  ///< the baseline left finger 1 out
+  bool fingers_ignored_ = false;  ///< the baseline left fingers 1, 2, ... out
   int steps_with_more_contacts_ = 0;  ///< steps with 3+ contact rows, modelled by their farthest two
   QuasiStaticGeometry qs_;
   bool estimate_c_ = false;

@@ -504,11 +504,11 @@ struct OnlineEstimator::Impl {
   double last_update_t = -INFINITY;
   double newest_t = -INFINITY;
   double first_t = INFINITY;
-  // Streams: 0 object pose; finger 0's pose, contact point, force (1-3); finger 1's (4-6).
-  static constexpr int kStreams = 7;
-  double last_seen[kStreams] = {-INFINITY, -INFINITY, -INFINITY, -INFINITY, -INFINITY, -INFINITY, -INFINITY};  // dropped samples included
+  // Streams: 0 object pose; finger 0's pose, contact point, force (1-3); finger k's at
+  // 3 k + 1 .. 3 k + 3.
+  std::vector<double> last_seen;  // dropped samples included
   bool repeated_contact = false;  // finger 0's newest contact sample is the second at its time
-  std::size_t seen[kStreams] = {0, 0, 0, 0, 0, 0, 0};
+  std::vector<std::size_t> seen;
   int dropped_late = 0;
   // Force sensor faults (the batch rule, Estimate's DropForceSpikes): a force above 50 times the
   // larger of the recent forces' 95th percentile and mu m g (and above 1 N) is left out.
@@ -519,8 +519,8 @@ struct OnlineEstimator::Impl {
   int dropped_faults = 0;
   std::string first_fault;
   bool finished = false;
-  bool declared[kStreams] = {true, true, false, false, false, false, false};
-  bool two_fingers = false;
+  std::vector<bool> declared;
+  int fingers = 1;
   double max_latency = 0.2;
   static constexpr std::size_t kRecentPeriods = 64;  // object periods the schedule looks at
   double object_period = 0.0;  // median of the newest kRecentPeriods; updated per object sample
@@ -537,13 +537,17 @@ struct OnlineEstimator::Impl {
   }
   Impl(const push::Trajectory& setup, Model model, const EstimatorConfig& cfg, const OnlineStreams& streams)
       : traj(Empty(setup)), smoother(traj, model, cfg, &streams) {
-    declared[2] = streams.contact_point;
-    declared[3] = streams.force;
-    // A second finger (the setup's extra_fingers[0]) has the same kinds of sensors as the first.
-    two_fingers = !traj.extra_fingers.empty();
-    declared[4] = two_fingers;
-    declared[5] = two_fingers && streams.contact_point;
-    declared[6] = two_fingers && streams.force;
+    // Every finger (finger k is the setup's extra_fingers[k - 1]) has the same kinds of sensors.
+    fingers = 1 + static_cast<int>(traj.extra_fingers.size());
+    last_seen.assign(1 + 3 * fingers, -INFINITY);
+    seen.assign(1 + 3 * fingers, 0);
+    declared.assign(1 + 3 * fingers, false);
+    declared[0] = true;
+    for (int k = 0; k < fingers; ++k) {
+      declared[3 * k + 1] = true;
+      declared[3 * k + 2] = streams.contact_point;
+      declared[3 * k + 3] = streams.force;
+    }
     if (!(streams.max_latency >= 0.0) || !std::isfinite(streams.max_latency)) {
       throw GraphError("OnlineStreams::max_latency must be finite and >= 0 (s)");
     }
@@ -556,18 +560,18 @@ struct OnlineEstimator::Impl {
   // The stream of `finger`'s pose (kind 0), contact point (1) or force (2); throws for a finger
   // the setup does not have.
   int FingerStream(int finger, int kind, const char* call) const {
-    if (finger == 0) return 1 + kind;
-    if (finger == 1 && two_fingers) return 4 + kind;
+    if (finger >= 0 && finger < fingers) return 3 * finger + 1 + kind;
     throw GraphError("OnlineEstimator::" + std::string(call) + ": finger " + std::to_string(finger) +
-                     " is out of range: the setup has " + (two_fingers ? "fingers 0 and 1" : "finger 0 only") +
-                     " (a second finger is the setup's second finger: Trajectory::extra_fingers[0] in C++, "
-                     "setup[\"fingers\"][0] in Python)");
+                     " is out of range: the setup has " +
+                     (fingers == 1 ? std::string("finger 0 only") : "fingers 0 to " + std::to_string(fingers - 1)) +
+                     " (finger k >= 1 is the setup's extra finger k: Trajectory::extra_fingers[k - 1] in C++, "
+                     "setup[\"fingers\"][k - 1] in Python)");
   }
 
   bool Accept(int stream, const char* name, double t, bool finite) {
     const std::size_t index = seen[stream];
     auto where = [&] {
-      return "OnlineEstimator: streams." + std::string(stream >= 4 ? "fingers[1]." : "") + name + "[" +
+      return "OnlineEstimator: streams." + (stream >= 4 ? "fingers[" + std::to_string((stream - 1) / 3) + "]." : std::string()) + name + "[" +
              std::to_string(index) + "] at t = " + Precise(t);
     };
     if (finished) throw GraphError(where() + " arrived after Finish()");
@@ -577,13 +581,13 @@ struct OnlineEstimator::Impl {
     }
     if (!std::isfinite(t) || !finite) throw GraphError(where() + " is not finite");
     // A second contact point at the same time is a second contact (a finger wedged in a notch);
-    // with two fingers, each has one (the estimator models two contacts in all).
-    const bool contact = stream == 2 || stream == 5;
-    const bool second_contact = stream == 2 && !two_fingers && t == last_seen[stream] && !repeated_contact;
+    // with several fingers, each has one.
+    const bool contact = stream >= 1 && (stream - 1) % 3 == 1;
+    const bool second_contact = stream == 2 && fingers == 1 && t == last_seen[stream] && !repeated_contact;
     if (!(t > last_seen[stream]) && !second_contact) {
       throw GraphError(where() + " is not after the previous sample (t = " + Precise(last_seen[stream]) + ")" +
                        (contact && t == last_seen[stream]
-                            ? (two_fingers ? ": two contacts in all, one per finger, in a two-finger push"
+                            ? (fingers > 1 ? ": one contact per finger in a push with several fingers"
                                            : ": at most two contacts at one time")
                             : ": each stream must arrive in time order"));
     }
@@ -677,14 +681,14 @@ bool OnlineEstimator::AddFingerPose(double t, int finger, const geometry::Pose2&
   Impl& m = *impl_;
   const int stream = m.FingerStream(finger, 0, "AddFingerPose");
   if (!m.Accept(stream, "finger_pose", t, pose.vector().allFinite())) return false;
-  (finger == 0 ? m.traj.measured.finger_pose : m.traj.extra_fingers[0].measured.finger_pose).push_back({t, pose});
+  (finger == 0 ? m.traj.measured.finger_pose : m.traj.extra_fingers[finger - 1].measured.finger_pose).push_back({t, pose});
   return true;
 }
 bool OnlineEstimator::AddContactPoint(double t, int finger, const geometry::Vec2& point) {
   Impl& m = *impl_;
   const int stream = m.FingerStream(finger, 1, "AddContactPoint");
   if (!m.Accept(stream, "contact_point", t, point.allFinite())) return false;
-  (finger == 0 ? m.traj.measured.contact_point : m.traj.extra_fingers[0].measured.contact_point).push_back({t, point});
+  (finger == 0 ? m.traj.measured.contact_point : m.traj.extra_fingers[finger - 1].measured.contact_point).push_back({t, point});
   return true;
 }
 bool OnlineEstimator::AddForce(double t, int finger, const geometry::Vec2& force) {
@@ -705,14 +709,14 @@ bool OnlineEstimator::AddForce(double t, int finger, const geometry::Vec2& force
     if (m.dropped_faults++ == 0) {
       char text[200];
       std::snprintf(text, sizeof text, "%sforce[%zu] at t = %.9g s, |f| = %.3g N (bound %.3g N)",
-                    finger == 0 ? "" : "fingers[1].", index, t, magnitude, bound);
+                    finger == 0 ? "" : ("fingers[" + std::to_string(finger) + "].").c_str(), index, t, magnitude, bound);
       m.first_fault = text;
     }
     return false;
   }
   m.recent_force.push_back(magnitude);
   if (m.recent_force.size() > Impl::kRecentForces) m.recent_force.pop_front();
-  (finger == 0 ? m.traj.measured.force : m.traj.extra_fingers[0].measured.force).push_back({t, force});
+  (finger == 0 ? m.traj.measured.force : m.traj.extra_fingers[finger - 1].measured.force).push_back({t, force});
   return true;
 }
 int OnlineEstimator::DroppedLateSamples() const { return impl_->dropped_late; }
@@ -752,10 +756,13 @@ double OnlineEstimator::Update(double until) {
     if (meas.finger_pose.empty() || meas.finger_pose.front().t > until) {
       throw GraphError("OnlineEstimator::Update: no finger pose measurement (streams.finger_pose) up to t = " + Precise(until));
     }
-    const auto* second = m.two_fingers ? &m.traj.extra_fingers[0].measured.finger_pose : nullptr;
-    if (second != nullptr && (second->empty() || second->front().t > until)) {
-      throw GraphError("OnlineEstimator::Update: no pose measurement of finger 1 (streams.fingers[1].finger_pose) up to t = " +
-                       Precise(until));
+    for (int k = 1; k < m.fingers; ++k) {
+      const auto& poses = m.traj.extra_fingers[k - 1].measured.finger_pose;
+      if (poses.empty() || poses.front().t > until) {
+        const std::string finger = std::to_string(k);
+        throw GraphError("OnlineEstimator::Update: no pose measurement of finger " + finger + " (streams.fingers[" + finger +
+                         "].finger_pose) up to t = " + Precise(until));
+      }
     }
   }
   // Samples within 1e-9 s after `until` join its step now (as batch merges them), so no later

@@ -98,12 +98,12 @@ double ForceFaultBound(double force_p95, const push::ObjectDescription& object) 
   return std::max(50.0 * scale, 1.0);
 }
 
-// Finger k+1 against finger 0 in their measured poses (at the times both are measured, at most
+// Finger j against finger k in their measured poses (at the times both are measured, at most
 // 200 of them): inside each other by more than 1 mm at the median is a wrong shape, offset or
 // pose stream, which no estimate could fit (the estimator would blame the sensors instead).
-void CheckFingersApart(const push::Trajectory& traj, std::size_t k) {
-  const auto& a = traj.measured.finger_pose;
-  const auto& b = traj.extra_fingers[k].measured.finger_pose;
+void CheckFingersApart(const push::Trajectory& traj, std::size_t j, std::size_t k) {
+  const auto& a = j == 0 ? traj.measured.finger_pose : traj.extra_fingers[j - 1].measured.finger_pose;
+  const auto& b = traj.extra_fingers[k - 1].measured.finger_pose;
   std::vector<std::pair<std::size_t, std::size_t>> common;
   for (std::size_t i = 0, j = 0; i < a.size() && j < b.size();) {
     if (std::abs(a[i].t - b[j].t) <= 1e-9) common.emplace_back(i++, j++);
@@ -111,26 +111,25 @@ void CheckFingersApart(const push::Trajectory& traj, std::size_t k) {
     else ++j;
   }
   if (common.size() < 5) return;
-  const geometry::ShapePairQuerier querier(traj.finger.shape, traj.extra_fingers[k].finger.shape);
+  const geometry::ShapePairQuerier querier(j == 0 ? traj.finger.shape : traj.extra_fingers[j - 1].finger.shape,
+                                           traj.extra_fingers[k - 1].finger.shape);
   const std::size_t stride = std::max<std::size_t>(1, common.size() / 200);
   std::vector<double> separation;
   for (std::size_t c = 0; c < common.size(); c += stride)
     separation.push_back(querier.Query(a[common[c].first].pose, b[common[c].second].pose).signed_distance);
   const double median = Median(separation);
   if (median < -1e-3) {
-    throw GraphError("trajectory: fingers 0 and " + std::to_string(k + 1) +
+    const std::string a_rows = j == 0 ? "finger_pose[" : "fingers[" + std::to_string(j) + "].finger_pose[";
+    throw GraphError("trajectory: fingers " + std::to_string(j) + " and " + std::to_string(k) +
                      " overlap each other in their measured poses (median separation " + Format("%.2f", 1e3 * median) +
-                     " mm over " + std::to_string(separation.size()) + " common times, e.g. finger_pose[" +
-                     std::to_string(common.front().first) + "] and fingers[" + std::to_string(k + 1) + "].finger_pose[" +
+                     " mm over " + std::to_string(separation.size()) + " common times, e.g. " + a_rows +
+                     std::to_string(common.front().first) + "] and fingers[" + std::to_string(k) + "].finger_pose[" +
                      std::to_string(common.front().second) + "]): check the fingers' shapes and their pose streams");
   }
 }
 
 void ValidateFingers(const push::Trajectory& traj) {
-  // The factor graphs model one finger with up to two contacts, or two fingers with one each.
-  if (traj.extra_fingers.size() > 1)
-    throw GraphError("trajectory: " + std::to_string(push::FingerCount(traj)) +
-                     " fingers: the estimator models at most two fingers");
+  // The factor graphs model one finger with up to two contacts, or several fingers with one each.
   for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k)
     if (traj.extra_fingers[k].finger.shape.empty())
       throw GraphError("trajectory: fingers[" + std::to_string(k + 1) + "].shape is missing or empty");
@@ -184,13 +183,13 @@ void ValidateTrajectory(const push::Trajectory& traj) {
       const auto& rows = finger == 0 ? m.contact_point : f.contact_point;
       for (std::size_t i = 1; i < rows.size(); ++i) {
         if (rows[i].t != rows[i - 1].t) continue;
-        throw GraphError("trajectory: a two-finger push with two contacts of one finger at a time (" +
+        throw GraphError("trajectory: a push with several fingers and two contacts of one finger at a time (" +
                          std::string(finger == 0 ? "" : "fingers[" + std::to_string(finger) + "].") + "contact_point[" +
                          std::to_string(i) + "] repeats the time " + Format("%.9g", rows[i].t) + " s of the row before, finger " +
-                         std::to_string(finger) + "): the estimator models two contacts in all, one per finger");
+                         std::to_string(finger) + "): with several fingers the estimator models one contact per finger");
       }
     }
-    CheckFingersApart(traj, k);
+    for (std::size_t j = 0; j <= k; ++j) CheckFingersApart(traj, j, k + 1);
   }
   CheckSorted(m.object_pose, "object_pose");
   {

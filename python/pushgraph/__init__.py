@@ -130,8 +130,9 @@ class OnlineEstimator:
     contact_point, force: which sensors will report (they decide contact gating and the
     limit-surface load factor). Each add_* returns False when the sample came too late (at or
     before the last update) and was dropped; samples out of order or not finite raise GraphError.
-    A two-finger push: setup["fingers"] holds finger 1 (its streams empty); its samples come with
-    finger=1 (each finger's sensors are the kinds declared), and latest_state() has finger1_pose.
+    Several fingers: setup["fingers"] holds fingers 1, 2, ... (their streams empty); their samples
+    come with finger=k (each finger's sensors are the kinds declared), and latest_state() has
+    finger1_pose, finger2_pose, ... and every contact with its finger.
     """
 
     def __init__(self, setup, model="qs", config=None, contact_point=False, force=True, max_latency=0.2):
@@ -160,8 +161,9 @@ class OnlineEstimator:
         return self._core.update(float(until))
 
     def latest_state(self):
-        """The newest state: dict with t, object_pose, finger_pose, contact and force (None when absent);
-        finger1_pose too in a two-finger push."""
+        """The newest state: dict with t, object_pose, finger_pose, contact and force (finger 0's; None
+        when absent), contacts (every contact: dicts of finger, point, force), and fingerK_pose of
+        each finger K >= 1 of a push with several."""
         return self._core.latest_state()
 
     @property

@@ -37,10 +37,19 @@ py::dict StateToDict(const StateEstimate& s) {
   d["finger_pose"] = py::make_tuple(s.finger_pose.x, s.finger_pose.y, s.finger_pose.theta);
   d["contact"] = s.contact ? py::object(py::make_tuple(s.contact->x(), s.contact->y())) : py::none();
   d["force"] = s.force ? py::object(py::make_tuple(s.force->x(), s.force->y())) : py::none();
-  if (!s.other_fingers.empty()) {  // a two-finger push: finger 1's pose
-    const geometry::Pose2& e = s.other_fingers[0].pose;
-    d["finger1_pose"] = py::make_tuple(e.x, e.y, e.theta);
+  for (const FingerPoseEstimate& f : s.other_fingers) {  // several fingers: finger k's pose
+    d[("finger" + std::to_string(f.finger) + "_pose").c_str()] = py::make_tuple(f.pose.x, f.pose.y, f.pose.theta);
   }
+  // Every contact (a wedged finger's two, or one per finger that touches), with its finger.
+  py::list contacts;
+  for (const ContactEstimate& c : s.contacts) {
+    py::dict e;
+    e["finger"] = c.finger;
+    e["point"] = py::make_tuple(c.point.x(), c.point.y());
+    e["force"] = c.force ? py::object(py::make_tuple(c.force->x(), c.force->y())) : py::none();
+    contacts.append(e);
+  }
+  d["contacts"] = contacts;
   return d;
 }
 
@@ -54,8 +63,17 @@ py::dict ResultToDict(const EstimationResult& r) {
   // Two-contact states (a finger wedged in a notch): the second contact and each one's force; in a
   // two-finger push the second contact is finger 1's, and finger 1 has its own pose.
   py::array_t<double> second = NewArray({n, 2}), second_cov = NewArray({n, 2, 2}), forces = NewArray({n, 2, 2});
-  const bool two_fingers = std::any_of(r.states.begin(), r.states.end(), [](const StateEstimate& s) { return !s.other_fingers.empty(); });
-  py::array_t<double> finger1 = NewArray({n, 3}), finger1_cov = NewArray({n, 3, 3});
+  int fingers = 1;
+  for (const StateEstimate& s : r.states) fingers = std::max(fingers, 1 + static_cast<int>(s.other_fingers.size()));
+  const bool two_fingers = fingers > 1;
+  // Fingers 1, 2, ...: each one's pose, contact point and force (NaN where it does not touch).
+  std::vector<py::array_t<double>> finger_k(fingers), finger_k_cov(fingers), contact_k(fingers), force_k(fingers);
+  for (int k = 1; k < fingers; ++k) {
+    finger_k[k] = NewArray({n, 3});
+    finger_k_cov[k] = NewArray({n, 3, 3});
+    contact_k[k] = NewArray({n, 2});
+    force_k[k] = NewArray({n, 2});
+  }
   auto put_cov = [](double* out, const auto& cov, int dim) {
     for (int k = 0; k < dim * dim; ++k) out[k] = cov ? (*cov)(k / dim, k % dim) : kNaN;
   };
@@ -79,7 +97,10 @@ py::dict ResultToDict(const EstimationResult& r) {
     const ContactEstimate* first = nullptr;
     const ContactEstimate* other = nullptr;
     if (two_fingers) {
-      for (const ContactEstimate& c : s.contacts) (c.finger == 0 ? first : other) = &c;
+      for (const ContactEstimate& c : s.contacts) {
+        if (c.finger == 0) first = &c;
+        if (c.finger == 1) other = &c;
+      }
     } else if (s.contacts.size() == 2) {
       first = &s.contacts[0];
       other = &s.contacts[1];
@@ -91,9 +112,18 @@ py::dict ResultToDict(const EstimationResult& r) {
         forces.mutable_data()[4 * i + 2 * c + k] = both[c] && both[c]->force ? (*both[c]->force)[k] : kNaN;
     }
     put_cov(second_cov.mutable_data() + 4 * i, other ? other->point_cov : std::nullopt, 2);
-    const FingerPoseEstimate* f1 = s.other_fingers.empty() ? nullptr : &s.other_fingers[0];
-    for (int k = 0; k < 3; ++k) finger1.mutable_data()[3 * i + k] = f1 ? f1->pose.vector()[k] : kNaN;
-    put_cov(finger1_cov.mutable_data() + 9 * i, f1 ? f1->pose_cov : std::nullopt, 3);
+    for (int f = 1; f < fingers; ++f) {
+      const FingerPoseEstimate* pose = nullptr;
+      for (const FingerPoseEstimate& e : s.other_fingers) pose = e.finger == f ? &e : pose;
+      const ContactEstimate* touch = nullptr;
+      for (const ContactEstimate& c : s.contacts) touch = c.finger == f ? &c : touch;
+      for (int k = 0; k < 3; ++k) finger_k[f].mutable_data()[3 * i + k] = pose ? pose->pose.vector()[k] : kNaN;
+      put_cov(finger_k_cov[f].mutable_data() + 9 * i, pose ? pose->pose_cov : std::nullopt, 3);
+      for (int k = 0; k < 2; ++k) {
+        contact_k[f].mutable_data()[2 * i + k] = touch ? touch->point[k] : kNaN;
+        force_k[f].mutable_data()[2 * i + k] = touch && touch->force ? (*touch->force)[k] : kNaN;
+      }
+    }
   }
   py::dict d;
   d["model"] = ModelName(r.model);
@@ -110,9 +140,12 @@ py::dict ResultToDict(const EstimationResult& r) {
   d["second_contact"] = second;
   d["second_contact_cov"] = second_cov;
   d["contact_forces"] = forces;
-  if (two_fingers) {
-    d["finger1_pose"] = finger1;
-    d["finger1_pose_cov"] = finger1_cov;
+  for (int k = 1; k < fingers; ++k) {
+    const std::string f = "finger" + std::to_string(k);
+    d[(f + "_pose").c_str()] = finger_k[k];
+    d[(f + "_pose_cov").c_str()] = finger_k_cov[k];
+    d[(f + "_contact").c_str()] = contact_k[k];
+    d[(f + "_force").c_str()] = force_k[k];
   }
   py::dict metrics;
   for (const auto& [k, v] : r.metrics) metrics[k.c_str()] = v;

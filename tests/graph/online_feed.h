@@ -12,8 +12,8 @@
 namespace pushgraph::graph::testing {
 
 /// One recorded sample: its time stamp t, when it reaches the estimator (at), its stream
-/// (0 object pose, 1 finger pose, 2 contact point, 3 force; 4-6 finger 1's pose, contact
-/// point and force in a two-finger push) and its index in that stream.
+/// (0 object pose, 1 finger pose, 2 contact point, 3 force; 3 k + 1 .. 3 k + 3 finger k's pose,
+/// contact point and force in a push with several fingers) and its index in that stream.
 struct Arrival {
   double t = 0.0, at = 0.0;
   int stream = 0;
@@ -29,11 +29,12 @@ inline std::vector<Arrival> ArrivalOrder(const push::Trajectory& t, double objec
   for (std::size_t i = 0; i < m.finger_pose.size(); ++i) out.push_back({m.finger_pose[i].t, m.finger_pose[i].t, 1, i});
   for (std::size_t i = 0; i < m.contact_point.size(); ++i) out.push_back({m.contact_point[i].t, m.contact_point[i].t, 2, i});
   for (std::size_t i = 0; i < m.force.size(); ++i) out.push_back({m.force[i].t, m.force[i].t, 3, i});
-  if (!t.extra_fingers.empty()) {
-    const push::FingerStreams& f = t.extra_fingers[0].measured;
-    for (std::size_t i = 0; i < f.finger_pose.size(); ++i) out.push_back({f.finger_pose[i].t, f.finger_pose[i].t, 4, i});
-    for (std::size_t i = 0; i < f.contact_point.size(); ++i) out.push_back({f.contact_point[i].t, f.contact_point[i].t, 5, i});
-    for (std::size_t i = 0; i < f.force.size(); ++i) out.push_back({f.force[i].t, f.force[i].t, 6, i});
+  for (std::size_t k = 1; k <= t.extra_fingers.size(); ++k) {
+    const push::FingerStreams& f = t.extra_fingers[k - 1].measured;
+    const int s = 3 * static_cast<int>(k);
+    for (std::size_t i = 0; i < f.finger_pose.size(); ++i) out.push_back({f.finger_pose[i].t, f.finger_pose[i].t, s + 1, i});
+    for (std::size_t i = 0; i < f.contact_point.size(); ++i) out.push_back({f.contact_point[i].t, f.contact_point[i].t, s + 2, i});
+    for (std::size_t i = 0; i < f.force.size(); ++i) out.push_back({f.force[i].t, f.force[i].t, s + 3, i});
   }
   std::stable_sort(out.begin(), out.end(), [](const Arrival& a, const Arrival& b) { return a.at < b.at; });
   return out;
@@ -48,11 +49,12 @@ inline bool Deliver(const Arrival& a, const push::Trajectory& t, OnlineEstimator
     case 2: return online.AddContactPoint(a.t, m.contact_point[a.index].point);
     case 3: return online.AddForce(a.t, m.force[a.index].force);
   }
-  const push::FingerStreams& f = t.extra_fingers[0].measured;
-  switch (a.stream) {
-    case 4: return online.AddFingerPose(a.t, 1, f.finger_pose[a.index].pose);
-    case 5: return online.AddContactPoint(a.t, 1, f.contact_point[a.index].point);
-    default: return online.AddForce(a.t, 1, f.force[a.index].force);
+  const int finger = (a.stream - 1) / 3;
+  const push::FingerStreams& f = t.extra_fingers[finger - 1].measured;
+  switch ((a.stream - 1) % 3) {
+    case 0: return online.AddFingerPose(a.t, finger, f.finger_pose[a.index].pose);
+    case 1: return online.AddContactPoint(a.t, finger, f.contact_point[a.index].point);
+    default: return online.AddForce(a.t, finger, f.force[a.index].force);
   }
 }
 

@@ -445,6 +445,52 @@ TEST(FactorJacobians, TwoContactQuasiStaticAndNetForce) {
 }
 
 
+// Any number of contacts (three fingers): D and the load of the summed wrench, checked with
+// three contacts (the third another random case's, some nearly open); with two contacts they are
+// the two-contact factors to the last bit, and a third contact without force changes nothing.
+TEST(FactorJacobians, MultiContactQuasiStaticAndLoad) {
+  Rng rng;
+  QuasiStaticGeometry g;
+  g.c = 0.0344;
+  g.centre_of_pressure = Vec2(0.003, -0.002);
+  g.dt = 0.004;
+  QuasiStaticMultiContactFactor d3(g, 3, 1e-3, 0.05, 0.1), dm2(g, 2, 1e-3, 0.05, 0.1);
+  LimitSurfaceLoadMultiContactFactor l3(g, 3, 2.0, 1e-3, 0.05, 0.1), lm2(g, 2, 2.0, 1e-3, 0.05, 0.1);
+  QuasiStaticTwoContactFactor d2(g, 1e-3, 0.05, 0.1);
+  LimitSurfaceLoadTwoContactFactor l2(g, 2.0, 1e-3, 0.05, 0.1);
+  JacobianTally td("D, three contacts"), tl("limit-surface load, three contacts");
+  WorstError wd{"D with three contacts"}, wl{"limit-surface load with three contacts"};
+  const std::vector<QsCase> cases = QuasiStaticCases(rng, g), others = QuasiStaticCases(rng, g);
+  auto eval = [](const ceres::CostFunction& f, const std::vector<Eigen::VectorXd>& values) {
+    std::vector<const double*> blocks;
+    for (const Eigen::VectorXd& v : values) blocks.push_back(v.data());
+    Eigen::VectorXd r(f.num_residuals());
+    EXPECT_TRUE(f.Evaluate(blocks.data(), r.data(), nullptr));
+    return r;
+  };
+  for (std::size_t n = 0; n < cases.size(); ++n) {
+    const QsCase& c = cases[n];
+    const QsCase& o = others[(n * 7 + 3) % others.size()];
+    const QsCase& q = others[(n * 5 + 1) % others.size()];
+    Vec2 f3 = q.f;
+    if (n % 5 == 0) f3 *= 1e-6;  // nearly open
+    const std::string ctx = "case " + std::to_string(n);
+    const std::vector<Eigen::VectorXd> three{V(c.x_prev), V(c.x), V(c.p), V(c.f), V(o.p), V(o.f), V(q.p), V(f3)};
+    CheckCost(d3, three, td, wd, ctx);
+    CheckCost(l3, three, tl, wl, ctx);
+    const std::vector<Eigen::VectorXd> two(three.begin(), three.begin() + 6);
+    EXPECT_EQ(eval(dm2, two), eval(d2, two)) << ctx;
+    EXPECT_EQ(eval(lm2, two), eval(l2, two)) << ctx;
+    std::vector<Eigen::VectorXd> open = three;
+    open[7] = V(Vec2::Zero());
+    EXPECT_LE((eval(d3, open) - eval(d2, two)).norm(), 1e-12 * (1.0 + eval(d2, two).norm())) << ctx;
+  }
+  EXPECT_TRUE(td.MostlyChecked(0.95));
+  EXPECT_TRUE(tl.MostlyChecked(0.95));
+  EXPECT_THROW(QuasiStaticMultiContactFactor(g, 0, 1e-3, 0.05, 0.1), GraphError);
+  EXPECT_THROW(LimitSurfaceLoadMultiContactFactor(g, 0, 2.0, 1e-3, 0.05, 0.1), GraphError);
+}
+
 // The shape frame F as a variable (shape registration): the wrapper composes the object-pose
 // blocks with F, so its Jacobians with respect to those blocks and to F are chained through
 // Compose; checked on wrapped C, touching, S and D, near contact and at vertices, and on its

@@ -238,3 +238,53 @@ def test_two_fingers_online_from_python(tmp_path):
     replay = pg.estimate(push, model="qs", mode="incremental")
     np.testing.assert_allclose(r["object_pose"], replay["object_pose"], rtol=0, atol=1e-9)
     np.testing.assert_allclose(r["finger1_pose"], replay["finger1_pose"], rtol=0, atol=1e-9)
+
+
+def test_three_fingers_batch_and_online(tmp_path):
+    # Three 4 mm disks 2.5 cm apart pushing the notched block's side face together: every finger's
+    # pose, contact and force come back (fingerK_pose, fingerK_contact, fingerK_force), online with
+    # finger=2 as in batch, and latest_state() lists every contact with its finger.
+    names = []
+    for k, y in enumerate((0.025, 0.0, -0.025)):
+        names.append(str(tmp_path / ("f%d.json" % k)))
+        (tmp_path / ("f%d.json" % k)).write_text('{"polygons": [{"outer": [[0, %g]]}], "radius": 0.004}' % y)
+    path = tmp_path / "three.json"
+    subprocess.run([TOOL, "simulate", "-o", str(path), "--fingers", *names, "--offset", "0", "--push-angle", "0"],
+                   check=True, capture_output=True)
+    push = pg.load_trajectory(str(path))
+    assert len(push["fingers"]) == 2
+    r = pg.estimate(push, model="qs")
+    assert r["metrics"]["object_position_rms"] < 0.6 * r["metrics"]["measured_object_position_rms"]
+    for k in (1, 2):
+        assert np.isfinite(r["finger%d_pose" % k]).all() and r["finger%d_pose_cov" % k].shape == (len(r["t"]), 3, 3)
+        touching = np.isfinite(r["finger%d_contact" % k][:, 0])
+        assert touching.sum() > 100 and np.isfinite(r["finger%d_force" % k][touching]).all()
+    setup = {"object": push["object"], "finger": push["finger"], "measured": {},
+             "measurement_sigmas": push["measurement_sigmas"],
+             "fingers": [{"shape": f["shape"], "mu_contact": f["mu_contact"], "measured": {}} for f in push["fingers"]]}
+    online = pg.OnlineEstimator(setup, model="qs", contact_point="contact_point" in push["measured"], force=True)
+    add = {"finger_pose": online.add_finger_pose, "contact_point": online.add_contact_point, "force": online.add_force}
+    samples = [(t, 0, "object_pose", v) for t, v in zip(push["measured"]["object_pose"]["t"], push["measured"]["object_pose"]["pose"])]
+    for finger, streams in enumerate([push["measured"]] + [f["measured"] for f in push["fingers"]]):
+        for stream, value in [("finger_pose", "pose"), ("contact_point", "point"), ("force", "force")]:
+            if stream in streams:
+                samples += [(t, finger, stream, v) for t, v in zip(streams[stream]["t"], streams[stream][value])]
+    samples.sort(key=lambda s: (s[0], s[1], s[2] != "object_pose"))
+    fingers_seen = set()
+    for k, (t, finger, stream, v) in enumerate(samples):
+        if stream == "object_pose":
+            online.add_object_pose(t, v)
+        else:
+            add[stream](t, v, finger=finger)
+        if (k + 1 == len(samples) or samples[k + 1][0] > t) and online.update_due():
+            online.update()
+            state = online.latest_state()
+            assert len(state["finger2_pose"]) == 3
+            fingers_seen |= {c["finger"] for c in state["contacts"]}
+    assert fingers_seen == {0, 1, 2}
+    with pytest.raises(pg.GraphError, match="finger 3 is out of range: the setup has fingers 0 to 2"):
+        online.add_force(samples[-1][0] + 1.0, (0.1, 0.0), finger=3)
+    done = online.finish()
+    replay = pg.estimate(push, model="qs", mode="incremental")
+    np.testing.assert_allclose(done["finger2_pose"], replay["finger2_pose"], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(done["object_pose"], replay["object_pose"], rtol=0, atol=1e-9)

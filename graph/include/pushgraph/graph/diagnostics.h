@@ -66,7 +66,8 @@ struct Diagnostics {
   double measured_gap_median = 0.0, measured_gap_mad = 0.0;
   int measured_samples = 0;
   double measured_noise = 0.0;  ///< 1.4826 MAD: the per-sample noise of that separation
-  /// The same of finger 1 of a two-finger push (its own shape and pose samples); empty otherwise.
+  /// The same of fingers 1, 2, ... of a push with several (each its own shape and pose samples);
+  /// empty with one finger.
   std::vector<MeasuredContactGap> other_finger_gaps;
   std::vector<SensorFault> faults;
   /// Probable causes when something is far off, one sentence each (also in the warnings).

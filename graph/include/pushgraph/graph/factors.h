@@ -345,6 +345,37 @@ class LimitSurfaceLoadTwoContactFactor : public ceres::SizedCostFunction<1, 3, 3
   double f_max_, eps_v_, eps_f_, w_;
 };
 
+/// D with any number of contacts (three fingers, or more): QuasiStaticTwoContactFactor's
+/// residual with g' the sum of every contact's g'(p_k, f_k). With two contacts it is that factor.
+/// Parameters: x_prev (3), x_t (3), then p_k (2), f_k (2) of each contact.
+class QuasiStaticMultiContactFactor : public ceres::CostFunction {
+ public:
+  QuasiStaticMultiContactFactor(const QuasiStaticGeometry& geometry, int contacts, double eps_velocity,
+                                double eps_force, double sigma);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  QuasiStaticGeometry geometry_;
+  int contacts_;
+  double eps_v_, eps_f_, w_;
+};
+
+/// LimitSurfaceLoadFactor of the summed load of any number of contacts. Parameters as
+/// QuasiStaticMultiContactFactor.
+class LimitSurfaceLoadMultiContactFactor : public ceres::CostFunction {
+ public:
+  LimitSurfaceLoadMultiContactFactor(const QuasiStaticGeometry& geometry, int contacts, double f_max,
+                                     double eps_velocity, double eps_force, double sigma);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  QuasiStaticGeometry geometry_;
+  int contacts_;
+  double f_max_, eps_v_, eps_f_, w_;
+};
+
 /// The limit-surface load with shared scalar parameters as variables, for their joint
 /// estimation: c (EstimatorConfig::estimate_c, the same c as QuasiStaticFactorWithC's) and/or the
 /// table friction mu (estimate_mu), with f_max = mu N, N = m g the normal load. The residual is

@@ -105,7 +105,7 @@ class IncrementalEstimator {
 /// IncrementalEstimator's (up to contact gating, which here sees only past samples).
 class OnlineEstimator {
  public:
-  /// `setup` gives the object, the finger (and a second one in extra_fingers, at most one) and,
+  /// `setup` gives the object, the finger (and any others in extra_fingers) and,
   /// when the trajectory has them, mass and frictions; its measured streams must be empty. Its ground truth, if any, is only used
   /// for Finish()'s metrics (simulation and testing).
   OnlineEstimator(const push::Trajectory& setup, Model model, const EstimatorConfig& config = {},
@@ -123,10 +123,10 @@ class OnlineEstimator {
   /// of the recent forces' 95th percentile and mu m g, and above 1 N): a sensor fault, left out;
   /// DroppedFaultySamples() counts them and Finish()'s warnings name the first.
   bool AddForce(double t, const geometry::Vec2& force);
-  /// Finger `finger`'s samples: 0 is Trajectory::finger, 1 a two-finger push's second finger
-  /// (the setup's extra_fingers[0], whose sensors are the kinds OnlineStreams declares). Its
-  /// pose is needed by the first update too; each finger's contact stream has one row per time
-  /// (two contacts in all). A finger the setup does not have is an error naming it.
+  /// Finger `finger`'s samples: 0 is Trajectory::finger, k >= 1 the setup's extra_fingers[k - 1]
+  /// (a push with several fingers; each has the kinds of sensors OnlineStreams declares). Every
+  /// finger's pose is needed by the first update; each finger's contact stream has one row per
+  /// time (one contact per finger). A finger the setup does not have is an error naming it.
   bool AddFingerPose(double t, int finger, const geometry::Pose2& pose);
   bool AddContactPoint(double t, int finger, const geometry::Vec2& point);
   bool AddForce(double t, int finger, const geometry::Vec2& force);
