@@ -1093,15 +1093,18 @@ void GraphBuilder::DropUnobservableForces(EstimationResult& result) const {
       const auto& contact = ContactRows(finger);
       const auto& force = ForceRows(finger);
       if (streams_.contact_point && contact.empty()) {
+        // Pushing rows: above the contact threshold and three force sigmas (the noise of a finger
+        // that never touched: 1% of its rows), in more than a tenth of its rows.
+        const double bound = std::max(cfg_.contact_force_threshold, 3.0 * cfg_.measurement.force);
         const auto pushing = std::count_if(force.begin(), force.end(), [&](const push::ForceSample& f) {
-          return f.force.norm() >= cfg_.contact_force_threshold;
+          return f.force.norm() >= bound;
         });
-        if (pushing > 0) {
+        if (pushing > 0 && 10 * pushing > static_cast<long>(force.size())) {
           char text[240];
           std::snprintf(text, sizeof text,
                         "finger %d has no contact rows while another finger has: it is taken as never touching, and its "
                         "%d force rows of at least %.3g N were left out",
-                        finger, static_cast<int>(pushing), cfg_.contact_force_threshold);
+                        finger, static_cast<int>(pushing), bound);
           result.warnings.push_back(text);
         }
       }

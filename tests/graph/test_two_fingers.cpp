@@ -23,6 +23,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <random>
 #include <string>
 
 namespace pushgraph::graph {
@@ -250,6 +251,14 @@ TEST(TwoFingers, AFingerWithoutTheOthersSensorIsSaid) {
   t = full;
   t.extra_fingers[0].measured.force.clear();
   EXPECT_TRUE(said(Estimate(t, Model::kQs, Mode::kBatch, config), "finger 1 has no force rows"));
+  // A finger that never touched (no contact rows, its force rows the sensor's noise alone) is
+  // not said to have pushed.
+  t = full;
+  t.extra_fingers[0].measured.contact_point.clear();
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> noise(0.0, config.measurement.force);
+  for (push::ForceSample& f : t.extra_fingers[0].measured.force) f.force = Vec2(noise(rng), noise(rng));
+  EXPECT_FALSE(said(Estimate(t, Model::kQs, Mode::kBatch, config), "finger 1 has no contact rows"));
 }
 
 // The self-diagnosis measures each finger's contact gap with its own shape: finger 1 given twice
