@@ -146,6 +146,8 @@ Contacts PoolContacts(const std::vector<const push::Trajectory*>& recordings, co
     const ContactPath path = MeasuredContactPath(traj, o);
     pooled.q.insert(pooled.q.end(), path.q.begin(), path.q.end());
     pooled.relative.insert(pooled.relative.end(), path.relative.begin(), path.relative.end());
+    pooled.finger.insert(pooled.finger.end(), path.finger.begin(), path.finger.end());
+    pooled.radius.insert(pooled.radius.end(), path.radius.begin(), path.radius.end());
     pooled.recording.insert(pooled.recording.end(), path.q.size(), static_cast<int>(k));
     spans->push_back(path.t.empty() ? 0.0 : path.t.back() - path.t.front());
     pooled.noise = std::max(pooled.noise, path.noise);

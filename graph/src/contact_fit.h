@@ -38,6 +38,8 @@ std::vector<Vec2> OutlineSamples(const Shape& shape);
 struct Contacts {
   std::vector<Vec2> q;
   std::vector<Pose2> relative;
+  std::vector<int> finger;      // which finger (ContactPath::finger)
+  std::vector<double> radius;   // its disk's radius
   std::vector<int> recording;
   std::vector<double> weight;
   int recordings = 0;
@@ -55,6 +57,8 @@ struct Contacts {
       const std::size_t i = static_cast<std::size_t>(k);
       out.q.push_back(q[i]);
       out.relative.push_back(relative[i]);
+      out.finger.push_back(finger[i]);
+      out.radius.push_back(radius[i]);
       out.recording.push_back(recording[i]);
     }
     std::vector<int> per(recordings, 0);
@@ -119,7 +123,7 @@ class ContactFit {
   // separation), and its gradient with respect to (tx, ty, theta, log s).
   double RawGap(std::size_t i, const Placement& p, Eigen::Vector4d* J) const {
     const Pose2 T{p.x.x(), p.x.y(), p.x.z()};
-    if (querier_) {
+    if (querier_ && c_.finger[i] == 0) {  // finger 0's exact shape; other fingers as disks
       geometry::ShapePairJacobians Js;
       const auto r = querier_->Query(T, c_.relative[i], &Js);
       if (J) *J << Js.J_sd_object_pose.transpose(), 0.0;
@@ -135,7 +139,7 @@ class ContactFit {
       J->head<3>() = (pq.normal.transpose() * J_local_T).transpose();
       (*J)(3) = sd - pq.normal.dot(local);
     }
-    return sd - disk_.radius;
+    return sd - c_.radius[i];
   }
   double Gap(std::size_t i, const Placement& p) const { return RawGap(i, p, nullptr) - p.gap(c_.recording[i]); }
 

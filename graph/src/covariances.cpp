@@ -131,15 +131,21 @@ std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder, c
       // Every finger's pose; each finger's contact and force (their own: each finger has a sensor).
       for (FingerPoseEstimate& f : s.other_fingers)
         if (get(builder.FingerPose(i, f.finger), c3.data())) f.pose_cov = Eigen::Matrix3d(c3);
+      // Each finger's first contact entry, then its second (a finger touching at two points).
+      std::vector<int> seen(builder.num_fingers(), 0);
       for (ContactEstimate& c : s.contacts) {
-        if (c.finger == 0) {
+        const int nth = seen[c.finger]++;
+        if (c.finger == 0 && nth == 0) {
           c.point_cov = s.contact_cov;
           c.force_cov = s.force_cov;
           continue;
         }
-        if (get(builder.FingerContact(i, c.finger), c2.data())) c.point_cov = Eigen::Matrix2d(c2);
-        if (c.force && get(builder.FingerForce(i, c.finger), c2.data())) c.force_cov = Eigen::Matrix2d(c2);
+        double* point = nth == 0 ? builder.FingerContact(i, c.finger) : builder.SecondContactPoint(i, c.finger);
+        double* force = nth == 0 ? builder.FingerForce(i, c.finger) : builder.SecondContactForce(i, c.finger);
+        if (get(point, c2.data())) c.point_cov = Eigen::Matrix2d(c2);
+        if (c.force && get(force, c2.data())) c.force_cov = Eigen::Matrix2d(c2);
       }
+      if (seen[0] == 2) s.force_cov.reset();  // the sum's would need the cross-covariance
     } else if (builder.HasSecondContact(i) && s.contacts.size() == 2) {
       // Each contact's own; the net force's would need the cross-covariance of f and f2.
       s.contacts[0].point_cov = s.contact_cov;

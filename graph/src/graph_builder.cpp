@@ -123,6 +123,10 @@ int GraphBuilder::AppendSteps(double until) {
       *slots[stream] = index;
     } else {
       Step::OtherFinger& o = s.others[(stream - 1) / 3 - 1];
+      if ((stream - 1) % 3 == 1 && o.contact >= 0) {  // finger k's second row at this time
+        if (o.contact2 < 0) o.contact2 = index;
+        continue;
+      }
       int* slots[] = {&o.finger, &o.contact, &o.force};
       *slots[(stream - 1) % 3] = index;
     }
@@ -133,14 +137,16 @@ int GraphBuilder::AppendSteps(double until) {
   // combination of the same force at the two); for others it is an approximation, and the
   // result's warnings count those steps.
   for (std::size_t i = first_new; i < steps_.size(); ++i) {
-    Step& s = steps_[i];
-    if (s.contact2 < 0) continue;
-    const auto [first, last] = ContactRowsAt(s.contact);
-    if (last - first + 1 <= 2) continue;
-    ++steps_with_more_contacts_;
-    const auto [a, b] = FarthestContactRows(s.contact);
-    s.contact = a;
-    s.contact2 = b;
+    for (int k = 0; k < num_fingers(); ++k) {
+      if (SecondContactRow(i, k) < 0) continue;
+      const auto& rows = ContactRows(k);
+      const auto [first, last] = ContactRowsAt(rows, ContactRow(i, k));
+      if (last - first + 1 <= 2) continue;
+      ++steps_with_more_contacts_;
+      const auto [a, b] = FarthestContactRows(rows, ContactRow(i, k));
+      ContactRow(i, k) = a;
+      SecondContactRow(i, k) = b;
+    }
   }
   // Contact gating, on the samples received so far (all of them in batch): a finger touches
   // while its nearest contact sample is within contact_max_gap, or, without a contact stream,
@@ -157,13 +163,21 @@ int GraphBuilder::AppendSteps(double until) {
   };
   for (std::size_t i = first_new; i < steps_.size(); ++i) {
     Step& s = steps_[i];
-    for (int k = 1; k <= other_fingers_; ++k) s.others[k - 1].in_contact = touching(ContactRows(k), ForceRows(k), s.t);
+    for (int k = 1; k <= other_fingers_; ++k) {
+      Step::OtherFinger& o = s.others[k - 1];
+      o.in_contact = touching(ContactRows(k), ForceRows(k), s.t);
+      if (!o.in_contact || !streams_.contact_point) continue;
+      int row = -1;  // two contacts of finger k while its nearest contact time has two rows
+      NearestGap(ContactRows(k), s.t, &row);
+      const auto [first, last] = ContactRowsAt(ContactRows(k), row);
+      o.two_contacts = last > first;
+    }
     s.in_contact = touching(m.contact_point, m.force, s.t);
     if (s.in_contact && streams_.contact_point) {
       // Two contacts while the nearest contact time has two rows.
       int k = -1;
       NearestGap(m.contact_point, s.t, &k);
-      const auto [first, last] = ContactRowsAt(k);
+      const auto [first, last] = ContactRowsAt(m.contact_point, k);
       s.two_contacts = last > first;
       if (s.two_contacts && model_ == Model::kYu) {
         // The baseline models one contact, as published: it keeps the first of the two.
@@ -174,6 +188,7 @@ int GraphBuilder::AppendSteps(double until) {
   }
   vars_.resize(steps_.size());
   if (other_fingers_ > 1) more_vars_.resize(steps_.size() * (other_fingers_ - 1));
+  if (other_fingers_ > 0) second_vars_.resize(steps_.size() * num_fingers());
   return static_cast<int>(steps_.size() - first_new);
 }
 
@@ -201,7 +216,8 @@ void GraphBuilder::SetUpShapes(std::shared_ptr<const geometry::ShapePairQuerier>
     outer.push_back({polygon.outer, {}});
   }
   if (object_has_holes_) object_outer_ = geometry::Shape::FromPolygons(outer, traj_.object.shape.radius());
-  finger_has_faces_ = !(traj_.finger.shape.is_degenerate_core() && traj_.finger.shape.num_vertices() <= 1);
+  for (int k = 0; k < num_fingers(); ++k)
+    finger_has_faces_.push_back(!(FingerShape(k).is_degenerate_core() && FingerShape(k).num_vertices() <= 1));
   for (int k = 1; k <= other_fingers_; ++k) other_queriers_.push_back(MakeQuerier(traj_, FingerShape(k), cfg_));
   if (ModelHasForce(model_)) qs_ = QuasiStaticGeometryFor(traj_, cfg_);
   if (traj_.object.mass > 0.0 && traj_.object.mu_surface > 0.0) {
@@ -397,7 +413,7 @@ void GraphBuilder::Initialize(int i, double limit) {
       const auto q = geometry::QueryPoint(traj_.object.shape, Pose2{v.x[0], v.x[1], v.x[2]}, Vec2(v.e[0], v.e[1]));
       v.p[0] = q.closest_point.x(); v.p[1] = q.closest_point.y();
     }
-    if (s.two_contacts) InitializeSecondContact(i, causal);
+    if (s.two_contacts) InitializeSecondContact(i, 0, causal);
     if (s.force >= 0) {
       v.f[0] = m.force[s.force].force.x(); v.f[1] = m.force[s.force].force.y();
     } else if (!m.force.empty() && !causal) {
@@ -413,21 +429,23 @@ void GraphBuilder::Initialize(int i, double limit) {
     }
     if (s.two_contacts) {
       // The measured (net) force shared by both contacts to start.
-      v.f2[0] = v.f[0] = 0.5 * v.f[0];
-      v.f2[1] = v.f[1] = 0.5 * v.f[1];
+      double* f2 = SecondContactForce(i, 0);
+      f2[0] = v.f[0] = 0.5 * v.f[0];
+      f2[1] = v.f[1] = 0.5 * v.f[1];
     }
   }
 }
 
-std::vector<std::pair<GraphBuilder::ContactFeature, Vec2>> GraphBuilder::NearbyContactFeatures(int i) const {
+std::vector<std::pair<GraphBuilder::ContactFeature, Vec2>> GraphBuilder::NearbyContactFeatures(int i, int k) const {
   const StepVars& v = vars_[i];
-  const Pose2 x{v.x[0], v.x[1], v.x[2]}, e{v.e[0], v.e[1], v.e[2]};
+  const double* pose = FingerPose(i, k);
+  const Pose2 x{v.x[0], v.x[1], v.x[2]}, e{pose[0], pose[1], pose[2]};
   // Candidates: every object feature the finger is near at the current values (3 sigma of a
   // contact measurement: the values may be that far off), each once.
   const double tolerance = 3.0 * cfg_.measurement.contact;
   std::vector<geometry::ContactPoint> found;
   try {
-    found = geometry::FindContacts(traj_.object.shape, x, traj_.finger.shape, e, {tolerance, tolerance});
+    found = geometry::FindContacts(traj_.object.shape, x, FingerShape(k), e, {tolerance, tolerance});
   } catch (const geometry::GeometryError&) {
     return {};
   }
@@ -445,15 +463,16 @@ std::vector<std::pair<GraphBuilder::ContactFeature, Vec2>> GraphBuilder::NearbyC
   return distinct;
 }
 
-bool GraphBuilder::TwoContactFeatures(int i, ContactFeature out[2]) const {
-  const std::vector<std::pair<ContactFeature, Vec2>> distinct = NearbyContactFeatures(i);
-  if (finger_has_faces_) {
+bool GraphBuilder::TwoContactFeatures(int i, int finger, ContactFeature out[2]) const {
+  const std::vector<std::pair<ContactFeature, Vec2>> distinct = NearbyContactFeatures(i, finger);
+  const double* pa = FingerContact(i, finger);
+  const double* pb = SecondContactPoint(i, finger);
+  if (finger_has_faces_[finger]) {
     // A finger with straight faces touches one object edge at two points (a flat pusher face on
     // an object face): each contact to the feature nearest it, the same one or not.
     if (distinct.empty()) return false;
-    const StepVars& v = vars_[i];
     for (int k = 0; k < 2; ++k) {
-      const Vec2 p = k == 0 ? Vec2(v.p[0], v.p[1]) : Vec2(v.p2[0], v.p2[1]);
+      const Vec2 p = k == 0 ? Vec2(pa[0], pa[1]) : Vec2(pb[0], pb[1]);
       out[k] = std::min_element(distinct.begin(), distinct.end(), [&](const auto& a, const auto& b) {
                  return (p - a.second).squaredNorm() < (p - b.second).squaredNorm();
                })->first;
@@ -465,8 +484,7 @@ bool GraphBuilder::TwoContactFeatures(int i, ContactFeature out[2]) const {
   // Each contact variable to its own feature: the pair of distinct features nearest the two
   // current values (a flat pusher across a notch touches four features; the rows kept are the
   // outer two, which the features nearest them match, not the nearest by separation).
-  const StepVars& v = vars_[i];
-  const Vec2 p1(v.p[0], v.p[1]), p2(v.p2[0], v.p2[1]);
+  const Vec2 p1(pa[0], pa[1]), p2(pb[0], pb[1]);
   double best = INFINITY;
   for (std::size_t a = 0; a < distinct.size(); ++a) {
     for (std::size_t b = 0; b < distinct.size(); ++b) {
@@ -548,32 +566,30 @@ std::array<long long, 2> GraphBuilder::FixedFeatureKeys(bool on_features, const 
   return keys;
 }
 
-std::array<long long, 2> GraphBuilder::FeatureChoice(int i) const {
-  const Step& s = steps_[i];
-  if (!s.in_contact || !s.two_contacts) return {-1, -1};
+std::array<long long, 2> GraphBuilder::FeatureChoice(int i, int k) const {
+  if (!FingerTwoContacts(i, k)) return {-1, -1};
   ContactFeature f[2];
-  const bool on_features = TwoContactFeatures(i, f);
+  const bool on_features = TwoContactFeatures(i, k, f);
   return FixedFeatureKeys(on_features, f);
 }
 
 int GraphBuilder::FeatureChoicesChanged() const {
   int changed = 0;
-  for (int i = 0; i < static_cast<int>(steps_.size()) && i < static_cast<int>(feature_choices_.size()); ++i)
-    changed += FeatureChoice(i) != feature_choices_[i];
+  const int fingers = num_fingers();
+  for (int i = 0; i < static_cast<int>(steps_.size()) && (i + 1) * fingers <= static_cast<int>(feature_choices_.size()); ++i)
+    for (int k = 0; k < fingers; ++k) changed += FeatureChoice(i, k) != feature_choices_[i * fingers + k];
   return changed;
 }
 
-std::pair<int, int> GraphBuilder::ContactRowsAt(int k) const {
-  const auto& c = traj_.measured.contact_point;
+std::pair<int, int> GraphBuilder::ContactRowsAt(const std::vector<push::PointSample>& c, int k) {
   int first = k, last = k;
   while (first > 0 && c[first - 1].t == c[k].t) --first;
   while (last + 1 < static_cast<int>(c.size()) && c[last + 1].t == c[k].t) ++last;
   return {first, last};
 }
 
-std::pair<int, int> GraphBuilder::FarthestContactRows(int k) const {
-  const auto& c = traj_.measured.contact_point;
-  const auto [first, last] = ContactRowsAt(k);
+std::pair<int, int> GraphBuilder::FarthestContactRows(const std::vector<push::PointSample>& c, int k) {
+  const auto [first, last] = ContactRowsAt(c, k);
   std::pair<int, int> best{first, std::min(first + 1, last)};
   double farthest = -1.0;
   for (int a = first; a <= last; ++a)
@@ -637,40 +653,50 @@ void GraphBuilder::InitializeOtherFinger(int i, int k, double limit) {
   }
   FingerForce(i, k)[0] = f.x();
   FingerForce(i, k)[1] = f.y();
+  if (s.two_contacts) {
+    InitializeSecondContact(i, k, causal);
+    double* f1 = FingerForce(i, k);
+    double* f2 = SecondContactForce(i, k);
+    f2[0] = f1[0] = 0.5 * f1[0];  // the finger's measured (net) force shared to start
+    f2[1] = f1[1] = 0.5 * f1[1];
+  }
 }
 
-void GraphBuilder::InitializeSecondContact(int i, bool causal) {
-  const auto& m = traj_.measured;
-  Step& s = steps_[i];
-  StepVars& v = vars_[i];
-  const StepVars* prev = i > 0 && steps_[i - 1].two_contacts ? &vars_[i - 1] : nullptr;
-  Vec2 a(v.p[0], v.p[1]), b = a;
-  if (s.contact >= 0 && s.contact2 >= 0) {
-    b = m.contact_point[s.contact2].point;
+void GraphBuilder::InitializeSecondContact(int i, int finger, bool causal) {
+  const std::vector<push::PointSample>& c = ContactRows(finger);
+  int& row = ContactRow(i, finger);
+  int& row2 = SecondContactRow(i, finger);
+  double* pa = FingerContact(i, finger);
+  double* pb = SecondContactPoint(i, finger);
+  const bool paired = i > 0 && FingerTwoContacts(i - 1, finger);
+  const double* prev_a = paired ? FingerContact(i - 1, finger) : nullptr;
+  const double* prev_b = paired ? SecondContactPoint(i - 1, finger) : nullptr;
+  Vec2 a(pa[0], pa[1]), b = a;
+  if (row >= 0 && row2 >= 0) {
+    b = c[row2].point;
   } else {
     // The two rows of the nearest contact time (none at this step).
     int k = -1;
-    NearestGap(m.contact_point, s.t, &k);
-    const auto& c = m.contact_point;
-    const auto [first, second] = FarthestContactRows(k);
-    if (!causal || c[first].t <= s.t) {
+    NearestGap(c, steps_[i].t, &k);
+    const auto [first, second] = FarthestContactRows(c, k);
+    if (!causal || c[first].t <= steps_[i].t) {
       a = c[first].point;
       b = c[second].point;
-    } else if (prev != nullptr) {
-      a = Vec2(prev->p[0], prev->p[1]);
-      b = Vec2(prev->p2[0], prev->p2[1]);
+    } else if (paired) {
+      a = Vec2(prev_a[0], prev_a[1]);
+      b = Vec2(prev_b[0], prev_b[1]);
     }
   }
-  // Pair the rows with p and p2 as the previous step's (the sensor's row order may change).
-  if (prev != nullptr) {
-    const Vec2 p1(prev->p[0], prev->p[1]), p2(prev->p2[0], prev->p2[1]);
+  // Pair the rows with the two contacts as the previous step's (the sensor's row order may change).
+  if (paired) {
+    const Vec2 p1(prev_a[0], prev_a[1]), p2(prev_b[0], prev_b[1]);
     if ((a - p2).norm() + (b - p1).norm() < (a - p1).norm() + (b - p2).norm()) {
       std::swap(a, b);
-      if (s.contact >= 0 && s.contact2 >= 0) std::swap(s.contact, s.contact2);
+      if (row >= 0 && row2 >= 0) std::swap(row, row2);
     }
   }
-  v.p[0] = a.x(); v.p[1] = a.y();
-  v.p2[0] = b.x(); v.p2[1] = b.y();
+  pa[0] = a.x(); pa[1] = a.y();
+  pb[0] = b.x(); pb[1] = b.y();
 }
 
 int GraphBuilder::SmoothInitialMotion(int max_iterations, double function_tolerance, int first, int last) {
@@ -755,6 +781,8 @@ void GraphBuilder::AddFactors(ceres::Problem& problem, int i, int parts) {
     if (HasSecondContact(i)) problem.AddParameterBlock(v.p2, 2);
     for (int k = 2; k <= other_fingers_; ++k)
       if (FingerTouches(i, k)) problem.AddParameterBlock(FingerContact(i, k), 2);
+    for (int k = 0; k <= other_fingers_ && other_fingers_ > 0; ++k)
+      if (FingerTwoContacts(i, k)) problem.AddParameterBlock(SecondContactPoint(i, k), 2);
     AddKinematicFactors(problem, i);
   }
   bool more_forces = false;
@@ -764,14 +792,17 @@ void GraphBuilder::AddFactors(ceres::Problem& problem, int i, int parts) {
     if (HasSecondForceVars(i)) problem.AddParameterBlock(v.f2, 2);
     for (int k = 2; k <= other_fingers_; ++k)
       if (FingerTouches(i, k)) problem.AddParameterBlock(FingerForce(i, k), 2);
+    for (int k = 0; k <= other_fingers_ && other_fingers_ > 0; ++k)
+      if (FingerTwoContacts(i, k)) problem.AddParameterBlock(SecondContactForce(i, k), 2);
     AddDynamicFactors(problem, i);
   }
 }
 
 void GraphBuilder::AddKinematicFactors(ceres::Problem& problem, int i) {
   adding_step_ = i;
-  if (feature_choices_.size() < steps_.size()) feature_choices_.resize(steps_.size(), {-1, -1});
-  feature_choices_[i] = {-1, -1};
+  const std::size_t fingers = num_fingers();
+  if (feature_choices_.size() < steps_.size() * fingers) feature_choices_.resize(steps_.size() * fingers, {-1, -1});
+  for (std::size_t k = 0; k < fingers; ++k) feature_choices_[i * fingers + k] = {-1, -1};
   const auto& m = traj_.measured;
   const Step& s = steps_[i];
   StepVars& v = vars_[i];
@@ -785,34 +816,9 @@ void GraphBuilder::AddKinematicFactors(ceres::Problem& problem, int i) {
     Add(problem, FactorType::kContactOnObject, new BoundaryPointFactor(ContactBoundary(i, 0), cfg_.contact_object_sigma),
         nullptr, {v.x, v.p}, {0});
     if (s.two_contacts) {
-      // Two contacts: each point on the object's boundary and at its own wall's touching pair
-      // (the shape-pair witness is the single nearest pair, one of the two: it would pull both
-      // points onto the same wall).
-      if (s.contact2 >= 0) {
-        Add(problem, FactorType::kContactPoint, new VectorMeasurementFactor(m.contact_point[s.contact2].point, cfg_.measurement.contact),
-            MakeLoss(cfg_.contact_loss), {v.p2});
-      }
-      Add(problem, FactorType::kContactOnObject, new BoundaryPointFactor(ContactBoundary(i, 0), cfg_.contact_object_sigma),
-          nullptr, {v.x, v.p2}, {0});
-      ContactFeature features[2];
-      const bool on_features = TwoContactFeatures(i, features);
-      feature_choices_[i] = FixedFeatureKeys(on_features, features);
-      double* points[2] = {v.p, v.p2};
-      for (int k = 0; k < 2; ++k) {
-        // An object vertex is never a fixed feature: pinned to a corner at the start, a contact
-        // that is really on the adjacent edge (a flat pusher's end near the corner) holds the
-        // object shifted along that edge, and the corner is then the nearest feature at the
-        // solution too. The local witness follows p instead.
-        const bool fixed = feature_choices_[i][k] >= 0;
-        ceres::CostFunction* cost =
-            fixed ? static_cast<ceres::CostFunction*>(new FeatureWitnessFactor(
-                        traj_.object.shape, features[k].edge, features[k].vertex, traj_.finger.shape,
-                        cfg_.contact_finger_sigma))
-                  : new LocalWitnessFactor(traj_.object.shape, traj_.finger.shape, cfg_.contact_finger_sigma);
-        Add(problem, FactorType::kContactOnFinger, cost, nullptr, {v.x, v.e, points[k]}, {0});
-      }
+      AddTwoContactFactors(problem, i, 0);
     } else if (cfg_.contact_finger == EstimatorConfig::ContactFinger::kWitness &&
-               (finger_has_faces_ || BetweenWalls(i))) {
+               (finger_has_faces_[0] || BetweenWalls(i))) {
       // A finger with straight faces (a flat pusher: along a parallel object face the nearest
       // pair is any pair of the overlap, and the shape-pair query returns a vertex's), or a disk
       // between two walls (the nearest pair may jump to the other wall): the local witness of p
@@ -852,6 +858,38 @@ void GraphBuilder::AddKinematicFactors(ceres::Problem& problem, int i) {
   for (int k = 1; k <= other_fingers_; ++k) AddOtherFingerKinematicFactors(problem, i, k);
 }
 
+void GraphBuilder::AddTwoContactFactors(ceres::Problem& problem, int i, int finger) {
+  // Two contacts: each point on the object's boundary and at its own wall's touching pair (the
+  // shape-pair witness is the single nearest pair, one of the two: it would pull both points
+  // onto the same wall). The first contact's M and C are the finger's own (added before).
+  StepVars& v = vars_[i];
+  double* second = SecondContactPoint(i, finger);
+  const int row2 = SecondContactRow(i, finger);
+  if (row2 >= 0) {
+    Add(problem, FactorType::kContactPoint, new VectorMeasurementFactor(ContactRows(finger)[row2].point, cfg_.measurement.contact),
+        MakeLoss(cfg_.contact_loss), {second});
+  }
+  Add(problem, FactorType::kContactOnObject, new BoundaryPointFactor(ContactBoundary(i, finger), cfg_.contact_object_sigma),
+      nullptr, {v.x, second}, {0});
+  ContactFeature features[2];
+  const bool on_features = TwoContactFeatures(i, finger, features);
+  std::array<long long, 2>& choice = feature_choices_[static_cast<std::size_t>(i) * num_fingers() + finger];
+  choice = FixedFeatureKeys(on_features, features);
+  double* points[2] = {FingerContact(i, finger), second};
+  const geometry::Shape& shape = FingerShape(finger);
+  for (int k = 0; k < 2; ++k) {
+    // An object vertex is never a fixed feature: pinned to a corner at the start, a contact
+    // that is really on the adjacent edge (a flat pusher's end near the corner) holds the
+    // object shifted along that edge, and the corner is then the nearest feature at the
+    // solution too. The local witness follows p instead.
+    ceres::CostFunction* cost =
+        choice[k] >= 0 ? static_cast<ceres::CostFunction*>(new FeatureWitnessFactor(
+                             traj_.object.shape, features[k].edge, features[k].vertex, shape, cfg_.contact_finger_sigma))
+                       : new LocalWitnessFactor(traj_.object.shape, shape, cfg_.contact_finger_sigma);
+    Add(problem, FactorType::kContactOnFinger, cost, nullptr, {v.x, FingerPose(i, finger), points[k]}, {0});
+  }
+}
+
 void GraphBuilder::AddOtherFingerKinematicFactors(ceres::Problem& problem, int i, int k) {
   // Finger k's own M of its contact, C, S and touching, with its own shape and querier.
   adding_step_ = i;
@@ -867,7 +905,13 @@ void GraphBuilder::AddOtherFingerKinematicFactors(ceres::Problem& problem, int i
     }
     Add(problem, FactorType::kContactOnObject, new BoundaryPointFactor(ContactBoundary(i, k), cfg_.contact_object_sigma),
         nullptr, {v.x, p}, {0});
-    if (cfg_.contact_finger == EstimatorConfig::ContactFinger::kWitness) {
+    if (s.two_contacts) {
+      AddTwoContactFactors(problem, i, k);
+    } else if (cfg_.contact_finger == EstimatorConfig::ContactFinger::kWitness && finger_has_faces_[k]) {
+      // A finger with straight faces: the local witness of p (as finger 0's, AddKinematicFactors).
+      Add(problem, FactorType::kContactOnFinger, new LocalWitnessFactor(traj_.object.shape, FingerShape(k), cfg_.contact_finger_sigma),
+          nullptr, {v.x, e, p}, {0});
+    } else if (cfg_.contact_finger == EstimatorConfig::ContactFinger::kWitness) {
       Add(problem, FactorType::kContactOnFinger, new ContactWitnessFactor(querier, cfg_.contact_finger_sigma), nullptr,
           {v.x, e, p}, {0});
     } else {
@@ -924,41 +968,39 @@ void GraphBuilder::AddConstantVelocityFactors(ceres::Problem& problem, int i) {
 
 void GraphBuilder::AddDynamicFactors(ceres::Problem& problem, int i) {
   adding_step_ = i;
-  const auto& m = traj_.measured;
   const Step& s = steps_[i];
   StepVars& v = vars_[i];
-  const bool has1 = HasForceVars(i);
-  const bool wedged = has1 && s.two_contacts;  // both contacts finger 0's
-  // The step's contacts with a force: finger 0's one or two, then one of each other finger
-  // that touches, each with its finger (whose friction and previous step it takes).
+  // The step's contacts with a force: each touching finger's one or two (finger 0's first),
+  // each with its finger (whose friction it takes) and the same contact's force at step i - 1.
   struct Contact {
     double* p;
     double* f;
     int finger;
-    bool previous;  // the same contact had a force at step i - 1
+    double* before;  // the same contact's force at step i - 1 (null: none)
   };
   std::vector<Contact> contacts;
-  if (has1) contacts.push_back({v.p, v.f, 0, i >= 1 && HasForceVars(i - 1)});
-  if (wedged) contacts.push_back({v.p2, v.f2, 0, i >= 1 && HasSecondForceVars(i - 1)});
-  for (int k = 1; k <= other_fingers_ && ModelHasForce(model_); ++k) {
+  for (int k = 0; k <= other_fingers_ && ModelHasForce(model_); ++k) {
     if (!FingerTouches(i, k)) continue;
-    // Finger 1's force is f2 as finger 0's second one is (the two never share a push).
-    const bool previous = i >= 1 && (k == 1 ? HasSecondForceVars(i - 1) : FingerTouches(i - 1, k));
-    contacts.push_back({FingerContact(i, k), FingerForce(i, k), k, previous});
+    const bool previous = i >= 1 && FingerTouches(i - 1, k);
+    contacts.push_back({FingerContact(i, k), FingerForce(i, k), k, previous ? FingerForce(i - 1, k) : nullptr});
+    if (!FingerTwoContacts(i, k)) continue;
+    const bool previous2 = i >= 1 && FingerTwoContacts(i - 1, k);
+    contacts.push_back({SecondContactPoint(i, k), SecondContactForce(i, k), k, previous2 ? SecondContactForce(i - 1, k) : nullptr});
   }
-  // Force: each finger's sensor (a wedged finger's measures the sum of its two contacts).
-  if (has1 && s.force >= 0 && wedged) {
-    Add(problem, FactorType::kForce, new VectorSumMeasurementFactor(m.force[s.force].force, cfg_.measurement.force),
-        MakeLoss(cfg_.force_loss), {v.f, v.f2});
-  } else if (has1 && s.force >= 0) {
-    Add(problem, FactorType::kForce, new VectorMeasurementFactor(m.force[s.force].force, cfg_.measurement.force),
-        MakeLoss(cfg_.force_loss), {v.f});
-  }
-  for (const Contact& c : contacts) {
-    if (c.finger == 0 || s.others[c.finger - 1].force < 0) continue;
-    Add(problem, FactorType::kForce,
-        new VectorMeasurementFactor(ForceRows(c.finger)[s.others[c.finger - 1].force].force, cfg_.measurement.force),
-        MakeLoss(cfg_.force_loss), {c.f});
+  // Force: each finger's sensor (one touching at two points measures the sum of both).
+  for (std::size_t c = 0; c < contacts.size(); ++c) {
+    const int k = contacts[c].finger;
+    if (c > 0 && contacts[c - 1].finger == k) continue;  // a finger's second contact
+    const int row = k == 0 ? s.force : s.others[k - 1].force;
+    if (row < 0) continue;
+    const Vec2& measured = ForceRows(k)[row].force;
+    if (FingerTwoContacts(i, k)) {
+      Add(problem, FactorType::kForce, new VectorSumMeasurementFactor(measured, cfg_.measurement.force),
+          MakeLoss(cfg_.force_loss), {contacts[c].f, contacts[c + 1].f});
+    } else {
+      Add(problem, FactorType::kForce, new VectorMeasurementFactor(measured, cfg_.measurement.force),
+          MakeLoss(cfg_.force_loss), {contacts[c].f});
+    }
   }
   // The weak prior; with several contacts each force in its friction cone (sigma a tenth of
   // the force sensor's): a wedged finger's sensor measures only the sum, and the cone keeps
@@ -970,13 +1012,10 @@ void GraphBuilder::AddDynamicFactors(ceres::Problem& problem, int i) {
         new FrictionConeFactor(traj_.object.shape, FingerMu(contacts[k].finger), 0.1 * cfg_.measurement.force), nullptr,
         {v.x, contacts[k].p, contacts[k].f}, {0});
   if (i < 1) return;
-  double* previous_f[3] = {vars_[i - 1].f, vars_[i - 1].f2, nullptr};
-  for (std::size_t k = 0; k < contacts.size(); ++k) {
-    if (!contacts[k].previous) continue;
-    double* before = contacts[k].finger >= 2 ? FingerForce(i - 1, contacts[k].finger)
-                                             : previous_f[contacts[k].f == v.f ? 0 : 1];
+  for (const Contact& c : contacts) {
+    if (c.before == nullptr) continue;
     Add(problem, FactorType::kForceContinuity, new VectorRandomWalkFactor(s.t - steps_[i - 1].t, cfg_.force_random_walk),
-        nullptr, {before, contacts[k].f});
+        nullptr, {c.before, c.f});
   }
   if (contacts.size() == 1) {
     AddOneContactQuasiStatic(problem, i, contacts[0].p, contacts[0].f);
@@ -1068,6 +1107,11 @@ std::vector<double*> GraphBuilder::Blocks(int i) {
     if (FingerTouches(i, k)) b.push_back(FingerContact(i, k));
     if (FingerTouches(i, k) && ModelHasForce(model_)) b.push_back(FingerForce(i, k));
   }
+  for (int k = 0; k <= other_fingers_ && other_fingers_ > 0; ++k) {
+    if (!FingerTwoContacts(i, k)) continue;
+    b.push_back(SecondContactPoint(i, k));
+    if (ModelHasForce(model_)) b.push_back(SecondContactForce(i, k));
+  }
   return b;
 }
 
@@ -1153,13 +1197,20 @@ void GraphBuilder::SetState(int i, const StateEstimate& st) {
       double* e = FingerPose(i, o.finger);
       e[0] = o.pose.x; e[1] = o.pose.y; e[2] = o.pose.theta;
     }
+    // Each finger's first contact entry, then its second (finger 0's first is contact above).
+    std::vector<int> seen(num_fingers(), 0);
     for (const ContactEstimate& c : st.contacts) {
-      if (c.finger < 1 || c.finger > other_fingers_) continue;
-      double* p = FingerContact(i, c.finger);
-      double* f = FingerForce(i, c.finger);
+      if (c.finger < 0 || c.finger > other_fingers_) continue;
+      const int nth = seen[c.finger]++;
+      if (nth > 1 || (c.finger == 0 && nth == 0)) continue;
+      double* p = nth == 0 ? FingerContact(i, c.finger) : SecondContactPoint(i, c.finger);
+      double* f = nth == 0 ? FingerForce(i, c.finger) : SecondContactForce(i, c.finger);
       p[0] = c.point.x(); p[1] = c.point.y();
       const Vec2 force = c.force.value_or(Vec2::Zero());
       f[0] = force.x(); f[1] = force.y();
+    }
+    if (seen[0] == 2 && st.contacts.front().force) {  // finger 0's first force: its own entry's
+      v.f[0] = st.contacts.front().force->x(); v.f[1] = st.contacts.front().force->y();
     }
   } else if (HasSecondContact(i) && st.contacts.size() == 2) {
     v.p2[0] = st.contacts[1].point.x(); v.p2[1] = st.contacts[1].point.y();
@@ -1192,20 +1243,20 @@ StateEstimate GraphBuilder::State(int i) const {
       const double* e = FingerPose(i, k);
       s.other_fingers.push_back({k, Pose2{e[0], e[1], e[2]}, std::nullopt});
     }
-    if (HasContactVars(i)) {
-      ContactEstimate c;
-      c.point = Vec2(v.p[0], v.p[1]);
-      if (HasForceVars(i)) c.force = Vec2(v.f[0], v.f[1]);
-      s.contacts.push_back(c);
-    }
-    for (int k = 1; k <= other_fingers_; ++k) {
+    for (int k = 0; k <= other_fingers_; ++k) {
       if (!FingerTouches(i, k)) continue;
-      ContactEstimate c;
-      c.finger = k;
-      c.point = Vec2(FingerContact(i, k)[0], FingerContact(i, k)[1]);
-      if (ModelHasForce(model_)) c.force = Vec2(FingerForce(i, k)[0], FingerForce(i, k)[1]);
-      s.contacts.push_back(c);
+      for (int nth = 0; nth < (FingerTwoContacts(i, k) ? 2 : 1); ++nth) {
+        const double* p = nth == 0 ? FingerContact(i, k) : SecondContactPoint(i, k);
+        const double* f = nth == 0 ? FingerForce(i, k) : SecondContactForce(i, k);
+        ContactEstimate c;
+        c.finger = k;
+        c.point = Vec2(p[0], p[1]);
+        if (ModelHasForce(model_)) c.force = Vec2(f[0], f[1]);
+        s.contacts.push_back(c);
+      }
     }
+    // Finger 0 touching at two points: force is their sum, as with one finger.
+    if (FingerTwoContacts(i, 0) && ModelHasForce(model_)) s.force = *s.contacts[0].force + *s.contacts[1].force;
   } else if (HasSecondContact(i)) {
     s.contacts.resize(2);
     s.contacts[0].point = Vec2(v.p[0], v.p[1]);

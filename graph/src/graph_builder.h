@@ -60,11 +60,13 @@ struct Step {
   bool two_contacts = false;
   int contact2 = -1;
   /// Fingers 1, 2, ... of a push with several (Trajectory::extra_fingers): each one's rows at
-  /// this time and whether it touches. Each touches at one point at most; finger 0 has two
-  /// contacts only when it is alone.
+  /// this time, whether it touches, and at two points (as finger 0's contact, contact2 and
+  /// two_contacts above).
   struct OtherFinger {
     int finger = -1, contact = -1, force = -1;
     bool in_contact = false;
+    bool two_contacts = false;
+    int contact2 = -1;
   };
   std::vector<OtherFinger> others;
 };
@@ -78,6 +80,12 @@ struct StepVars {
   double p2[2] = {0, 0};  ///< the second contact (Step::two_contacts, or finger 1's)
   double f2[2] = {0, 0};
   double e2[3] = {0, 0, 0};  ///< finger 1's pose (pushes with several fingers)
+};
+
+/// A contact's point and force blocks (GraphBuilder::SecondContactPoint).
+struct ContactVars {
+  double p[2] = {0, 0};
+  double f[2] = {0, 0};
 };
 
 /// Parameter blocks of finger 2, 3, ... at one step (GraphBuilder::FingerPose and friends).
@@ -160,10 +168,10 @@ class GraphBuilder {
   Model model() const { return model_; }
   bool HasContactVars(int i) const { return steps_[i].in_contact; }
   bool HasForceVars(int i) const { return steps_[i].in_contact && ModelHasForce(model_); }
-  /// Whether step i has the second contact's variables p2 (and, with forces, f2): finger 0's
-  /// second contact, or finger 1's contact in a push with several fingers.
+  /// Whether step i has the blocks p2 (and, with forces, f2): finger 0's second contact when it
+  /// is alone, finger 1's contact in a push with several fingers.
   bool HasSecondContact(int i) const {
-    return (steps_[i].in_contact && steps_[i].two_contacts) || (other_fingers_ > 0 && steps_[i].others[0].in_contact);
+    return other_fingers_ == 0 ? steps_[i].in_contact && steps_[i].two_contacts : steps_[i].others[0].in_contact;
   }
   bool HasSecondForceVars(int i) const { return HasSecondContact(i) && ModelHasForce(model_); }
   /// The fingers estimated: 1, or every finger of a push with several (the baseline keeps one).
@@ -179,6 +187,15 @@ class GraphBuilder {
   const double* FingerContact(int i, int k) const { return const_cast<GraphBuilder*>(this)->FingerContact(i, k); }
   const double* FingerForce(int i, int k) const { return const_cast<GraphBuilder*>(this)->FingerForce(i, k); }
   bool FingerTouches(int i, int k) const { return k == 0 ? steps_[i].in_contact : steps_[i].others[k - 1].in_contact; }
+  /// Whether finger k touches at two points at step i, and the second contact's blocks: finger
+  /// 0's alone are p2 and f2; with several fingers each finger's are its own.
+  bool FingerTwoContacts(int i, int k) const {
+    return FingerTouches(i, k) && (k == 0 ? steps_[i].two_contacts : steps_[i].others[k - 1].two_contacts);
+  }
+  double* SecondContactPoint(int i, int k) { return other_fingers_ == 0 ? vars_[i].p2 : SecondVars(i, k).p; }
+  double* SecondContactForce(int i, int k) { return other_fingers_ == 0 ? vars_[i].f2 : SecondVars(i, k).f; }
+  const double* SecondContactPoint(int i, int k) const { return const_cast<GraphBuilder*>(this)->SecondContactPoint(i, k); }
+  const double* SecondContactForce(int i, int k) const { return const_cast<GraphBuilder*>(this)->SecondContactForce(i, k); }
 
   /// Initial values of step i from the measurements with time stamps <= limit (interpolated;
   /// the newest held). limit = INFINITY in batch; the update time in incremental mode.
@@ -291,9 +308,14 @@ class GraphBuilder {
   void AddPoseMeasurementFactors(ceres::Problem& problem, int i);   ///< M of both poses
   void AddConstantVelocityFactors(ceres::Problem& problem, int i);  ///< V on steps i-2, i-1, i
   void AddDynamicFactors(ceres::Problem& problem, int i);
-  /// Step i's second contact point from its rows, paired with the previous step's (Initialize).
-  void InitializeSecondContact(int i, bool causal);
-  /// The object features (edge, or vertex) of step i's two contacts at the current values:
+  /// Finger k's second contact point at step i from its rows, paired with the previous step's.
+  void InitializeSecondContact(int i, int k, bool causal);
+  /// Finger k's contact rows of step i (the second: -1 when none) and its two-contact flag.
+  int& ContactRow(int i, int k) { return k == 0 ? steps_[i].contact : steps_[i].others[k - 1].contact; }
+  int& SecondContactRow(int i, int k) { return k == 0 ? steps_[i].contact2 : steps_[i].others[k - 1].contact2; }
+  bool& TwoContactsFlag(int i, int k) { return k == 0 ? steps_[i].two_contacts : steps_[i].others[k - 1].two_contacts; }
+  ContactVars& SecondVars(int i, int k) { return second_vars_[static_cast<std::size_t>(i) * num_fingers() + k]; }
+  /// The object features (edge, or vertex) of finger k's two contacts at step i's current values:
   /// geometry::FindContacts within 3 contact-measurement sigmas, and of its distinct features
   /// the pair nearest the two contact variables' current values (one each). False when fewer
   /// than two.
@@ -301,32 +323,35 @@ class GraphBuilder {
     geometry::EdgeId edge;
     bool vertex = false;
   };
-  bool TwoContactFeatures(int i, ContactFeature out[2]) const;
-  /// The distinct object features (each with its contact point) within 3 contact sigmas of the
-  /// finger at step i's current values.
-  std::vector<std::pair<ContactFeature, Vec2>> NearbyContactFeatures(int i) const;
+  bool TwoContactFeatures(int i, int k, ContactFeature out[2]) const;
+  /// The distinct object features (each with its contact point) within 3 contact sigmas of
+  /// finger k at step i's current values.
+  std::vector<std::pair<ContactFeature, Vec2>> NearbyContactFeatures(int i, int k) const;
+  /// Finger k's two contacts at step i: M of both rows, C on the object's boundary and at each
+  /// one's own feature (FeatureWitnessFactor) or local witness.
+  void AddTwoContactFactors(ceres::Problem& problem, int i, int k);
   /// Whether finger 0 at step i's current values is between two walls: two contacts within
   /// that tolerance whose normals differ by more than 60 degrees.
   bool BetweenWalls(int i) const;
   /// The two facing object edges finger 0 is within `tolerance` of at step i's current values
   /// (their contact points in a[0], a[1]); false when none.
   bool FacingWalls(int i, double tolerance, Vec2 points[2]) const;
-  /// Step i's fixed contact features at the current values, as keys (-1: none, the nearest pair
-  /// or the local witness): what AddKinematicFactors gives its contact-on-finger factors.
-  std::array<long long, 2> FeatureChoice(int i) const;
+  /// Finger k's fixed contact features at step i's current values, as keys (-1: none, the
+  /// nearest pair or the local witness): what AddTwoContactFactors gives its witness factors.
+  std::array<long long, 2> FeatureChoice(int i, int k) const;
   /// The keys of the features the contact factors hold fixed (edges; a vertex, or none: -1).
   static std::array<long long, 2> FixedFeatureKeys(bool on_features, const ContactFeature features[2]);
   /// A non-negative key of a feature (EdgeId's ring is -1 for the outer boundary).
   static long long FeatureKey(const ContactFeature& f) {
     return ((static_cast<long long>(f.edge.polygon) * 4096 + f.edge.ring + 1) * 1048576 + f.edge.index) * 2 + f.vertex;
   }
-  std::vector<std::array<long long, 2>> feature_choices_;  ///< per step, as last added
+  std::vector<std::array<long long, 2>> feature_choices_;  ///< per step and finger, as last added
   /// Querier (the given one, else a new one), quasi-static geometry, friction (both constructors).
   void SetUpShapes(std::shared_ptr<const geometry::ShapePairQuerier> querier);
-  /// The first and last contact rows at row k's time.
-  std::pair<int, int> ContactRowsAt(int k) const;
-  /// Of the contact rows at row k's time, the two farthest apart (k's own pair when two).
-  std::pair<int, int> FarthestContactRows(int k) const;
+  /// The first and last of `rows` at row k's time.
+  static std::pair<int, int> ContactRowsAt(const std::vector<push::PointSample>& rows, int k);
+  /// Of `rows` at row k's time, the two farthest apart (k's own pair when two).
+  static std::pair<int, int> FarthestContactRows(const std::vector<push::PointSample>& rows, int k);
   /// The object point nearest finger k's shape at step i's current values.
   Vec2 FingerNearestObjectPoint(int i, int k) const;
   /// Finger k's (k >= 1) initial pose, contact and force at step i.
@@ -350,14 +375,15 @@ class GraphBuilder {
   std::shared_ptr<const geometry::ShapePairQuerier> querier_;
   int other_fingers_ = 0;  ///< fingers 1, 2, ... estimated (several fingers, not the baseline)
   StableArray<MoreFingerVars> more_vars_;  ///< fingers 2, 3, ...: other_fingers_ - 1 per step
-  bool finger_has_faces_ = false;  ///< finger 0's core is more than a point (not a disk)
+  StableArray<ContactVars> second_vars_;   ///< several fingers: each finger's second contact
+  std::vector<bool> finger_has_faces_;  ///< per finger: its core is more than a point (not a disk)
   std::vector<std::shared_ptr<const geometry::ShapePairQuerier>> other_queriers_;  ///< object and finger k >= 1
   /// The object without its holes: the boundary a finger outside the object touches. C's "p on
   /// the object's boundary" measures p against it (ContactBoundary), not against the nearest
   /// ring: a noisy contact row pulled p onto a hole's edge 2 cm inside the pushed face.
   geometry::Shape object_outer_;
   bool object_has_holes_ = false;
-  /// The shape whose boundary a contact of `finger` (0 or 1) at step i lies on: the outer
+  /// The shape whose boundary a contact of finger `finger` at step i lies on: the outer
   /// boundary while the finger's reference point is outside the hole-free object (as it is when
   /// it pushes from outside), the whole shape when it is inside a hole.
   const geometry::Shape& ContactBoundary(int i, int finger) const;

@@ -507,7 +507,7 @@ struct OnlineEstimator::Impl {
   // Streams: 0 object pose; finger 0's pose, contact point, force (1-3); finger k's at
   // 3 k + 1 .. 3 k + 3.
   std::vector<double> last_seen;  // dropped samples included
-  bool repeated_contact = false;  // finger 0's newest contact sample is the second at its time
+  std::vector<bool> repeated_contact;  // per finger: its newest contact sample is the second at its time
   std::vector<std::size_t> seen;
   int dropped_late = 0;
   // Force sensor faults (the batch rule, Estimate's DropForceSpikes): a force above 50 times the
@@ -542,6 +542,7 @@ struct OnlineEstimator::Impl {
     last_seen.assign(1 + 3 * fingers, -INFINITY);
     seen.assign(1 + 3 * fingers, 0);
     declared.assign(1 + 3 * fingers, false);
+    repeated_contact.assign(fingers, false);
     declared[0] = true;
     for (int k = 0; k < fingers; ++k) {
       declared[3 * k + 1] = true;
@@ -580,18 +581,18 @@ struct OnlineEstimator::Impl {
                        "arguments in Python): it decides contact gating and the load factor");
     }
     if (!std::isfinite(t) || !finite) throw GraphError(where() + " is not finite");
-    // A second contact point at the same time is a second contact (a finger wedged in a notch);
-    // with several fingers, each has one.
+    // A second contact point of a finger at the same time is its second contact (a finger wedged
+    // in a notch, a flat face along the object's).
     const bool contact = stream >= 1 && (stream - 1) % 3 == 1;
-    const bool second_contact = stream == 2 && fingers == 1 && t == last_seen[stream] && !repeated_contact;
+    const int finger = (stream - 1) / 3;
+    const bool second_contact = contact && t == last_seen[stream] && !repeated_contact[finger];
     if (!(t > last_seen[stream]) && !second_contact) {
       throw GraphError(where() + " is not after the previous sample (t = " + Precise(last_seen[stream]) + ")" +
                        (contact && t == last_seen[stream]
-                            ? (fingers > 1 ? ": one contact per finger in a push with several fingers"
-                                           : ": at most two contacts at one time")
+                            ? ": at most two contacts at one time (per finger)"
                             : ": each stream must arrive in time order"));
     }
-    if (stream == 2) repeated_contact = second_contact;
+    if (contact) repeated_contact[finger] = second_contact;
     // A clock jump (the batch estimator's bound: 10 s or 1000 object periods): the smoother's
     // states follow the clock, so its cost would follow the jump, not the samples.
     const double jump_bound = std::max(10.0, std::isfinite(object_period) ? 1000.0 * object_period : 0.0);

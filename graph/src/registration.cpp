@@ -122,12 +122,13 @@ int OutlineSymmetryOrder(const geometry::Shape& shape, const geometry::Vec2& cen
 
 namespace {
 
-// The contact samples of `fingers` against `objects` (both already smoothed or not), gated on
-// the trajectory's contact or force stream.
+// The contact samples of every finger's poses `fingers[k]` against `objects` (both already
+// smoothed or not), each finger's gated on its own contact or force stream (with a contact sensor
+// on any finger, one without contact rows never touched), finger by finger.
 ContactPath PathOf(const push::Trajectory& traj, const std::vector<push::PoseSample>& objects,
-                   const std::vector<push::PoseSample>& fingers, const RegistrationOptions& o) {
-  const auto& m = traj.measured;
-  const FingerDisk disk = FingerAsDisk(traj.finger.shape);
+                   const std::vector<std::vector<push::PoseSample>>& fingers, const RegistrationOptions& o) {
+  bool any_contact_rows = !traj.measured.contact_point.empty();
+  for (const push::ExtraFinger& e : traj.extra_fingers) any_contact_rows = any_contact_rows || !e.measured.contact_point.empty();
   auto nearest = [](const auto& stream, double t, int* index) {
     auto it = std::lower_bound(stream.begin(), stream.end(), t, [](const auto& a, double tt) { return a.t < tt; });
     double best = INFINITY;
@@ -137,27 +138,37 @@ ContactPath PathOf(const push::Trajectory& traj, const std::vector<push::PoseSam
     return best;
   };
   ContactPath path;
-  for (const push::PoseSample& f : fingers) {
-    int k = -1;
-    if (!m.contact_point.empty()) {
-      if (nearest(m.contact_point, f.t, &k) > o.contact_max_gap) continue;
-    } else if (!m.force.empty()) {
-      if (nearest(m.force, f.t, &k) > o.contact_max_gap || m.force[k].force.norm() < o.contact_force_threshold) continue;
+  for (std::size_t finger = 0; finger < fingers.size(); ++finger) {
+    const push::FingerStreams* extra = finger == 0 ? nullptr : &traj.extra_fingers[finger - 1].measured;
+    const auto& contact = extra ? extra->contact_point : traj.measured.contact_point;
+    const auto& force = extra ? extra->force : traj.measured.force;
+    const FingerDisk disk = FingerAsDisk(finger == 0 ? traj.finger.shape : traj.extra_fingers[finger - 1].finger.shape);
+    for (const push::PoseSample& f : fingers[finger]) {
+      int k = -1;
+      if (!contact.empty()) {
+        if (nearest(contact, f.t, &k) > o.contact_max_gap) continue;
+      } else if (any_contact_rows) {
+        break;  // another finger has the contact sensor: this one never touched
+      } else if (!force.empty()) {
+        if (nearest(force, f.t, &k) > o.contact_max_gap || force[k].force.norm() < o.contact_force_threshold) continue;
+      }
+      // The object pose at f.t, interpolated across gaps of at most max_object_gap.
+      auto it = std::lower_bound(objects.begin(), objects.end(), f.t - 1e-9, [](const auto& a, double tt) { return a.t < tt; });
+      if (it == objects.end()) continue;
+      Pose2 x;
+      if (std::abs(it->t - f.t) <= 1e-9) {
+        x = it->pose;
+      } else {
+        if (it == objects.begin() || it->t - (it - 1)->t > o.max_object_gap) continue;
+        x = push::PoseAtClamped(it - 1, it + 1, f.t);
+      }
+      const Pose2 rel = geometry::Between(x, f.pose);
+      path.t.push_back(f.t);
+      path.relative.push_back(rel);
+      path.q.push_back(geometry::Act(rel, disk.centre));
+      path.finger.push_back(static_cast<int>(finger));
+      path.radius.push_back(disk.radius);
     }
-    // The object pose at f.t, interpolated across gaps of at most max_object_gap.
-    auto it = std::lower_bound(objects.begin(), objects.end(), f.t - 1e-9, [](const auto& a, double tt) { return a.t < tt; });
-    if (it == objects.end()) continue;
-    Pose2 x;
-    if (std::abs(it->t - f.t) <= 1e-9) {
-      x = it->pose;
-    } else {
-      if (it == objects.begin() || it->t - (it - 1)->t > o.max_object_gap) continue;
-      x = push::PoseAtClamped(it - 1, it + 1, f.t);
-    }
-    const Pose2 rel = geometry::Between(x, f.pose);
-    path.t.push_back(f.t);
-    path.relative.push_back(rel);
-    path.q.push_back(geometry::Act(rel, disk.centre));
   }
   return path;
 }
@@ -183,8 +194,10 @@ ContactPath MeasuredContactPath(const push::Trajectory& traj, const Registration
     StreamNoise(m.object_pose, &st, &sr);
     StreamNoise(m.finger_pose, &ft, &unused);
   }
+  std::vector<std::vector<push::PoseSample>> raw_fingers{m.finger_pose};
+  for (const push::ExtraFinger& e : traj.extra_fingers) raw_fingers.push_back(e.measured.finger_pose);
   if (!o.smooth) {
-    ContactPath path = PathOf(traj, m.object_pose, m.finger_pose, o);
+    ContactPath path = PathOf(traj, m.object_pose, raw_fingers, o);
     std::vector<double> radii;
     for (const Vec2& q : path.q) radii.push_back(q.norm());
     path.noise = std::sqrt(st * st + ft * ft + std::pow(sr * Median(radii), 2));
@@ -193,18 +206,28 @@ ContactPath MeasuredContactPath(const push::Trajectory& traj, const Registration
   // Noise-free streams still need a finite weight (ApplyMeasurementSigmas' floors).
   const double wt = std::max(st, 1e-4), wr = std::max(sr, 1e-3), wf = std::max(ft, 1e-4);
   const auto objects = Smoothed(m.object_pose, wt, wr, o.accel_trans, o.accel_rot);
-  const auto fingers = Smoothed(m.finger_pose, wf, 1.0, o.accel_trans, o.accel_rot);
+  std::vector<std::vector<push::PoseSample>> fingers;
+  for (const auto& poses : raw_fingers) fingers.push_back(Smoothed(poses, wf, 1.0, o.accel_trans, o.accel_rot));
   ContactPath path = PathOf(traj, objects, fingers, o);
   // The smoothed path's own noise, by a parametric bootstrap: the raw noise added to the
   // smoothed streams, smoothed again; the RMS change of q per axis. It depends on the rates
   // (a 25 Hz tracker is smoothed less than a 250 Hz one) and cannot be read off the residuals,
   // which a misplaced shape inflates.
   std::mt19937_64 rng(0x5eedULL + m.finger_pose.size());
-  const ContactPath again = PathOf(traj, Smoothed(WithNoise(objects, st, sr, rng), wt, wr, o.accel_trans, o.accel_rot),
-                                   Smoothed(WithNoise(fingers, ft, 0.0, rng), wf, 1.0, o.accel_trans, o.accel_rot), o);
+  // The fingers' noise drawn first, the object's then (the order of the draws sets the bootstrap).
+  std::vector<std::vector<push::PoseSample>> fingers_again;
+  for (const auto& poses : fingers)
+    fingers_again.push_back(Smoothed(WithNoise(poses, ft, 0.0, rng), wf, 1.0, o.accel_trans, o.accel_rot));
+  const auto objects_again = Smoothed(WithNoise(objects, st, sr, rng), wt, wr, o.accel_trans, o.accel_rot);
+  const ContactPath again = PathOf(traj, objects_again, fingers_again, o);
   double sum = 0.0;
   int count = 0;
+  // Both paths hold the fingers' samples finger by finger, each finger's in time order.
   for (std::size_t i = 0, j = 0; i < path.t.size() && j < again.t.size();) {
+    if (path.finger[i] != again.finger[j]) {
+      (path.finger[i] < again.finger[j] ? i : j) += 1;
+      continue;
+    }
     if (path.t[i] < again.t[j]) { ++i; continue; }
     if (again.t[j] < path.t[i]) { ++j; continue; }
     sum += (again.q[j] - path.q[i]).squaredNorm();

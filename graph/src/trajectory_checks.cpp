@@ -105,26 +105,31 @@ void CheckFingersApart(const push::Trajectory& traj, std::size_t j, std::size_t 
   const auto& a = j == 0 ? traj.measured.finger_pose : traj.extra_fingers[j - 1].measured.finger_pose;
   const auto& b = traj.extra_fingers[k - 1].measured.finger_pose;
   std::vector<std::pair<std::size_t, std::size_t>> common;
-  for (std::size_t i = 0, j = 0; i < a.size() && j < b.size();) {
-    if (std::abs(a[i].t - b[j].t) <= 1e-9) common.emplace_back(i++, j++);
-    else if (a[i].t < b[j].t) ++i;
-    else ++j;
+  for (std::size_t u = 0, w = 0; u < a.size() && w < b.size();) {
+    if (std::abs(a[u].t - b[w].t) <= 1e-9) common.emplace_back(u++, w++);
+    else if (a[u].t < b[w].t) ++u;
+    else ++w;
   }
   if (common.size() < 5) return;
   const geometry::ShapePairQuerier querier(j == 0 ? traj.finger.shape : traj.extra_fingers[j - 1].finger.shape,
                                            traj.extra_fingers[k - 1].finger.shape);
   const std::size_t stride = std::max<std::size_t>(1, common.size() / 200);
   std::vector<double> separation;
-  for (std::size_t c = 0; c < common.size(); c += stride)
+  std::size_t deepest = 0;  // the common time where they overlap most: the example named
+  for (std::size_t c = 0; c < common.size(); c += stride) {
     separation.push_back(querier.Query(a[common[c].first].pose, b[common[c].second].pose).signed_distance);
+    if (separation.back() < separation[deepest / stride]) deepest = c;
+  }
   const double median = Median(separation);
   if (median < -1e-3) {
     const std::string a_rows = j == 0 ? "finger_pose[" : "fingers[" + std::to_string(j) + "].finger_pose[";
     throw GraphError("trajectory: fingers " + std::to_string(j) + " and " + std::to_string(k) +
                      " overlap each other in their measured poses (median separation " + Format("%.2f", 1e3 * median) +
-                     " mm over " + std::to_string(separation.size()) + " common times, e.g. " + a_rows +
-                     std::to_string(common.front().first) + "] and fingers[" + std::to_string(k) + "].finger_pose[" +
-                     std::to_string(common.front().second) + "]): check the fingers' shapes and their pose streams");
+                     " mm over " + std::to_string(separation.size()) + " common times; deepest " +
+                     Format("%.2f", -1e3 * separation[deepest / stride]) + " mm at t = " + Format("%.9g", a[common[deepest].first].t) +
+                     " s, " + a_rows + std::to_string(common[deepest].first) + "] and fingers[" + std::to_string(k) +
+                     "].finger_pose[" + std::to_string(common[deepest].second) +
+                     "]): check the fingers' shapes and their pose streams");
   }
 }
 
@@ -179,16 +184,6 @@ void ValidateTrajectory(const push::Trajectory& traj) {
     if (f.finger_pose.empty())
       throw GraphError("trajectory: no pose measurements of finger " + std::to_string(k + 1) +
                        " (its finger_pose rows are missing)");
-    for (int finger : {0, static_cast<int>(k) + 1}) {
-      const auto& rows = finger == 0 ? m.contact_point : f.contact_point;
-      for (std::size_t i = 1; i < rows.size(); ++i) {
-        if (rows[i].t != rows[i - 1].t) continue;
-        throw GraphError("trajectory: a push with several fingers and two contacts of one finger at a time (" +
-                         std::string(finger == 0 ? "" : "fingers[" + std::to_string(finger) + "].") + "contact_point[" +
-                         std::to_string(i) + "] repeats the time " + Format("%.9g", rows[i].t) + " s of the row before, finger " +
-                         std::to_string(finger) + "): with several fingers the estimator models one contact per finger");
-      }
-    }
     for (std::size_t j = 0; j <= k; ++j) CheckFingersApart(traj, j, k + 1);
   }
   CheckSorted(m.object_pose, "object_pose");

@@ -104,16 +104,18 @@ def evaluate(inputs=(), protocols="all", simulate=0, sim_object=None, sim_finger
                                 _os.fspath(mesh_dir), _config_json(estimator_config))
 
 
-def _finger_index(finger):
+def _finger_index(finger, fingers):
     # bool and numpy.bool_ are not indices (numpy.bool_ passes operator.index).
+    have = "finger 0 only" if fingers == 1 else "fingers 0 to %d" % (fingers - 1)
+    expected = "0" if fingers == 1 else "0 to %d" % (fingers - 1)
     if isinstance(finger, bool) or type(finger).__name__ in ("bool_", "bool"):
-        raise TypeError("finger: expected an integer index (0 or 1), got %r" % (finger,))
+        raise TypeError("finger: expected an integer index (%s), got %r" % (expected, finger))
     try:
         index = _operator.index(finger)
     except TypeError:
-        raise TypeError("finger: expected an integer index (0 or 1), got %r" % (finger,)) from None
+        raise TypeError("finger: expected an integer index (%s), got %r" % (expected, finger)) from None
     if not -2**31 <= index < 2**31:  # beyond C++'s int: out of range like any other index
-        raise GraphError("finger %d is out of range: the setup has fingers 0 and 1 at most" % index)
+        raise GraphError("finger %d is out of range: the setup has %s" % (index, have))
     return index
 
 
@@ -140,18 +142,19 @@ class OnlineEstimator:
             raise GraphError("model: expected one of %s, got %r" % (", ".join(MODELS), model))
         self._core = _pushgraph._OnlineEstimator(setup, model, _config_json(config), bool(contact_point), bool(force),
                                                  float(max_latency))
+        self._fingers = 1 + len(setup.get("fingers") or ())
 
     def add_object_pose(self, t, pose):
         return self._core.add_object_pose(float(t), pose)
 
     def add_finger_pose(self, t, pose, finger=0):
-        return self._core.add_finger_pose(float(t), pose, _finger_index(finger))
+        return self._core.add_finger_pose(float(t), pose, _finger_index(finger, self._fingers))
 
     def add_contact_point(self, t, point, finger=0):
-        return self._core.add_contact_point(float(t), point, _finger_index(finger))
+        return self._core.add_contact_point(float(t), point, _finger_index(finger, self._fingers))
 
     def add_force(self, t, force, finger=0):
-        return self._core.add_force(float(t), force, _finger_index(finger))
+        return self._core.add_force(float(t), force, _finger_index(finger, self._fingers))
 
     def update_due(self):
         return self._core.update_due()

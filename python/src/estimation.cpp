@@ -67,12 +67,15 @@ py::dict ResultToDict(const EstimationResult& r) {
   for (const StateEstimate& s : r.states) fingers = std::max(fingers, 1 + static_cast<int>(s.other_fingers.size()));
   const bool two_fingers = fingers > 1;
   // Fingers 1, 2, ...: each one's pose, contact point and force (NaN where it does not touch).
-  std::vector<py::array_t<double>> finger_k(fingers), finger_k_cov(fingers), contact_k(fingers), force_k(fingers);
+  std::vector<py::array_t<double>> finger_k(fingers), finger_k_cov(fingers), contact_k(fingers), force_k(fingers),
+      contact_k_cov(fingers), force_k_cov(fingers);
   for (int k = 1; k < fingers; ++k) {
     finger_k[k] = NewArray({n, 3});
     finger_k_cov[k] = NewArray({n, 3, 3});
     contact_k[k] = NewArray({n, 2});
     force_k[k] = NewArray({n, 2});
+    contact_k_cov[k] = NewArray({n, 2, 2});
+    force_k_cov[k] = NewArray({n, 2, 2});
   }
   auto put_cov = [](double* out, const auto& cov, int dim) {
     for (int k = 0; k < dim * dim; ++k) out[k] = cov ? (*cov)(k / dim, k % dim) : kNaN;
@@ -115,14 +118,16 @@ py::dict ResultToDict(const EstimationResult& r) {
     for (int f = 1; f < fingers; ++f) {
       const FingerPoseEstimate* pose = nullptr;
       for (const FingerPoseEstimate& e : s.other_fingers) pose = e.finger == f ? &e : pose;
-      const ContactEstimate* touch = nullptr;
-      for (const ContactEstimate& c : s.contacts) touch = c.finger == f ? &c : touch;
+      const ContactEstimate* touch = nullptr;  // its first contact
+      for (const ContactEstimate& c : s.contacts) touch = c.finger == f && touch == nullptr ? &c : touch;
       for (int k = 0; k < 3; ++k) finger_k[f].mutable_data()[3 * i + k] = pose ? pose->pose.vector()[k] : kNaN;
       put_cov(finger_k_cov[f].mutable_data() + 9 * i, pose ? pose->pose_cov : std::nullopt, 3);
       for (int k = 0; k < 2; ++k) {
         contact_k[f].mutable_data()[2 * i + k] = touch ? touch->point[k] : kNaN;
         force_k[f].mutable_data()[2 * i + k] = touch && touch->force ? (*touch->force)[k] : kNaN;
       }
+      put_cov(contact_k_cov[f].mutable_data() + 4 * i, touch ? touch->point_cov : std::nullopt, 2);
+      put_cov(force_k_cov[f].mutable_data() + 4 * i, touch ? touch->force_cov : std::nullopt, 2);
     }
   }
   py::dict d;
@@ -146,6 +151,8 @@ py::dict ResultToDict(const EstimationResult& r) {
     d[(f + "_pose_cov").c_str()] = finger_k_cov[k];
     d[(f + "_contact").c_str()] = contact_k[k];
     d[(f + "_force").c_str()] = force_k[k];
+    d[(f + "_contact_cov").c_str()] = contact_k_cov[k];
+    d[(f + "_force_cov").c_str()] = force_k_cov[k];
   }
   py::dict metrics;
   for (const auto& [k, v] : r.metrics) metrics[k.c_str()] = v;

@@ -259,6 +259,7 @@ def test_three_fingers_batch_and_online(tmp_path):
         assert np.isfinite(r["finger%d_pose" % k]).all() and r["finger%d_pose_cov" % k].shape == (len(r["t"]), 3, 3)
         touching = np.isfinite(r["finger%d_contact" % k][:, 0])
         assert touching.sum() > 100 and np.isfinite(r["finger%d_force" % k][touching]).all()
+        assert np.isfinite(r["finger%d_contact_cov" % k][touching]).all() and np.isfinite(r["finger%d_force_cov" % k][touching]).all()
     setup = {"object": push["object"], "finger": push["finger"], "measured": {},
              "measurement_sigmas": push["measurement_sigmas"],
              "fingers": [{"shape": f["shape"], "mu_contact": f["mu_contact"], "measured": {}} for f in push["fingers"]]}
@@ -282,8 +283,11 @@ def test_three_fingers_batch_and_online(tmp_path):
             assert len(state["finger2_pose"]) == 3
             fingers_seen |= {c["finger"] for c in state["contacts"]}
     assert fingers_seen == {0, 1, 2}
-    with pytest.raises(pg.GraphError, match="finger 3 is out of range: the setup has fingers 0 to 2"):
-        online.add_force(samples[-1][0] + 1.0, (0.1, 0.0), finger=3)
+    for far in (3, 2**40):
+        with pytest.raises(pg.GraphError, match="finger %d is out of range: the setup has fingers 0 to 2" % far):
+            online.add_force(samples[-1][0] + 1.0, (0.1, 0.0), finger=far)
+    with pytest.raises(TypeError, match=r"finger: expected an integer index \(0 to 2\), got 1.5"):
+        online.add_force(samples[-1][0] + 1.0, (0.1, 0.0), finger=1.5)
     done = online.finish()
     replay = pg.estimate(push, model="qs", mode="incremental")
     np.testing.assert_allclose(done["finger2_pose"], replay["finger2_pose"], rtol=0, atol=1e-9)

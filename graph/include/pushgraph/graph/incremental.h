@@ -125,8 +125,9 @@ class OnlineEstimator {
   bool AddForce(double t, const geometry::Vec2& force);
   /// Finger `finger`'s samples: 0 is Trajectory::finger, k >= 1 the setup's extra_fingers[k - 1]
   /// (a push with several fingers; each has the kinds of sensors OnlineStreams declares). Every
-  /// finger's pose is needed by the first update; each finger's contact stream has one row per
-  /// time (one contact per finger). A finger the setup does not have is an error naming it.
+  /// finger's pose is needed by the first update; each finger's contact stream has one or two
+  /// rows per time (two: the finger touches at two points). A finger the setup does not have
+  /// is an error naming it.
   bool AddFingerPose(double t, int finger, const geometry::Pose2& pose);
   bool AddContactPoint(double t, int finger, const geometry::Vec2& point);
   bool AddForce(double t, int finger, const geometry::Vec2& force);

@@ -196,6 +196,11 @@ struct ContactPath {
   std::vector<double> t;
   std::vector<geometry::Vec2> q;          ///< finger reference point, object frame
   std::vector<geometry::Pose2> relative;  ///< finger pose in the object frame
+  /// Which finger touched (0 is Trajectory::finger; a push with several fingers has the samples
+  /// of each, finger by finger, each gated on its own contact or force stream) and the radius of
+  /// its disk (FingerAsDisk).
+  std::vector<int> finger;
+  std::vector<double> radius;
   /// Standard deviation (m, per axis) of q's error: a parametric bootstrap of the smoothing with
   /// the raw noise (the measurement sigmas, else the streams' own second differences).
   double noise = 0.0;
