@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace pushgraph::evaluation::internal {
 namespace {
@@ -90,16 +91,23 @@ void AccumulateRun(const push::Trajectory& traj, const graph::EstimationResult& 
         sink.Nees(prefix + "/object_pose", NeesOf<3>(e, P), 3);
       }
     }
-    if (push::TruthPoseAt(gt.finger_pose, s.t, &g)) {
-      const Eigen::Vector2d e(s.finger_pose.x - g.x(), s.finger_pose.y - g.y());
+    // Every finger's position (fingers 1, 2, ... against their own ground truth).
+    auto finger_position = [&](const std::vector<push::PoseSample>& truth, const geometry::Pose2& pose,
+                               const std::optional<Eigen::Matrix3d>& cov) {
+      if (!push::TruthPoseAt(truth, s.t, &g)) return;
+      const Eigen::Vector2d e(pose.x - g.x(), pose.y - g.y());
       sink.Error(prefix + "/finger_position", e.norm());
-      if (s.finger_pose_cov) {
+      if (cov) {
         // Position block only: the finger's angle is not measured meaningfully (pinned).
-        const Eigen::Matrix2d P = s.finger_pose_cov->topLeftCorner<2, 2>();
+        const Eigen::Matrix2d P = cov->topLeftCorner<2, 2>();
         sink.Variance(prefix + "/finger_position", P.trace());
         sink.Nees(prefix + "/finger_position", NeesOf<2>(e, P), 2);
       }
-    }
+    };
+    finger_position(gt.finger_pose, s.finger_pose, s.finger_pose_cov);
+    for (const graph::FingerPoseEstimate& f : s.other_fingers)
+      if (f.finger >= 1 && f.finger <= static_cast<int>(traj.extra_fingers.size()) && traj.extra_fingers[f.finger - 1].ground_truth)
+        finger_position(traj.extra_fingers[f.finger - 1].ground_truth->finger_pose, f.pose, f.pose_cov);
     Vec2 v;
     // Every estimated contact against its finger's nearest true contact at that time (several
     // contacts: a wedged finger, a flat pusher, two fingers).
@@ -117,9 +125,18 @@ void AccumulateRun(const push::Trajectory& traj, const graph::EstimationResult& 
         sink.Variance(prefix + "/contact", c.point_cov->trace());
         sink.Nees(prefix + "/contact", NeesOf<2>(e, *c.point_cov), 2);
       }
-      // Another finger's own force (finger 0's is `force` below).
-      if (!own && c.force && push::TruthForceAt(traj.extra_fingers[c.finger - 1].ground_truth->force, s.t, &v))
-        sink.Error(prefix + "/force", (*c.force - v).norm());
+      // Another finger's own force (finger 0's is `force` below); one touching at two points
+      // measures their sum, which has no covariance of its own: its first contact's is not it.
+      const bool its_only = std::count_if(contacts.begin(), contacts.end(),
+                                          [&](const graph::ContactEstimate& o) { return o.finger == c.finger; }) == 1;
+      if (!own && its_only && c.force && push::TruthForceAt(traj.extra_fingers[c.finger - 1].ground_truth->force, s.t, &v)) {
+        const Eigen::Vector2d ef = *c.force - v;
+        sink.Error(prefix + "/force", ef.norm());
+        if (c.force_cov) {
+          sink.Variance(prefix + "/force", c.force_cov->trace());
+          sink.Nees(prefix + "/force", NeesOf<2>(ef, *c.force_cov), 2);
+        }
+      }
     }
     if (s.force && push::TruthForceAt(gt.force, s.t, &v)) {
       const Eigen::Vector2d e = *s.force - v;
@@ -160,10 +177,15 @@ void AccumulateRaw(const push::Trajectory& traj, const std::string& prefix, Stat
       sink.Error(prefix + "/object_rotation_moving", er);
     }
   }
-  for (const push::PoseSample& s : m.finger_pose) {
-    Eigen::Vector3d g;
-    if (push::TruthPoseAt(gt.finger_pose, s.t, &g)) sink.Error(prefix + "/finger_position", std::hypot(s.pose.x - g.x(), s.pose.y - g.y()));
-  }
+  auto finger_positions = [&](const std::vector<push::PoseSample>& measured, const std::vector<push::PoseSample>& truth) {
+    for (const push::PoseSample& s : measured) {
+      Eigen::Vector3d g;
+      if (push::TruthPoseAt(truth, s.t, &g)) sink.Error(prefix + "/finger_position", std::hypot(s.pose.x - g.x(), s.pose.y - g.y()));
+    }
+  };
+  finger_positions(m.finger_pose, gt.finger_pose);
+  for (const push::ExtraFinger& f : traj.extra_fingers)
+    if (f.ground_truth) finger_positions(f.measured.finger_pose, f.ground_truth->finger_pose);
   // Every finger's contact rows, each against its finger's nearest true contact.
   auto contacts = [&](const std::vector<push::PointSample>& measured, const std::vector<push::PointSample>& truth) {
     for (const push::PointSample& s : measured) {
@@ -180,6 +202,14 @@ void AccumulateRaw(const push::Trajectory& traj, const std::string& prefix, Stat
     sink.Error(prefix + "/force", (s.force - v).norm());
     sink.Error(prefix + "/force_magnitude", s.force.norm() - v.norm());
     if (v.norm() >= kDirectionMinForce) sink.Error(prefix + "/force_direction", SignedAngle(s.force, v) * 180.0 / M_PI);
+  }
+  // The other fingers' force rows (their estimates count in "force" too).
+  for (const push::ExtraFinger& f : traj.extra_fingers) {
+    if (!f.ground_truth) continue;
+    for (const push::ForceSample& s : f.measured.force) {
+      Vec2 v;
+      if (push::TruthForceAt(f.ground_truth->force, s.t, &v)) sink.Error(prefix + "/force", (s.force - v).norm());
+    }
   }
 }
 
