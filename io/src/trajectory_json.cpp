@@ -88,7 +88,11 @@ class Reader {
       const json& row = value[i];
       if (!row.is_array() || row.size() != row_width)
         Fail(row_path, "must be a row of " + std::to_string(row_width) + " numbers" +
-                           (indexed ? " [t, finger, ...]" : "") + ", got " + row.dump());
+                           (indexed ? " [t, finger, ...]" : "") + ", got " + row.dump() +
+                           (!indexed && row.is_array() && row.size() == row_width + 1 &&
+                                    path.find("object_pose") == std::string::npos
+                                ? " (with one finger the rows carry no finger index)"
+                                : ""));
       std::vector<double> v;
       v.reserve(width);
       std::size_t finger = 0;

@@ -345,6 +345,10 @@ own frame (metres). Immutable; copies share their acceleration structures.
       .def_static("regular_polygon", &Shape::RegularPolygon, "n"_a, "circumradius"_a, "radius"_a = 0.0)
       .def_static("load_json", &geometry::LoadShapeJson, "path"_a, "A shape JSON file (docs/formats.md).")
       .def_static("from_json", &geometry::ParseShapeJson, "text"_a, "source_name"_a = "<string>")
+      // Pickling (copy.deepcopy of a trajectory dict, multiprocessing): its JSON, whose numbers
+      // round-trip exactly.
+      .def(py::pickle([](const Shape& shape) { return geometry::ShapeToJson(shape, -1); },
+                      [](const std::string& json) { return geometry::ParseShapeJson(json, "<pickled Shape>"); }))
       .def_static(
           "from_mesh",
           [](const std::string& path, const std::string& up, const std::string& object, double scale) {

@@ -96,6 +96,8 @@ TEST(TrajectoryJson, BadInputNamesFileAndPath) {
   ExpectError(Doc("{}", R"(, "extra": 1)"), "unknown field \"extra\"");
   ExpectError(Doc(R"({"object_pose": [[0, 1, 2]]})"), "streams.object_pose[0]");
   ExpectError(Doc(R"({"object_pose": [[0, 1, 2, "x"]]})"), "streams.object_pose[0][3]");
+  // A row with a finger index in a one-finger file: said why it is too long.
+  ExpectError(Doc(R"({"force": [[0.0, 0, 1.0, 0.0]]})"), "with one finger the rows carry no finger index");
   ExpectError(Doc(R"({"force": [[0, 1e999, 2]]})"), "malformed JSON");
   ExpectError(Doc(R"({"force": [[0, 1, 2], [0, 1, 2]]})"), "same time stamp");
   ExpectError(Doc(R"({"velocity": []})"), "unknown field \"velocity\"");

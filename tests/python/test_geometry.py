@@ -167,3 +167,15 @@ def test_a_mesh_footprint_in_millimetres(tmp_path):
     empty.write_text("# nothing\n")
     with pytest.raises(pg.IoError, match="empty.obj"):
         pg.Shape.from_mesh(str(empty))
+
+
+def test_shapes_pickle_and_deepcopy(notched_block):
+    # A shape survives pickling and copy.deepcopy (of a trajectory dict, say) to the last bit.
+    import copy
+    import pickle
+    again = pickle.loads(pickle.dumps(notched_block))
+    assert again.to_json() == notched_block.to_json()
+    points = np.array([[0.01, 0.02], [-0.05, 0.039], [0.3, 0.0]])
+    np.testing.assert_array_equal(again.signed_distance(points), notched_block.signed_distance(points))
+    rounded = pg.Shape.box(0.02, 0.01, radius=0.003)
+    assert copy.deepcopy({"shape": rounded})["shape"].to_json() == rounded.to_json()
