@@ -106,6 +106,11 @@ std::string TrajectorySvg(const push::Trajectory& trajectory, const graph::Estim
   for (const auto& s : measured.force) max_force = std::max(max_force, s.force.norm());
   if (truth)
     for (const auto& s : truth->force) max_force = std::max(max_force, s.force.norm());
+  for (const push::ExtraFinger& e : trajectory.extra_fingers) {
+    for (const auto& s : e.measured.force) max_force = std::max(max_force, s.force.norm());
+    if (e.ground_truth)
+      for (const auto& s : e.ground_truth->force) max_force = std::max(max_force, s.force.norm());
+  }
   const bool draw_forces = options.forces && max_force > 0.0 && std::isfinite(max_force);
   const double mm_per_newton = draw_forces ? NiceFloor(0.12 * extent * 1e3 / max_force) : 0.0;
   const double m_per_newton = mm_per_newton * 1e-3;
@@ -132,6 +137,16 @@ std::string TrajectorySvg(const push::Trajectory& trajectory, const graph::Estim
       if (truth) {
         const auto* f = Nearest(truth->force, s.t, tolerance);
         const auto* c = Nearest(truth->contact_point, s.t, tolerance);
+        if (f && c && f->force.norm() > 0.0) arrows_truth.push_back({c->point, f->force});
+      }
+      // The other fingers' own sensors and truth, at their own contacts.
+      for (const push::ExtraFinger& e : trajectory.extra_fingers) {
+        const auto* f = Nearest(e.measured.force, s.t, tolerance);
+        const auto* c = Nearest(e.measured.contact_point, s.t, tolerance);
+        if (f && c && f->force.norm() > 0.0) arrows_measured.push_back({c->point, f->force});
+        if (!e.ground_truth) continue;
+        f = Nearest(e.ground_truth->force, s.t, tolerance);
+        c = Nearest(e.ground_truth->contact_point, s.t, tolerance);
         if (f && c && f->force.norm() > 0.0) arrows_truth.push_back({c->point, f->force});
       }
     }

@@ -528,8 +528,10 @@ TEST(ThreeFingers, EveryFingerIsEstimatedWithItsContactAndForce) {
   }
   // The Ceres path and the chain solver reach the same minimum. The three forces along one face
   // share the load in a shallow valley (each finger's sensor alone tells them apart), where the
-  // default tolerance stops both 0.06 mm apart: solved to 1e-12 here.
+  // default tolerance stops both 0.06 mm apart: solved to 1e-12 here (not in the scaled-down
+  // sanitizer run: two more solves of 50 iterations each).
   ASSERT_EQ(qs.size(), 2u);
+  if (pushgraph::testing::TestScale() < 1.0) return;
   config.covariance = false;
   config.function_tolerance = 1e-12;
   config.max_iterations = 500;
@@ -629,6 +631,7 @@ TEST(SeveralFingers, AFingerTouchingAtTwoPointsBesideAnother) {
               r.metrics.at("force_rms"));
   EXPECT_GT(steps_with_three, two_of_bar / 2);
   EXPECT_LT(several.rms, 0.6 * several.raw_rms);
+  if (pushgraph::testing::TestScale() < 1.0) return;  // the online path: ThreeFingers.IncrementalAndOnline*
   // Online, sample by sample: the replay's estimate at its update times.
   IncrementalEstimator replay(t, Model::kQs, config);
   while (!replay.Done()) replay.Update();
