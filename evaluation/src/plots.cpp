@@ -72,13 +72,17 @@ std::string TrajectorySvg(const push::Trajectory& trajectory, const graph::Estim
   // Extent of everything drawn, in metres.
   Bounds bounds;
   std::vector<std::vector<std::vector<Vec2>>> estimated_footprints, truth_footprints, finger_shapes;
+  std::vector<int> finger_of_shape;  // which finger each of finger_shapes is
   for (std::size_t i : marked) {
     estimated_footprints.push_back(WorldRings(trajectory.object.shape, states[i].object_pose));
     finger_shapes.push_back(WorldRings(trajectory.finger.shape, states[i].finger_pose));
-    // Every other finger (pushes with several) at its own estimated pose.
+    finger_of_shape.push_back(0);
+    // Every other finger (pushes with several) at its own estimated pose, in its own colour.
     for (const graph::FingerPoseEstimate& f : states[i].other_fingers)
-      if (f.finger >= 1 && f.finger <= static_cast<int>(trajectory.extra_fingers.size()))
+      if (f.finger >= 1 && f.finger <= static_cast<int>(trajectory.extra_fingers.size())) {
         finger_shapes.push_back(WorldRings(trajectory.extra_fingers[f.finger - 1].finger.shape, f.pose));
+        finger_of_shape.push_back(f.finger);
+      }
     if (truth_poses) truth_footprints.push_back(WorldRings(trajectory.object.shape, InterpolatePose(truth->object_pose, states[i].t)));
   }
   for (const auto* set : {&estimated_footprints, &truth_footprints, &finger_shapes})
@@ -237,8 +241,9 @@ std::string TrajectorySvg(const push::Trajectory& trajectory, const graph::Estim
     body += "<path class='finger-path-truth' d='" + PolylinePath(t, p, infinite_gap, view) + "' fill='none' stroke='" +
             kTruthColor + "' stroke-opacity='0.6' stroke-width='1.2' stroke-dasharray='6 4'/>\n";
   }
-  for (const auto& rings : finger_shapes)
-    body += "<path class='finger' d='" + RingsPath(rings, view) + "' fill='" + kFingerColor +
+  for (std::size_t k = 0; k < finger_shapes.size(); ++k)
+    body += "<path class='finger' d='" + RingsPath(finger_shapes[k], view) + "' fill='" +
+            (finger_of_shape[k] == 0 ? kFingerColor : OtherFingerColor(finger_of_shape[k])) +
             "' fill-opacity='0.35' fill-rule='evenodd' stroke='#555555' stroke-width='0.8'/>\n";
   body += "<path class='finger-path-estimated' d='" + PolylinePath(state_t, finger_path, infinite_gap, view) +
           "' fill='none' stroke='#555555' stroke-width='1.4'/>\n";
@@ -250,7 +255,7 @@ std::string TrajectorySvg(const push::Trajectory& trajectory, const graph::Estim
         if (f.finger == static_cast<int>(k) + 1) other_t.push_back(s.t), other_path.push_back(f.pose.translation());
     if (!other_path.empty())
       body += "<path class='finger-path-estimated' d='" + PolylinePath(other_t, other_path, infinite_gap, view) +
-              "' fill='none' stroke='#555555' stroke-width='1.4' stroke-dasharray='2 2'/>\n";
+              "' fill='none' stroke='" + OtherFingerColor(static_cast<int>(k) + 1) + "' stroke-width='1.4' stroke-dasharray='2 2'/>\n";
   }
   {
     std::string dots;
@@ -338,7 +343,12 @@ std::string TrajectorySvg(const push::Trajectory& trajectory, const graph::Estim
                       "footprint, ground truth"});
   legend.push_back({"<circle cx='14' cy='0' r='5' fill='#7f7f7f' fill-opacity='0.35' stroke='#555555'/>"
                     "<line x1='0' y1='0' x2='8' y2='0' stroke='#555555' stroke-width='1.4'/>",
-                    "finger: shape, estimated path"});
+                    trajectory.extra_fingers.empty() ? "finger: shape, estimated path" : "finger 0: shape, estimated path"});
+  for (std::size_t k = 1; k <= trajectory.extra_fingers.size(); ++k)
+    legend.push_back({std::string("<circle cx='14' cy='0' r='5' fill='") + OtherFingerColor(static_cast<int>(k)) +
+                          "' fill-opacity='0.35' stroke='#555555'/><line x1='0' y1='0' x2='8' y2='0' stroke='" +
+                          OtherFingerColor(static_cast<int>(k)) + "' stroke-width='1.4' stroke-dasharray='2 2'/>",
+                      "finger " + std::to_string(k)});
   if (std::any_of(marked.begin(), marked.end(), [&](std::size_t i) { return states[i].contact.has_value(); }))
     legend.push_back({std::string("<circle cx='14' cy='0' r='2.4' fill='") + kContactColor + "'/>",
                       "contact point, estimate"});

@@ -15,8 +15,7 @@ using namespace svg;
 namespace {
 
 // One colour per finger (finger 0 the pictures' usual grey).
-constexpr const char* kFingerColors[] = {"#555555", "#2ca02c", "#9467bd", "#17becf", "#8c564b", "#bcbd22"};
-const char* FingerColor(int k) { return kFingerColors[k % 6]; }
+const char* FingerColor(int k) { return k == 0 ? "#555555" : OtherFingerColor(k); }
 
 // One finger's streams, whichever struct holds them.
 struct FingerView {

@@ -27,6 +27,9 @@ inline constexpr const char* kMeasuredColor = "#d6449a";
 inline constexpr const char* kEstimatedColor = "#1f5fa8";
 inline constexpr const char* kTruthColor = "#222222";
 inline constexpr const char* kFingerColor = "#7f7f7f";
+// One colour per finger k >= 1 of a push with several (finger 0 is each picture's own grey).
+inline constexpr const char* kOtherFingerColors[] = {"#2ca02c", "#9467bd", "#17becf", "#8c564b", "#bcbd22"};
+inline const char* OtherFingerColor(int k) { return kOtherFingerColors[(k - 1) % 5]; }
 inline constexpr const char* kContactColor = "#e07b00";
 inline constexpr const char* kForceColor = "#c0282d";
 // Series colours of the time-series plot (raw first: pink like the measured dots).
