@@ -161,24 +161,24 @@ int GraphBuilder::AppendSteps(double until) {
     const double gap = NearestGap(force, t, &k);
     return k >= 0 && gap <= cfg_.contact_max_gap && force[k].force.norm() >= cfg_.contact_force_threshold;
   };
+  // A touching finger has two contacts while its nearest contact time has two rows.
+  auto two_rows_nearest = [&](const std::vector<push::PointSample>& contact, double t) {
+    if (!streams_.contact_point) return false;
+    int row = -1;
+    NearestGap(contact, t, &row);
+    const auto [first, last] = ContactRowsAt(contact, row);
+    return last > first;
+  };
   for (std::size_t i = first_new; i < steps_.size(); ++i) {
     Step& s = steps_[i];
     for (int k = 1; k <= other_fingers_; ++k) {
       Step::OtherFinger& o = s.others[k - 1];
       o.in_contact = touching(ContactRows(k), ForceRows(k), s.t);
-      if (!o.in_contact || !streams_.contact_point) continue;
-      int row = -1;  // two contacts of finger k while its nearest contact time has two rows
-      NearestGap(ContactRows(k), s.t, &row);
-      const auto [first, last] = ContactRowsAt(ContactRows(k), row);
-      o.two_contacts = last > first;
+      o.two_contacts = o.in_contact && two_rows_nearest(ContactRows(k), s.t);
     }
     s.in_contact = touching(m.contact_point, m.force, s.t);
     if (s.in_contact && streams_.contact_point) {
-      // Two contacts while the nearest contact time has two rows.
-      int k = -1;
-      NearestGap(m.contact_point, s.t, &k);
-      const auto [first, last] = ContactRowsAt(m.contact_point, k);
-      s.two_contacts = last > first;
+      s.two_contacts = two_rows_nearest(m.contact_point, s.t);
       if (s.two_contacts && model_ == Model::kYu) {
         // The baseline models one contact, as published: it keeps the first of the two.
         s.two_contacts = false;
@@ -785,9 +785,9 @@ void GraphBuilder::AddFactors(ceres::Problem& problem, int i, int parts) {
       if (FingerTwoContacts(i, k)) problem.AddParameterBlock(SecondContactPoint(i, k), 2);
     AddKinematicFactors(problem, i);
   }
-  bool more_forces = false;
-  for (int k = 2; k <= other_fingers_; ++k) more_forces = more_forces || (FingerTouches(i, k) && ModelHasForce(model_));
-  if ((parts & kDynamic) && (HasForceVars(i) || HasSecondForceVars(i) || more_forces)) {
+  bool touches = false;  // any finger: then every touching finger has its force blocks
+  for (int k = 0; k <= other_fingers_; ++k) touches = touches || FingerTouches(i, k);
+  if ((parts & kDynamic) && touches && ModelHasForce(model_)) {
     if (HasForceVars(i)) problem.AddParameterBlock(v.f, 2);
     if (HasSecondForceVars(i)) problem.AddParameterBlock(v.f2, 2);
     for (int k = 2; k <= other_fingers_; ++k)
