@@ -75,6 +75,11 @@ std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder, c
             blocks.emplace_back(builder.FingerForce(i, k), finger + " force");
           }
         }
+        for (int k = 0; k < builder.num_fingers() && builder.several_fingers(); ++k) {
+          const std::string finger = "finger " + std::to_string(k);
+          blocks.emplace_back(builder.SecondContactPoint(i, k), finger + " second contact point");
+          blocks.emplace_back(builder.SecondContactForce(i, k), finger + " second contact force");
+        }
         for (const auto& [block, name] : blocks) {
           if (block != bad) continue;
           marginals_error += " [step " + std::to_string(i) + ", t = " + std::to_string(builder.steps()[i].t) +
