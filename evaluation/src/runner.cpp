@@ -321,6 +321,7 @@ EvaluationRow EvaluateItem(const EvaluationItem& item, const EvaluationOptions& 
     }
     const bool plot = item.plot && !o.plot_dir.empty();
     std::map<std::string, graph::EstimationResult> kept;  // batch results, for the pictures
+    std::vector<std::string> covariance_notes;  // runs whose covariances failed: said, not dropped silently
     for (const RunSpec& run : runs) {
       stage = run.Prefix();
       const push::Trajectory& t = noisy.at(run.noise);
@@ -343,10 +344,14 @@ EvaluationRow EvaluateItem(const EvaluationItem& item, const EvaluationOptions& 
         if (r.shape_alignment && r.shape_alignment->aligned) row.stats["shape/run_aligned/sum"] = 1.0;
       }
       if (r.shape_alignment && r.shape_alignment->aligned) row.stats[run.Prefix() + "/aligned/sum"] = 1.0;
+      if (run.covariance && r.solver.covariance_status != "ok")
+        covariance_notes.push_back(run.Prefix() + ": no covariances (" + r.solver.covariance_status +
+                                   "): the consistency tables leave this run out");
       AccumulateRun(t, r, run.Prefix(), run.noise == "occluded" ? window : Window{}, sink);
       if (row.steps == 0) row.steps = static_cast<int>(r.states.size());
       if (plot && run.mode == graph::Mode::kBatch) kept.emplace(run.Prefix(), std::move(r));
     }
+    row.notes.insert(row.notes.end(), covariance_notes.begin(), covariance_notes.end());
     if (plot) {
       stage = "plots";
       WriteItemPlots(item, o.plot_dir, noisy, kept, window);

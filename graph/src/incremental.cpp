@@ -103,6 +103,24 @@ struct StepConditional {
   Eigen::MatrixXd S;
 };
 
+// The eigen-decomposition of D^-1 H D^-1, D = sqrt(diag H) (zero diagonal entries scaled by 1):
+// eigenvalues relative to each unknown's own scale, so rank decisions do not depend on units.
+struct JacobiScaled {
+  Eigen::VectorXd d, d_inv, eigenvalues;
+  Eigen::MatrixXd eigenvectors;
+  double max_eigenvalue = 0.0;
+  explicit JacobiScaled(const Eigen::MatrixXd& H) {
+    d = H.diagonal().cwiseMax(0.0).cwiseSqrt();
+    for (Eigen::Index i = 0; i < d.size(); ++i)
+      if (!(d[i] > 0.0)) d[i] = 1.0;
+    d_inv = d.cwiseInverse();
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(d_inv.asDiagonal() * H * d_inv.asDiagonal());
+    eigenvalues = solver.eigenvalues();
+    eigenvectors = solver.eigenvectors();
+    max_eigenvalue = eigenvalues.size() > 0 ? std::max(eigenvalues.maxCoeff(), 1e-300) : 1e-300;
+  }
+};
+
 // The fixed-lag smoother both front ends drive: steps join at updates, the window is re-solved,
 // steps older than the window are marginalized.
 struct FixedLagSmoother {
@@ -226,11 +244,17 @@ struct FixedLagSmoother {
     }
     for (double* p : removed) problem->RemoveParameterBlock(p);
     const int sep_dim = dim - removed_dim;
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> er(H.topLeftCorner(removed_dim, removed_dim));
-    const double emax = std::max(er.eigenvalues().maxCoeff(), 1e-300);
-    Eigen::VectorXd inv = er.eigenvalues();
-    for (int i = 0; i < inv.size(); ++i) inv[i] = inv[i] > 1e-12 * emax ? 1.0 / inv[i] : 0.0;
-    const Eigen::MatrixXd Hrr_inv = er.eigenvectors() * inv.asDiagonal() * er.eigenvectors().transpose();
+    // Rank decisions on the Jacobi-scaled matrix D^-1 H D^-1 (D = sqrt(diag H)): relative to the
+    // largest eigenvalue of H itself they depended on the units, and a direction held only by a
+    // weak prior (a force at its 100 N prior, 1e-4 against 4e6 for a contact point at 0.5 mm)
+    // fell below the cutoff and was dropped: the smoothed covariances of a flat pusher's line
+    // contact then failed as rank deficient.
+    const JacobiScaled er(H.topLeftCorner(removed_dim, removed_dim));
+    Eigen::VectorXd inv = er.eigenvalues;
+    for (int i = 0; i < inv.size(); ++i) inv[i] = inv[i] > 1e-12 * er.max_eigenvalue ? 1.0 / inv[i] : 0.0;
+    // H_rr^+ = D^-1 U diag(inv) U^T D^-1.
+    const Eigen::MatrixXd U_rr = er.d_inv.asDiagonal() * er.eigenvectors;
+    const Eigen::MatrixXd Hrr_inv = U_rr * inv.asDiagonal() * U_rr.transpose();
     const Eigen::MatrixXd Hsr = H.bottomLeftCorner(sep_dim, removed_dim);
     const std::vector<double*> sep(order.begin() + removed.size(), order.end());
     const std::vector<int> sep_sizes(order_sizes.begin() + removed.size(), order_sizes.end());
@@ -249,9 +273,10 @@ struct FixedLagSmoother {
         std::vector<int> informative;
         for (int i = 0; i < removed_dim; ++i) if (inv[i] > 0.0) informative.push_back(i);
         c.S.resize(static_cast<Eigen::Index>(informative.size()), removed_dim);
+        // H_rr = (D U) diag(lambda) (D U)^T: rows sqrt(lambda_i) (D u_i)^T.
         for (std::size_t i = 0; i < informative.size(); ++i) {
-          c.S.row(static_cast<Eigen::Index>(i)) =
-              std::sqrt(er.eigenvalues()[informative[i]]) * er.eigenvectors().col(informative[i]).transpose();
+          c.S.row(static_cast<Eigen::Index>(i)) = std::sqrt(er.eigenvalues[informative[i]]) *
+                                                   (er.d.asDiagonal() * er.eigenvectors.col(informative[i])).transpose();
         }
       }
       conditionals.push_back(std::move(c));
@@ -259,18 +284,19 @@ struct FixedLagSmoother {
     if (sep_dim == 0) return;
     const Eigen::MatrixXd Hm = H.bottomRightCorner(sep_dim, sep_dim) - Hsr * Hrr_inv * Hsr.transpose();
     const Eigen::VectorXd bm = b.tail(sep_dim) - Hsr * Hrr_inv * b.head(removed_dim);
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (Hm + Hm.transpose()));
-    const double smax = es.eigenvalues().maxCoeff();
+    const JacobiScaled es(0.5 * (Hm + Hm.transpose()));
     std::vector<int> keep;
-    for (int i = 0; i < sep_dim; ++i) if (es.eigenvalues()[i] > 1e-10 * smax && es.eigenvalues()[i] > 0) keep.push_back(i);
+    for (int i = 0; i < sep_dim; ++i)
+      if (es.eigenvalues[i] > 1e-10 * es.max_eigenvalue && es.eigenvalues[i] > 0) keep.push_back(i);
     if (keep.empty()) return;
+    // Hm = (D U) diag(lambda) (D U)^T: S rows sqrt(lambda) (D u)^T, and S^T r0 = bm on them.
     Eigen::MatrixXd S(keep.size(), sep_dim);
     Eigen::VectorXd r0(keep.size());
     for (std::size_t i = 0; i < keep.size(); ++i) {
-      const double lambda = es.eigenvalues()[keep[i]];
-      const Eigen::VectorXd u = es.eigenvectors().col(keep[i]);
-      S.row(i) = std::sqrt(lambda) * u.transpose();
-      r0[i] = u.dot(bm) / std::sqrt(lambda);
+      const double lambda = es.eigenvalues[keep[i]];
+      const Eigen::VectorXd u = es.eigenvectors.col(keep[i]);
+      S.row(i) = std::sqrt(lambda) * (es.d.asDiagonal() * u).transpose();
+      r0[i] = u.dot(es.d_inv.asDiagonal() * bm) / std::sqrt(lambda);
     }
     problem->AddResidualBlock(new MarginalPriorFactor(sep_sizes, x_bar, S, r0), nullptr, sep);
   }

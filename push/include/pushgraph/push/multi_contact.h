@@ -46,7 +46,11 @@ struct MultiPushingSpec {
   ObjectDescription object;                ///< shape = support region (no rounding)
   std::vector<FingerDescription> fingers;  ///< at least one; each with its own mu_contact
   SurfaceModel surface = SurfaceModel::kExact;
-  double contact_tolerance = 1e-7;         ///< m: contacts with a gap up to this are active
+  /// m: contacts with a gap up to this are active. 1 um, not less: a face settling onto a face
+  /// (a flat pusher, a disk between two walls) rotates a little past flat within a step, so at
+  /// 0.1 um the contact flipped from one end of the face to the other at every step instead of
+  /// becoming a line contact (docs/simulator.md).
+  double contact_tolerance = 1e-6;
   double penetration_tolerance = 1e-10;    ///< m: deeper overlap after a step is pushed out
   /// m: overlap deeper than this is not a contact of a feature pair (geometry::ContactOptions).
   double max_contact_depth = 1e-4;

@@ -62,7 +62,7 @@ struct PushingSpec {
   FingerDescription finger;     ///< any finger shape (disk, rounded square, polygon), mu_contact >= 0
   SurfaceModel surface = SurfaceModel::kExact;
   /// The shapes touch when their signed separation is at most this (m). Must be > 0.
-  double contact_tolerance = 1e-7;
+  double contact_tolerance = 1e-6;
   /// After each step, penetration deeper than this (m) is pushed out quasi-statically.
   double penetration_tolerance = 1e-10;
 };

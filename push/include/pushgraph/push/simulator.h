@@ -53,7 +53,7 @@ struct PushPlan {
   StreamRates rates;
   double internal_step = 1e-3;     ///< s, > 0
   double max_step_length = 2e-4;   ///< m, > 0: finger travel per internal step at most this
-  double contact_tolerance = 1e-7; ///< m (PushingSpec::contact_tolerance)
+  double contact_tolerance = 1e-6; ///< m (PushingSpec::contact_tolerance, MultiPushingSpec's)
   double penetration_tolerance = 1e-10;  ///< m (PushingSpec::penetration_tolerance)
   NoiseModel noise;                ///< default: no noise
   std::uint64_t seed = 1;
