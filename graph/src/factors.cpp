@@ -138,8 +138,10 @@ bool LocalWitnessFactor::Evaluate(double const* const* parameters, double* resid
 }
 
 FeatureWitnessFactor::FeatureWitnessFactor(geometry::Shape object, geometry::EdgeId feature, bool vertex,
-                                           geometry::Shape finger, double sigma)
-    : finger_(std::move(finger)), vertex_(vertex), radius_(object.radius()), w_(CheckedWeight(sigma, "contact feature witness")) {
+                                           geometry::Shape finger, double sigma, int overlap_end)
+    : finger_(std::move(finger)), vertex_(vertex), end_(overlap_end), radius_(object.radius()),
+      w_(CheckedWeight(sigma, "contact feature witness")) {
+  if (overlap_end < -1 || overlap_end > 1) throw GraphError("contact feature witness: overlap_end must be -1, 0 or +1");
   const auto& polygons = object.polygons();
   if (feature.polygon < 0 || feature.polygon >= static_cast<int>(polygons.size()) || feature.ring < -1 ||
       feature.ring >= static_cast<int>(polygons[feature.polygon].holes.size()))
@@ -198,6 +200,38 @@ SegmentClosest ClosestOnFeature(const Vec2& A, const Vec2& B, bool vertex, bool 
   out.J_q_B = d * ds_dB + s * I + r * dn_dd;
   return out;
 }
+
+// A flat finger face along an object face touches it along their overlap (a line contact), and
+// its contact measurements are the overlap's two end points. A contact point free to slide on
+// the overlap let a noisy measurement beyond an end that is an object corner (the notched
+// block's notch, 3.5 mm from the flat pusher's end) pull the object along its face, while those
+// inside pulled back nothing: a one-sided, biased pull. Each of the two contacts is held at its
+// own end instead: `side` -1 or +1, the end toward the object edge's start A or its end B, the
+// projection of the finger edge's vertex there onto the object edge, clamped to it
+// (ClosestOnFeature does both). False when the finger's closest feature is not an edge facing
+// the object's (within 45 degrees of antiparallel).
+struct OverlapEnd {
+  SegmentClosest c;
+  Eigen::Matrix<double, 2, 3> J_F_e;
+};
+bool SnapToOverlapEnd(const Vec2& A, const Vec2& B, bool two_sided, double radius, const geometry::Shape& finger,
+                      const Pose2& e, const geometry::BoundaryFeature& finger_feature, int side, OverlapEnd* out) {
+  if (finger_feature.kind != geometry::BoundaryFeature::Kind::kEdge) return false;
+  const geometry::Ring& ring = finger.ring(finger_feature.edge.polygon, finger_feature.edge.ring);
+  const int n = static_cast<int>(ring.size());
+  if (n < 2) return false;
+  Eigen::Matrix<double, 2, 3> J_FA_e, J_FB_e;
+  const Vec2 FA = geometry::Act(e, ring[finger_feature.edge.index], &J_FA_e);
+  const Vec2 FB = geometry::Act(e, ring[(finger_feature.edge.index + 1) % n], &J_FB_e);
+  const Vec2 d = B - A, fd = FB - FA;
+  if (!(d.squaredNorm() > 0.0) || !(fd.squaredNorm() > 0.0)) return false;
+  if (d.dot(fd) > -std::sqrt(0.5 * d.squaredNorm() * fd.squaredNorm())) return false;  // not facing
+  // The finger vertex farther toward the chosen end of the object edge.
+  const bool fa_is_end = side < 0 ? (FA - FB).dot(d) < 0.0 : (FA - FB).dot(d) > 0.0;
+  out->c = ClosestOnFeature(A, B, false, two_sided, radius, fa_is_end ? FA : FB);
+  out->J_F_e = fa_is_end ? J_FA_e : J_FB_e;
+  return true;
+}
 }  // namespace
 
 bool FeatureWitnessFactor::Evaluate(double const* const* parameters, double* residuals,
@@ -209,6 +243,17 @@ bool FeatureWitnessFactor::Evaluate(double const* const* parameters, double* res
   if (!QueryPointOrReject(finger_, parameters[1], p, &on_finger, &Jf)) return false;
   Eigen::Matrix<double, 2, 3> J_A_x, J_B_x;
   const Vec2 A = geometry::Act(x, a_, &J_A_x), B = geometry::Act(x, b_, &J_B_x);
+  OverlapEnd end;
+  if (!vertex_ && end_ != 0 &&
+      SnapToOverlapEnd(A, B, two_sided_, radius_, finger_, PoseFrom(parameters[1]), on_finger.feature, end_, &end)) {
+    Eigen::Map<Eigen::Vector2d>{residuals} = w_ * (p - end.c.q);
+    if (jacobians != nullptr) {
+      if (jacobians[0] != nullptr) Eigen::Map<RowMat23>{jacobians[0]} = -w_ * (end.c.J_q_A * J_A_x + end.c.J_q_B * J_B_x);
+      if (jacobians[1] != nullptr) Eigen::Map<RowMat23>{jacobians[1]} = -w_ * end.c.J_q_f * end.J_F_e;
+      if (jacobians[2] != nullptr) Eigen::Map<RowMat22>{jacobians[2]} = w_ * Eigen::Matrix2d::Identity();
+    }
+    return true;
+  }
   const SegmentClosest c = ClosestOnFeature(A, B, vertex_, two_sided_, radius_, on_finger.closest_point);
   Eigen::Map<Eigen::Vector2d>{residuals} = w_ * (p - c.q);
   if (jacobians != nullptr) {

@@ -877,6 +877,20 @@ void GraphBuilder::AddTwoContactFactors(ceres::Problem& problem, int i, int fing
   choice = FixedFeatureKeys(on_features, features);
   double* points[2] = {FingerContact(i, finger), second};
   const geometry::Shape& shape = FingerShape(finger);
+  // A flat face along an object face (a line contact): each contact at its own end of the
+  // overlap, the one away from the other contact (the rows are the contact's two end points).
+  int overlap_end[2] = {0, 0};
+  if (finger_has_faces_[finger]) {
+    const Pose2 x{v.x[0], v.x[1], v.x[2]};
+    for (int k = 0; k < 2 && on_features; ++k) {
+      if (choice[k] < 0 || features[k].vertex) continue;
+      const geometry::Ring& ring = traj_.object.shape.ring(features[k].edge.polygon, features[k].edge.ring);
+      const Vec2 a = ring[features[k].edge.index], b = ring[(features[k].edge.index + 1) % ring.size()];
+      const Vec2 own = geometry::InverseAct(x, Vec2(points[k][0], points[k][1]));
+      const Vec2 other = geometry::InverseAct(x, Vec2(points[1 - k][0], points[1 - k][1]));
+      overlap_end[k] = (other - own).dot(b - a) > 0.0 ? -1 : 1;
+    }
+  }
   for (int k = 0; k < 2; ++k) {
     // An object vertex is never a fixed feature: pinned to a corner at the start, a contact
     // that is really on the adjacent edge (a flat pusher's end near the corner) holds the
@@ -884,7 +898,8 @@ void GraphBuilder::AddTwoContactFactors(ceres::Problem& problem, int i, int fing
     // solution too. The local witness follows p instead.
     ceres::CostFunction* cost =
         choice[k] >= 0 ? static_cast<ceres::CostFunction*>(new FeatureWitnessFactor(
-                             traj_.object.shape, features[k].edge, features[k].vertex, shape, cfg_.contact_finger_sigma))
+                             traj_.object.shape, features[k].edge, features[k].vertex, shape, cfg_.contact_finger_sigma,
+                             overlap_end[k]))
                        : new LocalWitnessFactor(traj_.object.shape, shape, cfg_.contact_finger_sigma);
     Add(problem, FactorType::kContactOnFinger, cost, nullptr, {v.x, FingerPose(i, finger), points[k]}, {0});
   }

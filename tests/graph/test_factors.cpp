@@ -163,6 +163,54 @@ TEST(FactorJacobians, FeatureWitness) {
   EXPECT_THROW(FeatureWitnessFactor(Objects()[0], geometry::EdgeId{0, -1, 999}, false, Shape::Disk(0.005), 1e-3), GraphError);
 }
 
+// A flat bar along an object edge (a line contact): with overlap_end -1 / +1 the witness is the
+// overlap's end toward the edge's start / end wherever p is on the facing bar face (the bar's
+// corner projected onto the edge, or the edge's own vertex where the bar hangs past it), and it
+// stays on the facing pair's features; Jacobians checked with the bar tilted up to 0.3 rad.
+TEST(FactorJacobians, FeatureWitnessAtAnOverlapEnd) {
+  Rng rng;
+  JacobianTally tally("C feature witness at an overlap end");
+  WorstError worst{"C feature witness at an overlap end"};
+  const Shape object = Shape::Box(0.12, 0.08);  // edge 2 of its ring: (0.06, 0.04) -> (-0.06, 0.04)
+  const Shape bar = Shape::Box(0.01, 0.064);    // its face x = +0.005 runs along y
+  const geometry::EdgeId top{0, -1, 2};
+  const auto& ring = object.polygons()[0].outer;
+  const Vec2 A = ring[2], B = ring[3];
+  ASSERT_NEAR(A.y(), 0.04, 1e-15);
+  ASSERT_NEAR(B.y(), 0.04, 1e-15);
+  int n = 0, at_corner = 0, at_vertex = 0;
+  for (const int end : {-1, 1}) {
+    FeatureWitnessFactor f(object, top, false, bar, 1e-3, end);
+    for (int i = 0; i < 60; ++i, ++n) {
+      const Pose2 x = rng.P(0.2);
+      // The bar's face on the top edge, turned by pi/2 - tilt so its +x face looks down at it,
+      // its centre anywhere from inside the edge to hanging 2 cm past an end.
+      const double along = rng.U(-0.07, 0.07), tilt = rng.U(-0.3, 0.3);
+      const Vec2 centre_obj(along, 0.04 + 0.005 + rng.U(-0.001, 0.001));
+      const Pose2 e = geometry::Compose(x, Pose2{centre_obj.x(), centre_obj.y(), -M_PI / 2 + tilt});
+      const Vec2 p = geometry::Act(x, Vec2(along + rng.U(-0.02, 0.02), 0.04 + rng.U(-0.002, 0.002)));
+      CheckCost(f, {V(x), V(e), V(p)}, tally, worst, "case " + std::to_string(n));
+      // With the bar square to the edge: the end is the bar's corner on that side, or the edge's
+      // vertex where the bar hangs past it.
+      const Pose2 e0 = geometry::Compose(x, Pose2{along, 0.045, -M_PI / 2});
+      const std::vector<Eigen::VectorXd> values{V(x), V(e0), V(p)};
+      const double* blocks[] = {values[0].data(), values[1].data(), values[2].data()};
+      Eigen::Vector2d r;
+      ASSERT_TRUE(f.Evaluate(blocks, r.data(), nullptr));
+      const Vec2 q_obj = geometry::InverseAct(x, p - 1e-3 * r);
+      // end -1: toward A (x = +0.06); +1: toward B (x = -0.06). The bar spans along +- 0.032.
+      const double expected = end < 0 ? std::min(0.06, along + 0.032) : std::max(-0.06, along - 0.032);
+      EXPECT_NEAR(q_obj.x(), expected, 1e-12) << "case " << n;
+      EXPECT_NEAR(q_obj.y(), 0.04, 1e-12) << "case " << n;
+      (std::abs(expected) == 0.06 ? at_vertex : at_corner)++;
+    }
+  }
+  EXPECT_GT(at_corner, 20);
+  EXPECT_GT(at_vertex, 10);
+  EXPECT_TRUE(tally.MostlyChecked(0.9));
+  EXPECT_THROW(FeatureWitnessFactor(object, top, false, bar, 1e-3, 2), GraphError);
+}
+
 // The friction cone: forces inside (zero residual), pulling, slipping on either side, at
 // contact points near the boundary of random objects (the normal varies with pose and point).
 TEST(FactorJacobians, FrictionCone) {

@@ -117,8 +117,11 @@ class FeatureWitnessFactor : public ceres::SizedCostFunction<2, 3, 3, 2> {
  public:
   /// `feature`: an edge of `object` (its start vertex when `vertex`). Throws GraphError for an
   /// edge the object does not have.
+  /// `overlap_end` -1 or +1, for an edge along a flat finger face (a line contact, sensed as the
+  /// overlap's two end points): q is the overlap's end toward the edge's start (-1) or its end
+  /// (+1), wherever G_f(e, p) is on the facing finger edge; 0: the closest point as above.
   FeatureWitnessFactor(geometry::Shape object, geometry::EdgeId feature, bool vertex, geometry::Shape finger,
-                       double sigma);
+                       double sigma, int overlap_end = 0);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
@@ -126,6 +129,7 @@ class FeatureWitnessFactor : public ceres::SizedCostFunction<2, 3, 3, 2> {
   geometry::Shape finger_;
   Vec2 a_, b_;          ///< the edge's end points (object frame); a_ alone for a vertex
   bool vertex_, two_sided_ = false;  ///< two-sided: a segment core, rounded on both sides
+  int end_ = 0;
   double radius_, w_;
 };
 
