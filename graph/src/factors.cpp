@@ -215,14 +215,13 @@ struct OverlapEnd {
   Eigen::Matrix<double, 2, 3> J_F_e;
 };
 bool SnapToOverlapEnd(const Vec2& A, const Vec2& B, bool two_sided, double radius, const geometry::Shape& finger,
-                      const Pose2& e, const geometry::BoundaryFeature& finger_feature, int side, OverlapEnd* out) {
-  if (finger_feature.kind != geometry::BoundaryFeature::Kind::kEdge) return false;
-  const geometry::Ring& ring = finger.ring(finger_feature.edge.polygon, finger_feature.edge.ring);
+                      const Pose2& e, const geometry::EdgeId& finger_edge, int side, OverlapEnd* out) {
+  const geometry::Ring& ring = finger.ring(finger_edge.polygon, finger_edge.ring);
   const int n = static_cast<int>(ring.size());
   if (n < 2) return false;
   Eigen::Matrix<double, 2, 3> J_FA_e, J_FB_e;
-  const Vec2 FA = geometry::Act(e, ring[finger_feature.edge.index], &J_FA_e);
-  const Vec2 FB = geometry::Act(e, ring[(finger_feature.edge.index + 1) % n], &J_FB_e);
+  const Vec2 FA = geometry::Act(e, ring[finger_edge.index], &J_FA_e);
+  const Vec2 FB = geometry::Act(e, ring[(finger_edge.index + 1) % n], &J_FB_e);
   const Vec2 d = B - A, fd = FB - FA;
   if (!(d.squaredNorm() > 0.0) || !(fd.squaredNorm() > 0.0)) return false;
   if (d.dot(fd) > -std::sqrt(0.5 * d.squaredNorm() * fd.squaredNorm())) return false;  // not facing
@@ -244,8 +243,8 @@ bool FeatureWitnessFactor::Evaluate(double const* const* parameters, double* res
   Eigen::Matrix<double, 2, 3> J_A_x, J_B_x;
   const Vec2 A = geometry::Act(x, a_, &J_A_x), B = geometry::Act(x, b_, &J_B_x);
   OverlapEnd end;
-  if (!vertex_ && end_ != 0 &&
-      SnapToOverlapEnd(A, B, two_sided_, radius_, finger_, PoseFrom(parameters[1]), on_finger.feature, end_, &end)) {
+  if (!vertex_ && end_ != 0 && on_finger.feature.kind == geometry::BoundaryFeature::Kind::kEdge &&
+      SnapToOverlapEnd(A, B, two_sided_, radius_, finger_, PoseFrom(parameters[1]), on_finger.feature.edge, end_, &end)) {
     Eigen::Map<Eigen::Vector2d>{residuals} = w_ * (p - end.c.q);
     if (jacobians != nullptr) {
       if (jacobians[0] != nullptr) Eigen::Map<RowMat23>{jacobians[0]} = -w_ * (end.c.J_q_A * J_A_x + end.c.J_q_B * J_B_x);
@@ -261,6 +260,46 @@ bool FeatureWitnessFactor::Evaluate(double const* const* parameters, double* res
     if (jacobians[1] != nullptr) Eigen::Map<RowMat23>{jacobians[1]} = -w_ * c.J_q_f * Jf.J_closest_pose;
     if (jacobians[2] != nullptr)
       Eigen::Map<RowMat22>{jacobians[2]} = w_ * (Eigen::Matrix2d::Identity() - c.J_q_f * Jf.J_closest_point);
+  }
+  return true;
+}
+
+OverlapEndMeasurementFactor::OverlapEndMeasurementFactor(const geometry::Shape& object, geometry::EdgeId object_edge,
+                                                         geometry::Shape finger, geometry::EdgeId finger_edge,
+                                                         int overlap_end, const Vec2& measured, double sigma)
+    : finger_(std::move(finger)), finger_edge_(finger_edge), end_(overlap_end), radius_(object.radius()), measured_(measured),
+      w_(CheckedWeight(sigma, "overlap end measurement")) {
+  if (overlap_end != -1 && overlap_end != 1) throw GraphError("overlap end measurement: overlap_end must be -1 or +1");
+  auto ring_of = [](const geometry::Shape& shape, const geometry::EdgeId& id, const char* what) -> const geometry::Ring& {
+    const auto& polygons = shape.polygons();
+    if (id.polygon < 0 || id.polygon >= static_cast<int>(polygons.size()) || id.ring < -1 ||
+        id.ring >= static_cast<int>(polygons[id.polygon].holes.size()))
+      throw GraphError(std::string("overlap end measurement: the ") + what + " has no ring " + std::to_string(id.ring) +
+                       " in polygon " + std::to_string(id.polygon));
+    const geometry::Ring& ring = shape.ring(id.polygon, id.ring);
+    if (id.index < 0 || id.index >= static_cast<int>(ring.size()) || ring.size() < 2)
+      throw GraphError(std::string("overlap end measurement: the ") + what + "'s ring has no edge " + std::to_string(id.index));
+    return ring;
+  };
+  const geometry::Ring& ring = ring_of(object, object_edge, "object");
+  ring_of(finger_, finger_edge, "finger");
+  a_ = ring[object_edge.index];
+  b_ = ring[(object_edge.index + 1) % ring.size()];
+  two_sided_ = ring.size() < 3;
+}
+
+bool OverlapEndMeasurementFactor::Evaluate(double const* const* parameters, double* residuals,
+                                           double** jacobians) const {
+  Eigen::Matrix<double, 2, 3> J_A_x, J_B_x;
+  const Pose2 x = PoseFrom(parameters[0]);
+  const Vec2 A = geometry::Act(x, a_, &J_A_x), B = geometry::Act(x, b_, &J_B_x);
+  OverlapEnd end;
+  if (!SnapToOverlapEnd(A, B, two_sided_, radius_, finger_, PoseFrom(parameters[1]), finger_edge_, end_, &end))
+    return false;  // the faces do not face each other at this step: rejected, as a failed query
+  Eigen::Map<Eigen::Vector2d>{residuals} = w_ * (end.c.q - measured_);
+  if (jacobians != nullptr) {
+    if (jacobians[0] != nullptr) Eigen::Map<RowMat23>{jacobians[0]} = w_ * (end.c.J_q_A * J_A_x + end.c.J_q_B * J_B_x);
+    if (jacobians[1] != nullptr) Eigen::Map<RowMat23>{jacobians[1]} = w_ * end.c.J_q_f * end.J_F_e;
   }
   return true;
 }

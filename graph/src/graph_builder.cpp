@@ -903,6 +903,69 @@ void GraphBuilder::AddTwoContactFactors(ceres::Problem& problem, int i, int fing
                        : new LocalWitnessFactor(traj_.object.shape, shape, cfg_.contact_finger_sigma);
     Add(problem, FactorType::kContactOnFinger, cost, nullptr, {v.x, FingerPose(i, finger), points[k]}, {0});
   }
+  if (overlap_end[0] != 0 || overlap_end[1] != 0) AddInnerEndRows(problem, i, finger, features, points, overlap_end);
+}
+
+void GraphBuilder::AddInnerEndRows(ceres::Problem& problem, int i, int finger, const ContactFeature features[2],
+                                   double* const points[2], const int overlap_end[2]) {
+  // A step's rows beyond the two kept (a flat face across a notch: the notch's corners between
+  // the face's ends) measure the other end of a contact's overlap, which places the object
+  // along its face (OverlapEndMeasurementFactor).
+  const std::vector<push::PointSample>& rows = ContactRows(finger);
+  const int kept[2] = {ContactRow(i, finger), SecondContactRow(i, finger)};
+  if (kept[0] < 0 || kept[1] < 0) return;
+  const auto [first, last] = ContactRowsAt(rows, kept[0]);
+  if (last - first + 1 <= 2) return;
+  StepVars& v = vars_[i];
+  double* e = FingerPose(i, finger);
+  const geometry::Shape& shape = FingerShape(finger);
+  geometry::EdgeId finger_edge[2];
+  bool facing[2] = {false, false};
+  const Pose2 x{v.x[0], v.x[1], v.x[2]}, pose_e{e[0], e[1], e[2]};
+  for (int k = 0; k < 2; ++k) {
+    if (overlap_end[k] == 0) continue;
+    // The finger's face along the object edge: of the finger edges at its closest feature to
+    // the contact (a contact at the face's end is nearest the corner, whose other edge is the
+    // finger's end face), the one most nearly antiparallel to the object edge.
+    geometry::PointQuery q;
+    try {
+      q = geometry::QueryPoint(shape, pose_e, Vec2(points[k][0], points[k][1]));
+    } catch (const geometry::GeometryError&) {
+      continue;
+    }
+    const geometry::Ring& oring = traj_.object.shape.ring(features[k].edge.polygon, features[k].edge.ring);
+    const Vec2 d = geometry::Act(x, oring[(features[k].edge.index + 1) % oring.size()]) -
+                   geometry::Act(x, oring[features[k].edge.index]);
+    const geometry::Ring& fring = shape.ring(q.feature.edge.polygon, q.feature.edge.ring);
+    const int n = static_cast<int>(fring.size());
+    if (n < 2) continue;
+    double best_cos = -std::sqrt(0.5);
+    const int j = q.feature.edge.index;
+    for (const int index : {j, (j + n - 1) % n, (j + 1) % n}) {
+      const Vec2 fd = geometry::Act(pose_e, fring[(index + 1) % n]) - geometry::Act(pose_e, fring[index]);
+      const double c = d.dot(fd) / (d.norm() * fd.norm());
+      if (c < best_cos) best_cos = c, finger_edge[k] = {q.feature.edge.polygon, q.feature.edge.ring, index}, facing[k] = true;
+    }
+  }
+  // Each contact's other end takes the nearest extra row, within three sigmas of the row and
+  // the object pose together (a row across the notch, 3 cm away, is the other contact's).
+  const double gate = 3.0 * std::hypot(cfg_.measurement.contact, cfg_.measurement.object_trans);
+  const double* values[2] = {v.x, e};
+  for (int k = 0; k < 2; ++k) {
+    if (!facing[k]) continue;
+    std::unique_ptr<OverlapEndMeasurementFactor> best;
+    double best_distance = INFINITY;
+    for (int r = first; r <= last; ++r) {
+      if (r == kept[0] || r == kept[1]) continue;
+      auto factor = std::make_unique<OverlapEndMeasurementFactor>(traj_.object.shape, features[k].edge, shape, finger_edge[k],
+                                                                  -overlap_end[k], rows[r].point, cfg_.measurement.contact);
+      Eigen::Vector2d residual;
+      if (!factor->Evaluate(values, residual.data(), nullptr)) continue;
+      const double distance = residual.norm() * cfg_.measurement.contact;
+      if (distance < best_distance && distance <= gate) best_distance = distance, best = std::move(factor);
+    }
+    if (best) Add(problem, FactorType::kContactPoint, best.release(), MakeLoss(cfg_.contact_loss), {v.x, e}, {0});
+  }
 }
 
 void GraphBuilder::AddOtherFingerKinematicFactors(ceres::Problem& problem, int i, int k) {
@@ -1138,7 +1201,8 @@ void GraphBuilder::DropUnobservableForces(EstimationResult& result) const {
     result.warnings.push_back(std::to_string(steps_with_more_contacts_) +
                               " steps have three or more contact rows at one time: each is modelled by its two rows "
                               "farthest apart (exact for contacts along one straight finger face, an approximation "
-                              "otherwise)");
+                              "otherwise); a flat finger face's other rows measure the ends of its overlaps with the "
+                              "object between them (a notch's corners)");
   if (fingers_ignored_)
     result.warnings.push_back(traj_.extra_fingers.size() == 1
                                   ? "the Yu-Rodriguez baseline models one finger: finger 1 of this two-finger push was left "

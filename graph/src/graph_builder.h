@@ -330,6 +330,10 @@ class GraphBuilder {
   /// Finger k's two contacts at step i: M of both rows, C on the object's boundary and at each
   /// one's own feature (FeatureWitnessFactor) or local witness.
   void AddTwoContactFactors(ceres::Problem& problem, int i, int k);
+  /// A faced finger's rows at step i beyond its two contacts' (three or four on a face broken by
+  /// a notch): each measures the other end of one contact's overlap (OverlapEndMeasurementFactor).
+  void AddInnerEndRows(ceres::Problem& problem, int i, int finger, const ContactFeature features[2],
+                       double* const points[2], const int overlap_end[2]);
   /// Whether finger 0 at step i's current values is between two walls: two contacts within
   /// that tolerance whose normals differ by more than 60 degrees.
   bool BetweenWalls(int i) const;

@@ -211,6 +211,41 @@ TEST(FactorJacobians, FeatureWitnessAtAnOverlapEnd) {
   EXPECT_THROW(FeatureWitnessFactor(object, top, false, bar, 1e-3, 2), GraphError);
 }
 
+// A line contact's inner end point measured (a notch's corner between a flat face's ends): the
+// same overlap end, as a function of both poses only; Jacobians and the end's position.
+TEST(FactorJacobians, OverlapEndMeasurement) {
+  Rng rng;
+  JacobianTally tally("overlap end measurement");
+  WorstError worst{"overlap end measurement"};
+  const Shape object = Shape::Box(0.12, 0.08);
+  const Shape bar = Shape::Box(0.01, 0.064);
+  const geometry::EdgeId top{0, -1, 2}, face{0, -1, 1};  // the bar's edge 1: x = +0.005, y from -0.032 to 0.032
+  int n = 0;
+  for (const int end : {-1, 1}) {
+    for (int i = 0; i < 60; ++i, ++n) {
+      const Vec2 measured(rng.U(-0.07, 0.07), rng.U(0.035, 0.045));
+      OverlapEndMeasurementFactor f(object, top, bar, face, end, measured, 1e-3);
+      const Pose2 x = rng.P(0.2);
+      const double along = rng.U(-0.07, 0.07), tilt = rng.U(-0.3, 0.3);
+      const Pose2 e = geometry::Compose(x, Pose2{along, 0.045 + rng.U(-0.001, 0.001), -M_PI / 2 + tilt});
+      CheckCost(f, {V(x), V(e)}, tally, worst, "case " + std::to_string(n));
+      // Square to the edge, at the identity object pose: the end is known in closed form.
+      const Pose2 e0{along, 0.045, -M_PI / 2};
+      const std::vector<Eigen::VectorXd> values{V(Pose2{0, 0, 0}), V(e0)};
+      const double* blocks[] = {values[0].data(), values[1].data()};
+      Eigen::Vector2d r;
+      ASSERT_TRUE(f.Evaluate(blocks, r.data(), nullptr));
+      const double expected = end < 0 ? std::min(0.06, along + 0.032) : std::max(-0.06, along - 0.032);
+      EXPECT_NEAR(measured.x() + 1e-3 * r.x(), expected, 1e-12) << "case " << n;
+      EXPECT_NEAR(measured.y() + 1e-3 * r.y(), 0.04, 1e-12) << "case " << n;
+    }
+  }
+  EXPECT_TRUE(tally.MostlyChecked(0.9));
+  EXPECT_THROW(OverlapEndMeasurementFactor(object, top, bar, face, 0, Vec2::Zero(), 1e-3), GraphError);
+  EXPECT_THROW(OverlapEndMeasurementFactor(object, geometry::EdgeId{0, -1, 9}, bar, face, 1, Vec2::Zero(), 1e-3), GraphError);
+  EXPECT_THROW(OverlapEndMeasurementFactor(object, top, bar, geometry::EdgeId{0, 3, 0}, 1, Vec2::Zero(), 1e-3), GraphError);
+}
+
 // The friction cone: forces inside (zero residual), pulling, slipping on either side, at
 // contact points near the boundary of random objects (the normal varies with pose and point).
 TEST(FactorJacobians, FrictionCone) {

@@ -133,6 +133,32 @@ class FeatureWitnessFactor : public ceres::SizedCostFunction<2, 3, 3, 2> {
   double radius_, w_;
 };
 
+/// M for a line contact's inner end points. A flat face across an object face broken by a notch
+/// touches it at four points: the face's two ends (a step's two contacts, held at the overlap's
+/// outer ends by FeatureWitnessFactor) and the notch's corners between them, which are the only
+/// ones that place the object along its face. Each such row measures the other end of one
+/// contact's overlap (the object edge `object_edge` against the finger edge `finger_edge`):
+/// r = (q_end(x, e) - measured) / sigma, q_end the overlap's end toward the edge's start (-1) or
+/// its end (+1), as in FeatureWitnessFactor. Parameters: object pose (3), finger pose (3).
+class OverlapEndMeasurementFactor : public ceres::SizedCostFunction<2, 3, 3> {
+ public:
+  /// Throws GraphError for an edge either shape does not have, or overlap_end not -1 or +1.
+  OverlapEndMeasurementFactor(const geometry::Shape& object, geometry::EdgeId object_edge, geometry::Shape finger,
+                              geometry::EdgeId finger_edge, int overlap_end, const Vec2& measured, double sigma);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  geometry::Shape finger_;
+  geometry::EdgeId finger_edge_;
+  int end_;
+  Vec2 a_, b_;
+  bool two_sided_ = false;
+  double radius_;
+  Vec2 measured_;
+  double w_;
+};
+
 /// Coulomb's friction cone of one contact, one-sided (zero inside the cone): with n the object's
 /// inward normal at p (geometry::QueryPoint), f_n = f.n, f_t = f.(z x n),
 ///   r = (max(0, -f_n), max(0, |f_t| - mu f_n)) / sigma.
