@@ -137,20 +137,31 @@ bool LocalWitnessFactor::Evaluate(double const* const* parameters, double* resid
   return true;
 }
 
+namespace {
+// The ring holding `feature` of `shape` (its edge, or its start vertex when `vertex`), or a
+// GraphError naming what is missing, prefixed by `factor` and `what` ("the object").
+const geometry::Ring& FeatureRing(const geometry::Shape& shape, const geometry::EdgeId& feature, bool vertex,
+                                  const std::string& factor, const std::string& what) {
+  const auto& polygons = shape.polygons();
+  if (feature.polygon < 0 || feature.polygon >= static_cast<int>(polygons.size()) || feature.ring < -1 ||
+      feature.ring >= static_cast<int>(polygons[feature.polygon].holes.size()))
+    throw GraphError(factor + ": " + what + " has no ring " + std::to_string(feature.ring) + " in polygon " +
+                     std::to_string(feature.polygon));
+  const geometry::Ring& ring = shape.ring(feature.polygon, feature.ring);
+  const int n = static_cast<int>(ring.size());
+  if (feature.index < 0 || feature.index >= n || (!vertex && n < 2))
+    throw GraphError(factor + ": " + what + "'s ring has no edge " + std::to_string(feature.index));
+  return ring;
+}
+}  // namespace
+
 FeatureWitnessFactor::FeatureWitnessFactor(geometry::Shape object, geometry::EdgeId feature, bool vertex,
                                            geometry::Shape finger, double sigma, int overlap_end)
     : finger_(std::move(finger)), vertex_(vertex), end_(overlap_end), radius_(object.radius()),
       w_(CheckedWeight(sigma, "contact feature witness")) {
   if (overlap_end < -1 || overlap_end > 1) throw GraphError("contact feature witness: overlap_end must be -1, 0 or +1");
-  const auto& polygons = object.polygons();
-  if (feature.polygon < 0 || feature.polygon >= static_cast<int>(polygons.size()) || feature.ring < -1 ||
-      feature.ring >= static_cast<int>(polygons[feature.polygon].holes.size()))
-    throw GraphError("contact feature witness: the object has no ring " + std::to_string(feature.ring) + " in polygon " +
-                     std::to_string(feature.polygon));
-  const geometry::Ring& ring = object.ring(feature.polygon, feature.ring);
+  const geometry::Ring& ring = FeatureRing(object, feature, vertex, "contact feature witness", "the object");
   const int n = static_cast<int>(ring.size());
-  if (feature.index < 0 || feature.index >= n || (!vertex && n < 2))
-    throw GraphError("contact feature witness: the object's ring has no edge " + std::to_string(feature.index));
   a_ = ring[feature.index];
   b_ = ring[(feature.index + 1) % n];
   two_sided_ = n < 3;
@@ -270,19 +281,8 @@ OverlapEndMeasurementFactor::OverlapEndMeasurementFactor(const geometry::Shape& 
     : finger_(std::move(finger)), finger_edge_(finger_edge), end_(overlap_end), radius_(object.radius()), measured_(measured),
       w_(CheckedWeight(sigma, "overlap end measurement")) {
   if (overlap_end != -1 && overlap_end != 1) throw GraphError("overlap end measurement: overlap_end must be -1 or +1");
-  auto ring_of = [](const geometry::Shape& shape, const geometry::EdgeId& id, const char* what) -> const geometry::Ring& {
-    const auto& polygons = shape.polygons();
-    if (id.polygon < 0 || id.polygon >= static_cast<int>(polygons.size()) || id.ring < -1 ||
-        id.ring >= static_cast<int>(polygons[id.polygon].holes.size()))
-      throw GraphError(std::string("overlap end measurement: the ") + what + " has no ring " + std::to_string(id.ring) +
-                       " in polygon " + std::to_string(id.polygon));
-    const geometry::Ring& ring = shape.ring(id.polygon, id.ring);
-    if (id.index < 0 || id.index >= static_cast<int>(ring.size()) || ring.size() < 2)
-      throw GraphError(std::string("overlap end measurement: the ") + what + "'s ring has no edge " + std::to_string(id.index));
-    return ring;
-  };
-  const geometry::Ring& ring = ring_of(object, object_edge, "object");
-  ring_of(finger_, finger_edge, "finger");
+  const geometry::Ring& ring = FeatureRing(object, object_edge, false, "overlap end measurement", "the object");
+  FeatureRing(finger_, finger_edge, false, "overlap end measurement", "the finger");
   a_ = ring[object_edge.index];
   b_ = ring[(object_edge.index + 1) % ring.size()];
   two_sided_ = ring.size() < 3;
