@@ -382,7 +382,7 @@ TEST(ChainSolver, SmoothingPassBringsAShortWindowToTheBatchEstimate) {
 TEST(ChainSolver, ConfigSelectsTheSolverAndTheUpdateRate) {
   EXPECT_EQ(ParseEstimatorConfig(R"({"solver": "ceres"})").solver, EstimatorConfig::Solver::kCeres);
   EXPECT_EQ(ParseEstimatorConfig(R"({"solver": "chain"})").solver, EstimatorConfig::Solver::kChain);
-  EXPECT_EQ(EstimatorConfig{}.solver, EstimatorConfig::Solver::kCeres);
+  EXPECT_EQ(EstimatorConfig{}.solver, EstimatorConfig::Solver::kChain);
   EXPECT_EQ(ParseEstimatorConfig(R"({"incremental_update_every_steps": 1})").incremental_update_every_steps, 1);
   EXPECT_EQ(ParseEstimatorConfig(R"({"incremental_window_steps": 40})").incremental_window_steps, 40);
   EXPECT_TRUE(EstimatorConfig{}.incremental_smoothing);

@@ -136,7 +136,7 @@ void RegisterEstimate(CLI::App& app) {
   sub->add_option("--mode", opts->mode, "batch or incremental (fixed-lag smoothing)")->capture_default_str();
   sub->add_option("-o,--output", opts->output, "Output RESULT.json")->required();
   sub->add_option("--solver", opts->solver,
-                  "ceres (the default, the reference) or chain (banded Levenberg-Marquardt, chain_solver.h); overrides the config's")
+                  "chain (the default: banded Levenberg-Marquardt, chain_solver.h) or ceres (the reference); overrides the config's")
       ->check(CLI::IsMember({"chain", "ceres"}));
   sub->add_option("--config", opts->config, "Estimator configuration JSON (sigmas, losses, window; docs/estimation.md)");
   sub->add_option("--object", opts->object, "Object shape JSON (required for MIT recordings; overrides a trajectory's)");

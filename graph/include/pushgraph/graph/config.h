@@ -103,16 +103,14 @@ struct EstimatorConfig {
   // Robust losses on measurement factors.
   LossConfig object_pose_loss, finger_pose_loss, contact_loss, force_loss;
   // Solver.
-  /// kCeres (the default): Ceres' LM with SPARSE_NORMAL_CHOLESKY, the reference; kChain:
-  /// ChainSolver (chain_solver.h), Levenberg-Marquardt on the block-banded normal equations with
-  /// its symbolic factorization reused by every iteration and by the covariances. Both reach the
-  /// same minimum from the same start (tested), the chain solver with about a quarter less time
-  /// per iteration; on the evaluation set some non-convex trajectories settle in other local
-  /// minima, which moves a few rows of docs/results.md by more than the noise, so Ceres stays
-  /// the default until the chain solver is also faster in iterations (docs/estimation.md,
-  /// Speed). JSON "solver": "ceres" | "chain".
+  /// kChain (the default): ChainSolver (chain_solver.h), Levenberg-Marquardt on the
+  /// block-banded normal equations with its symbolic factorization reused by every iteration and
+  /// by the covariances; kCeres: Ceres' LM with SPARSE_NORMAL_CHOLESKY, the reference and the
+  /// benchmarks' peer. Both reach the same minimum from the same start (tested); the chain solver
+  /// takes less time per iteration, and on docs/results.md's set its rows are within 2 % (object
+  /// RMS) and 10 % (QS NEES) of Ceres' (docs/estimation.md, Solvers). JSON "solver": "chain" | "ceres".
   enum class Solver { kChain, kCeres };
-  Solver solver = Solver::kCeres;
+  Solver solver = Solver::kChain;
   int max_iterations = 100;
   double function_tolerance = 1e-6;
   bool covariance = true;  ///< marginal covariances of every state

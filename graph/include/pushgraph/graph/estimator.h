@@ -89,7 +89,7 @@ struct SolverStats {
   double max_update_time_s = 0.0;
   double mean_update_time_s = 0.0;
   std::string covariance_status = "not computed";
-  std::string name = "ceres";           ///< which solver ran: "ceres" or "chain" (ChainSolver)
+  std::string name = "chain";           ///< which solver ran: "ceres" or "chain" (ChainSolver)
   std::vector<double> update_times_s;   ///< incremental: each update's wall time, in order
   /// The chain solver's profile of the batch's final stage: wall time (s) in residual and
   /// Jacobian evaluation with the J^T J accumulation and in factorizations and solves, and the
