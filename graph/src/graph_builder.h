@@ -200,6 +200,11 @@ class GraphBuilder {
   /// Initial values of step i from the measurements with time stamps <= limit (interpolated;
   /// the newest held). limit = INFINITY in batch; the update time in incremental mode.
   void Initialize(int i, double limit);
+  /// Batch start beyond the object stream's ends (a camera lost before the push ends, or started
+  /// late): after Initialize, the object's initial poses in an end gap longer than
+  /// max(3 object periods, 0.1 s) follow the translation of a finger in contact (sticking)
+  /// instead of holding the nearest measured pose. Returns the number of steps moved.
+  int CarryObjectThroughGaps();
   /// Replaces the initial poses (all steps already Initialize()d) by a motion-only smoother's:
   /// pose measurements and the constant-velocity prior alone (nearly linear: 2 to 5 LM
   /// iterations; it is only a starting point, so the batch solver caps it at 10 iterations and a

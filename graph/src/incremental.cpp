@@ -407,7 +407,10 @@ struct FixedLagSmoother {
     r.solver = stats;
     r.solver.time_s = total_update_time;
     r.solver.final_cost = last_cost;
-    r.solver.mean_update_time_s = stats.updates > 0 ? total_update_time / stats.updates : 0.0;
+    // The updates' own mean (time_s also holds Finish's smoothing pass, which is no update).
+    double update_sum = 0.0;
+    for (double u : stats.update_times_s) update_sum += u;
+    r.solver.mean_update_time_s = stats.updates > 0 ? update_sum / stats.updates : 0.0;
     builder.DropUnobservableForces(r);
     r.metrics = ComputeMetrics(traj, r.states);
     return r;
