@@ -1294,7 +1294,7 @@ void GraphBuilder::DropUnobservableForces(EstimationResult& result) const {
   const std::string how = model_ == Model::kYu
                               ? "the baseline has no limit-surface load"
                               : (f_max_ > 0.0 ? "limit_surface_load is off"
-                                              : "the object's mass or mu_surface is missing, so there is no limit-surface load");
+                                              : "the object's mass or mu_surface is missing or zero, so there is no limit-surface load");
   result.warnings.push_back("forces not reported: there is no force stream and " + how +
                             ", so nothing fixes their size (the quasi-static factor fixes only their direction)");
 }

@@ -221,6 +221,26 @@ TEST_F(EstimateCli, RefusesInputsItWouldMisread) {
   EXPECT_NE(r.err.find("rows [2] and [3]"), std::string::npos) << r.err;
 }
 
+// Without a force stream (rect1's is frozen) the limit-surface load alone sets the forces' size.
+// The dataset's rect1 mesh with 10 kg instead of 0.84 kg drove the forces to 0.14 N at a load
+// ratio of 19.8, and nothing said so; the self-diagnosis names it now, and not the right mass.
+TEST_F(EstimateCli, AWrongMassWithoutAForceStreamIsNamed) {
+  const std::string shared = std::string(PUSHGRAPH_SHARED_DIR) + "/data/mit-push/";
+  const std::string h5 = shared + "abs/rect1/motion_surface=abs_shape=rect1_a=0_v=75_i=2.000_s=0.700_t=-1.047.h5";
+  if (!std::ifstream(h5)) GTEST_SKIP() << "no MIT data at " << shared;
+  const std::string shape = dir() + "/rect1_mesh.json", tip = dir() + "/tip_mass.json";
+  ASSERT_EQ(Tool("footprint " + shared + "obj/rect1.obj -o " + shape).status, 0);
+  std::ofstream(tip) << R"({"polygons": [{"outer": [[0, 0]]}], "radius": 0.0047})";
+  for (const char* mass : {"0.8374", "10"}) {
+    const std::string out = dir() + "/mass_" + mass + ".json";
+    const pushgraph::testing::ToolRun r = Tool("estimate '" + h5 + "' --object " + shape + " --finger " + tip + " --mass " +
+                                               mass + " --mu 0.35 --add-noise gaussian -o " + out);
+    ASSERT_EQ(r.status, 0) << r.err;
+    const bool named = r.err.find("check the mass (kg) and mu_surface") != std::string::npos;
+    EXPECT_EQ(named, std::string(mass) == "10") << mass << ": " << r.err;
+  }
+}
+
 // An MIT recording (HDF5) read directly: trimmed to contact, time stamps kept (unix seconds),
 // the paper's noise added with the clean recording as ground truth, and a picture.
 TEST_F(EstimateCli, MitRecordingWithAddedNoise) {
