@@ -31,9 +31,9 @@ namespace {
 // ceres::Covariance's QR on J, the selected inverse's worst relative error was 1e-16 to 1.3e-13
 // divided by the smallest ratio (a simulated push with C and S made stiff on purpose, ratios
 // 2e-3 to 3e-14; MIT ellip1 recordings at their full rate, about 3e-8, where 250 Hz steps make
-// V stiff: errors 1e-6 to 5e-6). Below kIllConditioned it could lose more than 4 digits: refuse
-// (the estimator then uses the QR); below kSingular the direction has no information of its own.
-constexpr double kIllConditioned = 1e-9;
+// V stiff: errors 1e-6 to 5e-6). Below 1e-9 (accepted_pivot_ratio_'s default) it could lose more
+// than 4 digits: refuse (the estimator then uses the QR); below kSingular the direction has no
+// information of its own.
 constexpr double kSingular = 1e-14;
 
 std::string FormatRatio(double ratio) {
@@ -147,6 +147,10 @@ bool SparseMarginals::Compute(ceres::Problem& problem) {
   return ok;
 }
 
+void SparseMarginals::set_accepted_pivot_ratio(double ratio) {
+  accepted_pivot_ratio_ = std::max(ratio, kSingular);
+}
+
 bool SparseMarginals::SelectedInverse(const Eigen::SparseMatrix<double>& L, const Eigen::VectorXd& h_diag,
                                       const std::vector<double*>& variable, Impl& impl_ref,
                                       std::chrono::steady_clock::time_point phase) {
@@ -167,7 +171,7 @@ bool SparseMarginals::SelectedInverse(const Eigen::SparseMatrix<double>& L, cons
     const double ratio = column.empty() || column.front().first != j
                              ? 0.0
                              : column.front().second * column.front().second / h_diag[j];
-    if (!(ratio > kIllConditioned) || !std::isfinite(h_diag[j]) || !(column.front().second > 0.0)) {
+    if (!(ratio > accepted_pivot_ratio_) || !std::isfinite(h_diag[j]) || !(column.front().second > 0.0)) {
       int a = 0;
       while (a < n && impl->perm[a] != j) ++a;
       for (double* b : variable) {
@@ -183,7 +187,8 @@ bool SparseMarginals::SelectedInverse(const Eigen::SparseMatrix<double>& L, cons
           } else {
             error_ = "the information matrix J^T J is ill-conditioned at a parameter block " + component +
                      ": pivot ratio " + FormatRatio(ratio) +
-                     " below 1e-9, the selected inverse could lose more than 4 digits (use a QR on J)";
+                     " below " + FormatRatio(accepted_pivot_ratio_) +
+                     ", the selected inverse could lose more than 4 digits (use a QR on J)";
           }
           break;
         }

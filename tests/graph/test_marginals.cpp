@@ -280,6 +280,16 @@ TEST(SparseMarginals, RefusesSingularProblemsAndEarlyQueries) {
   EXPECT_NEAR(m.Covariance(p1)(0, 0), 1.0 + 1e-6, 1e-9);  // Var(x0) + 1/w^2
   EXPECT_GT(m.min_pivot_ratio(), 1e-8);
   EXPECT_LT(m.min_pivot_ratio(), 1e-4);
+  // A user that needs fewer digits (the self-diagnosis' leverages) accepts the 1e5 link, with
+  // Var(x1) = 1 + 1e-10 right to about 1e-16 / 1e-10 = 1e-6; the 3e7 link stays singular.
+  SparseMarginals relaxed;
+  relaxed.set_accepted_pivot_ratio(1e-13);
+  ASSERT_TRUE(relaxed.Compute(conditioned)) << relaxed.error();
+  EXPECT_NEAR(relaxed.Covariance(p1)(0, 0), 1.0, 1e-5);
+  EXPECT_LT(relaxed.min_pivot_ratio(), 1e-9);
+  EXPECT_FALSE(relaxed.Compute(stiff));
+  relaxed.set_accepted_pivot_ratio(0.0);  // clamped to 1e-14
+  EXPECT_FALSE(relaxed.Compute(stiff));
 }
 
 // The push generator's 2 cm off-centre push.

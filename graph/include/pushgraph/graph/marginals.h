@@ -78,6 +78,10 @@ class SparseMarginals {
   /// information left after conditioning on the ones eliminated before it (1 for independent
   /// unknowns; small for nearly dependent directions, where J^T J loses digits).
   double min_pivot_ratio() const { return min_pivot_ratio_; }
+  /// The smallest pivot ratio Compute accepts (default 1e-9, about 4 digits kept; at least 1e-14,
+  /// below which a direction has no information of its own). A user that needs fewer digits
+  /// (the self-diagnosis' leverages) may accept more ill-conditioned problems.
+  void set_accepted_pivot_ratio(double ratio);
 
  private:
   struct Impl;
@@ -90,6 +94,7 @@ class SparseMarginals {
   const double* failed_block_ = nullptr;
   Timings timings_;
   double min_pivot_ratio_ = 0.0;
+  double accepted_pivot_ratio_ = 1e-9;
 };
 
 }  // namespace pushgraph::graph
