@@ -215,24 +215,19 @@ std::optional<push::Trajectory> DropForceSpikes(const push::Trajectory& traj, st
 EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model model, Mode mode,
                                    const EstimatorConfig& config);
 
-// The longest stretch of the trajectory without an object pose (an occluded camera), when it is
-// longer than max(3 object periods, 0.1 s): CP and SDF have no pushing model, so nothing moves
-// the object there but the finger's contact point, which may pass through it (a push occluded
-// from 20 % of its length on: CP object RMS 28 to 38 mm where QS had 1.3 to 3.2 mm).
+// The longest stretch of the trajectory without an object pose (up to the finger stream's end),
+// when it is a long gap (internal::LongObjectGap): CP and SDF have no pushing model, so nothing
+// moves the object there but the finger's contact point, which may pass through it (a push
+// occluded from 20 % of its length on: CP object RMS 28 to 38 mm where QS had 1.3 to 3.2 mm).
 std::optional<std::string> UnobservedObjectNote(const push::Trajectory& t, Model model) {
-  if (model == Model::kQs || model == Model::kYu) return std::nullopt;
+  const double min_gap = internal::LongObjectGap(t);
+  if (model == Model::kQs || model == Model::kYu || !std::isfinite(min_gap)) return std::nullopt;
   const auto& s = t.measured.object_pose;
-  if (s.size() < 2) return std::nullopt;
-  std::vector<double> periods;
-  for (std::size_t k = 1; k < s.size(); ++k) periods.push_back(s[k].t - s[k - 1].t);
-  std::vector<double> sorted = periods;
-  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-  const double min_gap = std::max(3.0 * sorted[sorted.size() / 2], 0.1);
   double end = s.back().t;
   for (const auto& f : t.measured.finger_pose) end = std::max(end, f.t);
   double gap = end - s.back().t, from = s.back().t;
-  for (std::size_t k = 0; k < periods.size(); ++k) {
-    if (periods[k] > gap) { gap = periods[k]; from = s[k].t; }
+  for (std::size_t k = 1; k < s.size(); ++k) {
+    if (s[k].t - s[k - 1].t > gap) { gap = s[k].t - s[k - 1].t; from = s[k - 1].t; }
   }
   if (gap <= min_gap) return std::nullopt;
   char text[400];
@@ -351,7 +346,8 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
     if (mode == Mode::kIncremental && !identity_wins) {
       EstimatorConfig converged = quick;
       converged.max_iterations = config.max_iterations;
-      framed_cost(best, &best, converged);
+      const ShapeTransform ranked = best;
+      framed_cost(ranked, &best, converged);
     }
     registration->transform = CanonicalTransform(best, trajectory.object.shape, registration->symmetry_order);
     if (identity_wins) {

@@ -707,13 +707,9 @@ int GraphBuilder::CarryObjectThroughGaps() {
   // step, had 1.3 to 3.2 mm). Gaps between two poses keep the linear interpolation: carrying
   // there too and blending onto the pose after the gap was worse on docs/results.md's occlusion
   // protocol (notched block QS 1.73 -> 2.29 mm).
-  const auto& samples = traj_.measured.object_pose;
   const int n = static_cast<int>(steps_.size());
-  if (samples.size() < 2 || n < 3) return 0;
-  std::vector<double> periods;
-  for (std::size_t k = 1; k < samples.size(); ++k) periods.push_back(samples[k].t - samples[k - 1].t);
-  std::nth_element(periods.begin(), periods.begin() + periods.size() / 2, periods.end());
-  const double min_gap = std::max(3.0 * periods[periods.size() / 2], 0.1);
+  const double min_gap = LongObjectGap(traj_);
+  if (n < 3 || !std::isfinite(min_gap)) return 0;
   // The translation of the first finger in contact over both steps j and k (none: the object rests).
   auto finger_move = [&](int j, int k) -> Vec2 {
     for (int f = 0; f <= other_fingers_; ++f) {

@@ -449,6 +449,9 @@ Diagnostics Diagnose(const push::Trajectory& trajectory, Model model, const Esti
 /// stream, sample and value): missing shapes or streams, NaN, unsupported magnitudes, unsorted
 /// samples, clock jumps within or between streams.
 void ValidateTrajectory(const push::Trajectory& trajectory);
+/// A gap in the object pose stream that counts as the object unobserved (an occluded camera):
+/// longer than max(3 median object periods, 0.1 s); INFINITY with fewer than two poses.
+double LongObjectGap(const push::Trajectory& trajectory);
 /// The finger count (at most two) and every finger's shape; ValidateTrajectory's first checks.
 void ValidateFingers(const push::Trajectory& trajectory);
 /// The 95th percentile of `values` (non-empty).

@@ -230,4 +230,10 @@ void ValidateTrajectory(const push::Trajectory& traj) {
   }
 }
 
+double LongObjectGap(const push::Trajectory& trajectory) {
+  const auto& poses = trajectory.measured.object_pose;
+  if (poses.size() < 2) return INFINITY;
+  return std::max(3.0 * MedianPeriod(poses), 0.1);
+}
+
 }  // namespace pushgraph::graph::internal
