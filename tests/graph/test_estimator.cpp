@@ -205,8 +205,12 @@ TEST(Estimator, MeasurementSigmasSetTheMeasurementFactors) {
 // A corrupted force byte (1e5 N in a 0.8 kg push) is a sensor fault: left out with a warning
 // naming it, so the estimate is the one without it (with it, LM chases the spike).
 TEST(Estimator, ForceSpikesAreLeftOutAsSensorFaults) {
-  push::Trajectory traj = GeneratePush(OffsetPush(4));
-  EstimatorConfig cfg = ApplyMeasurementSigmas(EstimatorConfig{}, *traj.measurement_sigmas);
+  const PushSpec spec = OffsetPush(4);
+  push::Trajectory traj = GeneratePush(spec);
+  // GeneratePush records no sigmas: this read an empty optional (and failed now and then).
+  const push::MeasurementSigmas sigmas{spec.sigma_object_trans, spec.sigma_object_rot, spec.sigma_finger_trans,
+                                       spec.sigma_finger_rot,   spec.sigma_contact,    spec.sigma_force};
+  EstimatorConfig cfg = ApplyMeasurementSigmas(EstimatorConfig{}, sigmas);
   cfg.covariance = false;
   cfg.diagnostics = false;
   const EstimationResult clean = Estimate(traj, Model::kQs, Mode::kBatch, cfg);
