@@ -5,8 +5,19 @@
 #include <exception>
 #include <iostream>
 
+#ifdef PUSHGRAPH_WITH_GRAPH
+#include <glog/logging.h>
+#endif
+
 int main(int argc, char** argv) {
   using namespace pushgraph::cli;
+#ifdef PUSHGRAPH_WITH_GRAPH
+  // Ceres logs through glog: warnings to stderr, no log files, and no "Logging before
+  // InitGoogleLogging()" line ahead of the first one.
+  FLAGS_logtostderr = true;
+  FLAGS_minloglevel = google::GLOG_WARNING;
+  google::InitGoogleLogging(argv[0]);
+#endif
   CLI::App app{"pushgraph: geometry-exact planar contact, limit surfaces and pushing estimation"};
   app.require_subcommand(1, 1);
   app.set_version_flag("--version", "pushgraph 0.1.0");
