@@ -138,6 +138,7 @@ std::string ResultToJson(const graph::EstimationResult& r, int indent) {
       shape["rotation_observable"] = a.rotation_observable;
       shape["refined_in_graph"] = a.refined;
     }
+    if (a.finger_radius) parameters["finger_radius"] = *a.finger_radius;
     if (!a.notes.empty()) shape["notes"] = a.notes;
     j["shape"] = std::move(shape);
   }

@@ -109,6 +109,10 @@ struct ShapeAlignment {
   Eigen::Vector3d sigma = Eigen::Vector3d::Zero();  ///< of (x, y, theta); theta 0 when unobservable
   bool rotation_observable = true;
   bool refined = false;  ///< refined as a static variable of the factor graph (batch)
+  /// The finger radius (m) the estimate used when it is not the given one: the shape did not
+  /// fit, and the shape as given with this finger fitted the whole graph clearly better than any
+  /// placement (a wrong probe radius or object size; align_shape "auto" only).
+  std::optional<double> finger_radius;
   std::vector<std::string> notes;  ///< registration's notes: symmetry, weak directions, ambiguity
 };
 
