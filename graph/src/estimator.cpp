@@ -457,6 +457,7 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
     } else if (align) {
       RegistrationResult final_transform = *registration;
       final_transform.transform = alignment.transform;
+      final_transform.sigma = alignment.sigma;
       std::string also;
       if (size_ties) {
         char size[220];
@@ -479,6 +480,7 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
   if (suspect && alignment.aligned) {
     RegistrationResult final_transform = *registration;
     final_transform.transform = alignment.transform;
+    final_transform.sigma = alignment.sigma;
     char text[200];
     std::snprintf(text, sizeof text,
                   "the object's shape fits this recording within the tolerance, but the contacts (log-likelihood +%.1f) "

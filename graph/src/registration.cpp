@@ -47,6 +47,12 @@ geometry::Shape RegistrationResult::Apply(const geometry::Shape& shape) const {
 std::string RegistrationResult::Describe() const {
   std::string s = Format("turned by %.1f deg, shifted by (%.1f, %.1f) mm", transform.pose.theta * 180.0 / kPi,
                          transform.pose.x * 1e3, transform.pose.y * 1e3);
+  // How sure: one push often leaves the position along its side to the centroid prior, and
+  // without the sigmas a placement 15 mm off read as exact.
+  if (sigma.x() > 0.0 || sigma.y() > 0.0) {
+    s += rotation_observable ? Format(" (sigma %.1f deg, %.1f and %.1f mm)", sigma.z() * 180.0 / kPi, sigma.x() * 1e3, sigma.y() * 1e3)
+                             : Format(" (sigma %.1f and %.1f mm)", sigma.x() * 1e3, sigma.y() * 1e3);
+  }
   if (transform.mirrored) s = "mirrored (y -> -y), " + s;
   if (transform.scale != 1.0) {
     s += Format(", scale %.6g", transform.scale);
