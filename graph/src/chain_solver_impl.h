@@ -74,11 +74,6 @@ struct ChainSolver::Impl {
   Eigen::VectorXd gradient, trial_gradient;
   Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> llt;
   bool analyzed = false;
-  // Scratch of Evaluate: one residual block's Jacobian, normal matrix and gradient, mapped onto
-  // buffers that only grow (an Eigen matrix resized to each block's size reallocated at almost
-  // every block: 5 % of a batch solve in malloc and free).
-  std::vector<double> local_jacobian, local_hessian, local_gradient;
-  std::vector<int> local_offset;
   Eigen::VectorXd x_evaluated;  // where `values` and `gradient` were computed
   bool evaluated_at_current = false;
 };
