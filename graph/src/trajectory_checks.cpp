@@ -82,6 +82,40 @@ void CheckNoClockJump(const std::vector<Sample>& s, const std::string& stream, d
   }
 }
 
+// Largest distance of a shape's core (its polygons) from its own origin (m).
+double CoreReach(const geometry::Shape& shape) {
+  double reach = 0.0;
+  for (const auto& polygon : shape.polygons()) {
+    for (const geometry::Vec2& v : polygon.outer) reach = std::max(reach, v.norm());
+  }
+  return reach;
+}
+
+// A rounded finger whose rounding radius exceeds every finger-object distance of the recording
+// plus both shapes' reach would hold the whole object inside it at every sample: its file is in
+// other units (a probe of radius 4.7 given in millimetres was read as 4.7 m, and the shape check
+// then "aligned" the object 4 m away). The object's own units the registration detects.
+void CheckFingerSize(const geometry::Shape& finger, const std::vector<push::PoseSample>& finger_pose,
+                     const std::vector<push::PoseSample>& object_pose, const geometry::Shape& object, const std::string& who) {
+  if (finger.radius() <= 0.0 || finger_pose.empty() || object_pose.empty()) return;
+  double farthest = 0.0;
+  std::size_t k = 0;
+  for (const push::PoseSample& f : finger_pose) {
+    while (k + 1 < object_pose.size() && std::abs(object_pose[k + 1].t - f.t) <= std::abs(object_pose[k].t - f.t)) ++k;
+    farthest = std::max(farthest, (f.pose.translation() - object_pose[k].pose.translation()).norm());
+  }
+  const double bound = farthest + CoreReach(finger) + CoreReach(object);
+  if (finger.radius() <= bound) return;
+  char text[600];
+  std::snprintf(text, sizeof text,
+                "trajectory: %sthe finger's radius %.6g m is larger than the whole push: the finger stays within %.3g m of "
+                "the object's origin and the object within %.3g m of it, so at every sample the finger would hold the whole "
+                "object inside it. Is the finger's shape file in millimetres? Shape files are in metres (pushgraph footprint "
+                "FILE --scale 0.001 converts one)",
+                who.c_str(), finger.radius(), farthest, CoreReach(object));
+  throw GraphError(text);
+}
+
 }  // namespace
 
 double Percentile95(std::vector<double> values) {
@@ -227,6 +261,11 @@ void ValidateTrajectory(const push::Trajectory& traj) {
   }
   if (m.finger_pose.empty()) {
     throw GraphError("trajectory: no finger pose measurements (streams.finger_pose is empty)");
+  }
+  CheckFingerSize(traj.finger.shape, m.finger_pose, m.object_pose, traj.object.shape, "");
+  for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k) {
+    CheckFingerSize(traj.extra_fingers[k].finger.shape, traj.extra_fingers[k].measured.finger_pose, m.object_pose,
+                    traj.object.shape, "fingers[" + std::to_string(k + 1) + "]: ");
   }
 }
 

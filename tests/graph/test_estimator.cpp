@@ -245,6 +245,15 @@ TEST(Estimator, BadTrajectoriesGetClearErrors) {
   auto no_shape = t;
   no_shape.finger.shape = geometry::Shape();
   EXPECT_NE(message(no_shape).find("finger.shape"), std::string::npos);
+  // A probe file in millimetres (radius 5 read as 5 m) would hold the object at every sample; the
+  // right radius (5 mm) passes, and so does a wrong one within the push's reach (0.1 m: the check
+  // is for units; the shape check and the self-diagnosis judge sizes).
+  for (const double radius : {5.0, 0.005, 0.1}) {
+    auto sized = t;
+    sized.finger.shape = geometry::Shape::Disk(radius);
+    const std::string m = message(sized);
+    EXPECT_EQ(m.find("Is the finger's shape file in millimetres?") != std::string::npos, radius == 5.0) << radius << ": " << m;
+  }
   // Clock jumps (a corrupted time stamp 1e9 s ahead) are refused at once in batch and
   // incremental alike, naming the stream and sample, instead of costing memory and time in
   // proportion to the jump.
