@@ -176,6 +176,25 @@ std::string TransformText(const ShapeTransform& t) {
   return s;
 }
 
+// "(to save it: pushgraph footprint SHAPE_FILE ...)". A file whose units (or mirror) were wrong
+// often comes back with a small turn and shift too, within their sigmas: saving those bakes an
+// error into the file that later recordings then accept (a rect1 mesh in millimetres came back
+// turned by 12 degrees, which the saved file kept), so the units alone are offered as well.
+std::string SaveAdvice(const ShapeTransform& t, const Eigen::Vector3d& sigma, bool rotation_observable) {
+  std::string s = "(to save it: pushgraph footprint SHAPE_FILE " + TransformText(t);
+  const bool units = t.scale != 1.0 || t.mirrored;
+  const bool turn_within = !rotation_observable || std::abs(t.pose.theta) <= 3.0 * sigma.z();
+  const bool shift_within = std::abs(t.pose.x) <= 3.0 * sigma.x() && std::abs(t.pose.y) <= 3.0 * sigma.y();
+  if (units && turn_within && shift_within) {
+    char scale[64] = "";
+    if (t.scale != 1.0) std::snprintf(scale, sizeof scale, "--scale %.6g", t.scale);
+    const std::string text = std::string(t.mirrored ? "--mirror" : "") + (t.mirrored && t.scale != 1.0 ? " " : "") + scale;
+    s += "; the turn and shift are within three sigmas of none: if the file's frame is otherwise right, "
+         "pushgraph footprint SHAPE_FILE " + text + " alone";
+  }
+  return s + ")";
+}
+
 }  // namespace
 
 namespace {
@@ -469,8 +488,8 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
                       sized_radius * 1e3);
         also = size;
       }
-      warnings.push_back(what + "; aligned it: " + final_transform.Describe() +
-                         " (to save it: pushgraph footprint SHAPE_FILE " + TransformText(alignment.transform) + ")" + also);
+      warnings.push_back(what + "; aligned it: " + final_transform.Describe() + " " +
+                         SaveAdvice(alignment.transform, alignment.sigma, alignment.rotation_observable) + also);
     } else if (misfit) {
       warnings.push_back(what + "; estimates may be worse than the raw measurements. The contacts suggest " +
                          registration->Describe() + ": --align-shape auto or on aligns it");
@@ -488,8 +507,8 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
                   "the object's shape fits this recording within the tolerance, but the contacts (log-likelihood +%.1f) "
                   "and the whole graph fit it clearly better elsewhere; aligned it: ",
                   registration->identity_cost - registration->aligned_cost);
-    warnings.push_back(text + final_transform.Describe() + " (to save it: pushgraph footprint SHAPE_FILE " +
-                       TransformText(alignment.transform) + ")");
+    warnings.push_back(text + final_transform.Describe() + " " +
+                       SaveAdvice(alignment.transform, alignment.sigma, alignment.rotation_observable));
   }
   if (registration && registration->fits_as_given && registration->better_elsewhere && !alignment.aligned) {
     // The gaps are within tolerance, but a different placement explains the contacts clearly
