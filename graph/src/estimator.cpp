@@ -306,6 +306,7 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
   const bool size_candidate = misfit && sized_radius > 0.0 &&
                               std::abs(registration->size_offset) <= std::max(5e-3, 3.0 * finger.radius());
   bool size_wins = false, size_ties = false, identity_wins = false;
+  double size_cost = 0.0, placement_cost = 0.0;  // the graph's, when a size candidate ran
   constexpr double kTieMargin = 2.0;  // in cost (a log-likelihood)
   // Within the gap tolerance, but one placement (not several alike) fits the contacts clearly
   // better: the whole graph decides that too, the shape as given winning ties. (A rect1
@@ -391,7 +392,12 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
       // outline to where the contacts are, which on one push absorbs most of a size error too)
       // and the warning names both.
       size_wins = sized_cost < best_cost - (identity_wins ? 0.0 : kTieMargin);
-      size_ties = !identity_wins && !size_wins && sized_cost < best_cost + kTieMargin;
+      // Named beside the placement also where the contacts alone cannot tell the two apart (one
+      // side of a block: a shift along its normal is a size change): a 1 mm probe given for the
+      // 4.7 mm one was aligned by 4 mm shifts on rect1 recordings and the radius never named.
+      size_ties = !identity_wins && !size_wins && (sized_cost < best_cost + kTieMargin || registration->size_explains);
+      size_cost = sized_cost;
+      placement_cost = best_cost;
       std::snprintf(text, sizeof text, "frame or size: graph cost %.1f with the shape %s, %.1f with the finger %.1f mm %s",
                     identity_wins ? best_cost + kTieMargin : best_cost, identity_wins ? "as given" : "aligned", sized_cost,
                     std::abs(registration->size_offset) * 1e3, registration->size_offset > 0 ? "larger" : "smaller");
@@ -481,11 +487,11 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
       final_transform.sigma = alignment.sigma;
       std::string also;
       if (size_ties) {
-        char size[220];
-        std::snprintf(size, sizeof size, "; the shape as given with the finger %.1f mm %s (radius %.1f mm) fits the whole "
-                      "recording as well: if the shape file's frame is right, check the probe radius and the object's size",
-                      std::abs(registration->size_offset) * 1e3, registration->size_offset > 0 ? "larger" : "smaller",
-                      sized_radius * 1e3);
+        char size[360];
+        std::snprintf(size, sizeof size, "; the shape as given with the finger %.1f mm %s (radius %.1f mm) explains the "
+                      "contacts about as well (whole-graph cost %.1f against %.1f aligned): if the shape file's frame is right, "
+                      "check the probe radius and the object's size", std::abs(registration->size_offset) * 1e3,
+                      registration->size_offset > 0 ? "larger" : "smaller", sized_radius * 1e3, size_cost, placement_cost);
         also = size;
       }
       warnings.push_back(what + "; aligned it: " + final_transform.Describe() + " " +

@@ -285,6 +285,23 @@ TEST_F(EstimateCli, AMeshInMillimetresIsOfferedItsUnitsAlone) {
   EXPECT_NE(r.err.find("pushgraph footprint SHAPE_FILE --scale 0.001 alone"), std::string::npos) << r.err;
 }
 
+// A 1 mm probe given for the 4.7 mm one, on a rect1 recording: one side's contacts cannot tell a
+// shift of the block along its normal from a larger finger, and the graph takes the placement
+// (by 2.8 in cost). The warning said "aligned it" and nothing of the radius; now it names both.
+TEST_F(EstimateCli, AProbeTooSmallIsNamedBesideThePlacement) {
+  const std::string shared = std::string(PUSHGRAPH_SHARED_DIR) + "/data/mit-push/";
+  const std::string h5 = shared + "abs/rect1/motion_surface=abs_shape=rect1_a=0_v=75_i=2.000_s=0.800_t=0.000.h5";
+  if (!std::ifstream(h5)) GTEST_SKIP() << "no MIT data at " << shared;
+  const std::string shape = dir() + "/rect1_small.json", tip = dir() + "/tip_1mm.json";
+  ASSERT_EQ(Tool("footprint " + shared + "obj/rect1.obj -o " + shape).status, 0);
+  std::ofstream(tip) << R"({"polygons": [{"outer": [[0, 0]]}], "radius": 0.001})";
+  const pushgraph::testing::ToolRun r = Tool("estimate '" + h5 + "' --object " + shape + " --finger " + tip +
+                                             " --mass 0.8374 --mu 0.35 --add-noise gaussian -o " + dir() + "/small.json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("explains the contacts about as well"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("check the probe radius"), std::string::npos) << r.err;
+}
+
 // A 9 mm probe given for the 4.7 mm one: on two ellip1 recordings the whole graph prefers the
 // finger 3.5 and 4.4 mm smaller to any placement by 8 and 5 in cost. Estimated with the probe as
 // given, against a shape it does not touch, they were 1.49 and 2.50 mm off; with the preferred
