@@ -39,6 +39,24 @@ class EstimateCli : public pushgraph::testing::ToolTest {
     io::SaveTrajectoryJson(testing::GeneratePush(s), path);
     return path;
   }
+  // The MIT sample (../shared), or "" when it is not there.
+  static std::string Mit() {
+    const std::string shared = std::string(PUSHGRAPH_SHARED_DIR) + "/data/mit-push/";
+    return std::ifstream(shared + "obj/rect1.obj") ? shared : "";
+  }
+  // A dataset mesh through `pushgraph footprint MESH FOOTPRINT_ARGS` (the user's file), and a
+  // probe of `radius` metres; returns the estimate's run on `h5` with the paper's noise, RESULT.json at `out`.
+  pushgraph::testing::ToolRun EstimateMit(const std::string& h5, const std::string& mesh, const std::string& footprint_args,
+                                          double radius, double mass, const std::string& out) {
+    const std::string shape = dir() + "/user_shape.json", tip = dir() + "/user_probe.json";
+    const pushgraph::testing::ToolRun f = Tool("footprint " + Mit() + "obj/" + mesh + " " + footprint_args + " -o " + shape);
+    if (f.status != 0) return f;
+    std::ofstream(tip) << R"({"polygons": [{"outer": [[0, 0]]}], "radius": )" << radius << "}";
+    char args[64];
+    std::snprintf(args, sizeof args, " --mass %g --mu 0.35", mass);
+    return Tool("estimate '" + h5 + "' --object " + shape + " --finger " + tip + args + " --add-noise gaussian -o " + out);
+  }
+  static constexpr double kRect1Mass = 0.8374, kEllip1Mass = 0.8937, kProbe = 0.0047;
 };
 
 TEST_F(EstimateCli, WritesTheResultFormatForEveryModelAndMode) {
@@ -246,16 +264,12 @@ TEST_F(EstimateCli, AWrongMassWithoutAForceStreamIsNamed) {
 // to "the finger 9.3 / 4.3 mm larger", 5.54 and 2.43 mm), and a misfit hidden within the gap
 // tolerance was only suspected (1.73 mm). The mesh as shipped gives 1.09 to 1.23 mm there.
 TEST_F(EstimateCli, AMeshTurnedBy37DegreesIsAligned) {
-  const std::string shared = std::string(PUSHGRAPH_SHARED_DIR) + "/data/mit-push/";
-  const std::string prefix = shared + "abs/rect1/motion_surface=abs_shape=rect1_a=0_v=75_i=2.000_s=0.800_t=";
-  if (!std::ifstream(prefix + "0.000.h5")) GTEST_SKIP() << "no MIT data at " << shared;
-  const std::string shape = dir() + "/rect1_turned.json", tip = dir() + "/tip_turned.json";
-  ASSERT_EQ(Tool("footprint " + shared + "obj/rect1.obj --transform 0,0,0.6458 -o " + shape).status, 0);
-  std::ofstream(tip) << R"({"polygons": [{"outer": [[0, 0]]}], "radius": 0.0047})";
+  if (Mit().empty()) GTEST_SKIP() << "no MIT data";
+  const std::string prefix = Mit() + "abs/rect1/motion_surface=abs_shape=rect1_a=0_v=75_i=2.000_s=0.800_t=";
   for (const char* t : {"-1.396", "0.000", "0.349"}) {
     const std::string out = dir() + "/turned_" + t + ".json";
-    const pushgraph::testing::ToolRun r = Tool("estimate '" + prefix + t + ".h5' --object " + shape + " --finger " + tip +
-                                               " --mass 0.8374 --mu 0.35 --add-noise gaussian -o " + out);
+    const pushgraph::testing::ToolRun r =
+        EstimateMit(prefix + t + ".h5", "rect1.obj", "--transform 0,0,0.6458", kProbe, kRect1Mass, out);
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.err.find("aligned it"), std::string::npos) << t << ": " << r.err;
     EXPECT_EQ(r.err.find("alone)"), std::string::npos) << t << ": a turn of 37 degrees is no units error: " << r.err;
@@ -272,14 +286,9 @@ TEST_F(EstimateCli, AMeshTurnedBy37DegreesIsAligned) {
 // of none, and saving it would bake the turn into the file (later recordings then accepted it:
 // 1.69 against 1.23 mm), so the units alone are offered too.
 TEST_F(EstimateCli, AMeshInMillimetresIsOfferedItsUnitsAlone) {
-  const std::string shared = std::string(PUSHGRAPH_SHARED_DIR) + "/data/mit-push/";
-  const std::string h5 = shared + "abs/rect1/motion_surface=abs_shape=rect1_a=0_v=75_i=2.000_s=0.800_t=0.000.h5";
-  if (!std::ifstream(h5)) GTEST_SKIP() << "no MIT data at " << shared;
-  const std::string shape = dir() + "/rect1_mm.json", tip = dir() + "/tip_mm.json";
-  ASSERT_EQ(Tool("footprint " + shared + "obj/rect1.obj --scale 1000 -o " + shape).status, 0);
-  std::ofstream(tip) << R"({"polygons": [{"outer": [[0, 0]]}], "radius": 0.0047})";
-  const pushgraph::testing::ToolRun r = Tool("estimate '" + h5 + "' --object " + shape + " --finger " + tip +
-                                             " --mass 0.8374 --mu 0.35 --add-noise gaussian -o " + dir() + "/mm.json");
+  if (Mit().empty()) GTEST_SKIP() << "no MIT data";
+  const std::string h5 = Mit() + "abs/rect1/motion_surface=abs_shape=rect1_a=0_v=75_i=2.000_s=0.800_t=0.000.h5";
+  const pushgraph::testing::ToolRun r = EstimateMit(h5, "rect1.obj", "--scale 1000", kProbe, kRect1Mass, dir() + "/mm.json");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("the file is in millimetres"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("pushgraph footprint SHAPE_FILE --scale 0.001 alone"), std::string::npos) << r.err;
@@ -289,14 +298,9 @@ TEST_F(EstimateCli, AMeshInMillimetresIsOfferedItsUnitsAlone) {
 // shift of the block along its normal from a larger finger, and the graph takes the placement
 // (by 2.8 in cost). The warning said "aligned it" and nothing of the radius; now it names both.
 TEST_F(EstimateCli, AProbeTooSmallIsNamedBesideThePlacement) {
-  const std::string shared = std::string(PUSHGRAPH_SHARED_DIR) + "/data/mit-push/";
-  const std::string h5 = shared + "abs/rect1/motion_surface=abs_shape=rect1_a=0_v=75_i=2.000_s=0.800_t=0.000.h5";
-  if (!std::ifstream(h5)) GTEST_SKIP() << "no MIT data at " << shared;
-  const std::string shape = dir() + "/rect1_small.json", tip = dir() + "/tip_1mm.json";
-  ASSERT_EQ(Tool("footprint " + shared + "obj/rect1.obj -o " + shape).status, 0);
-  std::ofstream(tip) << R"({"polygons": [{"outer": [[0, 0]]}], "radius": 0.001})";
-  const pushgraph::testing::ToolRun r = Tool("estimate '" + h5 + "' --object " + shape + " --finger " + tip +
-                                             " --mass 0.8374 --mu 0.35 --add-noise gaussian -o " + dir() + "/small.json");
+  if (Mit().empty()) GTEST_SKIP() << "no MIT data";
+  const std::string h5 = Mit() + "abs/rect1/motion_surface=abs_shape=rect1_a=0_v=75_i=2.000_s=0.800_t=0.000.h5";
+  const pushgraph::testing::ToolRun r = EstimateMit(h5, "rect1.obj", "", 0.001, kRect1Mass, dir() + "/small.json");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("explains the contacts about as well"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("check the probe radius"), std::string::npos) << r.err;
@@ -308,26 +312,22 @@ TEST_F(EstimateCli, AProbeTooSmallIsNamedBesideThePlacement) {
 // radius 0.88 and 0.96 mm (with the right probe 1.13 and 0.97 mm). On other recordings a
 // placement wins (the contacts of one push cannot tell a shift from a size), also near 1 mm.
 TEST_F(EstimateCli, AFingerSizeTheGraphPrefersIsUsedAndNamed) {
-  const std::string shared = std::string(PUSHGRAPH_SHARED_DIR) + "/data/mit-push/";
-  const std::string dir_ellip = shared + "abs/ellip1/motion_surface=abs_shape=ellip1_a=0_v=";
-  if (!std::ifstream(dir_ellip + "100_i=0.000_s=0.075_t=0.349.h5")) GTEST_SKIP() << "no MIT data at " << shared;
-  const std::string shape = dir() + "/ellip1.json", tip = dir() + "/tip_9mm.json";
-  ASSERT_EQ(Tool("footprint " + shared + "obj/ellip1.obj -o " + shape).status, 0);
-  std::ofstream(tip) << R"({"polygons": [{"outer": [[0, 0]]}], "radius": 0.009})";
+  if (Mit().empty()) GTEST_SKIP() << "no MIT data";
   for (const char* rec : {"100_i=0.000_s=0.075_t=0.000.h5", "100_i=0.000_s=0.075_t=0.349.h5"}) {
     const std::string out = dir() + "/sized.json";
-    const pushgraph::testing::ToolRun r = Tool("estimate '" + dir_ellip + rec + "' --object " + shape + " --finger " + tip +
-                                               " --mass 0.8937 --mu 0.35 --add-noise gaussian -o " + out);
+    const pushgraph::testing::ToolRun r = EstimateMit(Mit() + "abs/ellip1/motion_surface=abs_shape=ellip1_a=0_v=" + rec,
+                                                      "ellip1.obj", "", 0.009, kEllip1Mass, out);
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.err.find("a wrong probe radius or object size? Estimated with that radius"), std::string::npos) << r.err;
     const nlohmann::json j = Load(out);
     ASSERT_TRUE(j["parameters"].contains("finger_radius")) << rec;
     const double radius = j["parameters"]["finger_radius"].get<double>(), rms = j["metrics"]["object_position_rms"].get<double>();
     std::printf("[registration] ellip1 with a 9 mm probe: radius used %.2f mm, object RMS %.2f mm\n", radius * 1e3, rms * 1e3);
-    EXPECT_NEAR(radius, 0.0047, 1.2e-3) << rec;  // 5.49 and 4.60 mm
+    EXPECT_NEAR(radius, kProbe, 1.2e-3) << rec;  // 5.49 and 4.60 mm
     EXPECT_LT(rms, 1.3e-3) << rec;
   }
 }
+
 
 // An MIT recording (HDF5) read directly: trimmed to contact, time stamps kept (unix seconds),
 // the paper's noise added with the clean recording as ground truth, and a picture.
