@@ -531,7 +531,17 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
   if (config.diagnostics) {
     result.diagnostics =
         internal::Diagnose(*working, model, config, result, frame_state ? &*frame_state : nullptr, querier);
-    for (const std::string& cause : result.diagnostics->causes) warnings.push_back("diagnostics: " + cause);
+    // With a misfit left in place (align_shape "off", or no placement won) the measured gap is the
+    // frame's or the units' as much as the probe's: a mesh in millimetres estimated as given was
+    // told "a finger radius 5748.5 mm smaller would touch".
+    const bool frame_left_off = alignment.checked && !alignment.check.fits && !alignment.aligned && !size_wins;
+    for (const std::string& cause : result.diagnostics->causes) {
+      const bool radius = cause.rfind("wrong probe radius or object size", 0) == 0;
+      warnings.push_back("diagnostics: " + cause +
+                         (radius && frame_left_off ? " (or the shape file's frame or units, which the shape check above "
+                                                     "found off: fix those first)"
+                                                   : ""));
+    }
   }
   result.warnings.insert(result.warnings.begin(), warnings.begin(), warnings.end());
   return result;

@@ -45,16 +45,19 @@ class EstimateCli : public pushgraph::testing::ToolTest {
     return std::ifstream(shared + "obj/rect1.obj") ? shared : "";
   }
   // A dataset mesh through `pushgraph footprint MESH FOOTPRINT_ARGS` (the user's file), and a
-  // probe of `radius` metres; returns the estimate's run on `h5` with the paper's noise, RESULT.json at `out`.
+  // probe of `radius` metres; returns the estimate's run on `h5` with the paper's noise (and
+  // `extra_args`), RESULT.json at `out`.
   pushgraph::testing::ToolRun EstimateMit(const std::string& h5, const std::string& mesh, const std::string& footprint_args,
-                                          double radius, double mass, const std::string& out) {
+                                          double radius, double mass, const std::string& out,
+                                          const std::string& extra_args = "") {
     const std::string shape = dir() + "/user_shape.json", tip = dir() + "/user_probe.json";
     const pushgraph::testing::ToolRun f = Tool("footprint " + Mit() + "obj/" + mesh + " " + footprint_args + " -o " + shape);
     if (f.status != 0) return f;
     std::ofstream(tip) << R"({"polygons": [{"outer": [[0, 0]]}], "radius": )" << radius << "}";
     char args[64];
     std::snprintf(args, sizeof args, " --mass %g --mu 0.35", mass);
-    return Tool("estimate '" + h5 + "' --object " + shape + " --finger " + tip + args + " --add-noise gaussian -o " + out);
+    return Tool("estimate '" + h5 + "' --object " + shape + " --finger " + tip + args + " --add-noise gaussian -o " + out +
+                " " + extra_args);
   }
   static constexpr double kRect1Mass = 0.8374, kEllip1Mass = 0.8937, kProbe = 0.0047;
 };
@@ -292,6 +295,13 @@ TEST_F(EstimateCli, AMeshInMillimetresIsOfferedItsUnitsAlone) {
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("the file is in millimetres"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("pushgraph footprint SHAPE_FILE --scale 0.001 alone"), std::string::npos) << r.err;
+  // Estimated as given (alignment off), the self-diagnosis' gap of 5748.5 mm was put on the probe
+  // alone ("a finger radius 5748.5 mm smaller would touch"); it now points at the shape check's finding.
+  const pushgraph::testing::ToolRun off =
+      EstimateMit(h5, "rect1.obj", "--scale 1000", kProbe, kRect1Mass, dir() + "/mm_off.json", "--align-shape off");
+  ASSERT_EQ(off.status, 0) << off.err;
+  EXPECT_NE(off.err.find("the file is in millimetres"), std::string::npos) << off.err;
+  EXPECT_NE(off.err.find("which the shape check above found off: fix those first"), std::string::npos) << off.err;
 }
 
 // A 1 mm probe given for the 4.7 mm one, on a rect1 recording: one side's contacts cannot tell a
