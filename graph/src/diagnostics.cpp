@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <optional>
 #include <set>
 
 namespace pushgraph::graph::internal {
@@ -284,6 +285,12 @@ Diagnostics Diagnose(const push::Trajectory& traj, Model model, const EstimatorC
   for (const SensorFault& fault : d.faults) {
     d.causes.push_back(fault.kind == "frozen" ? "frozen sensor: " + fault.detail : "spiking sensor: " + fault.detail);
   }
+  // With a misfit the shape check left in place (align_shape "off", or no placement won and no
+  // finger size used) the gap is the shape file's frame or units as much as the probe's: a mesh
+  // in millimetres estimated as given was told "a finger radius 5748.5 mm smaller would touch".
+  const std::optional<ShapeAlignment>& shape = result.shape_alignment;
+  const bool misfit_left = shape && shape->checked && !shape->check.fits && !shape->aligned && !shape->finger_radius;
+  const char* misfit_note = " (or the shape file's frame or units: the shape check above found the shape as given off)";
   // Beyond 1 mm and three standard errors of the median (1.25 sigma / sqrt(n)).
   auto wrong_size = [&](int finger, double median, double mad, int samples) {
     const double median_error = 1.25 * 1.4826 * mad / std::sqrt(std::max(1, samples));
@@ -291,9 +298,9 @@ Diagnostics Diagnose(const push::Trajectory& traj, Model model, const EstimatorC
     const std::string who = finger == 0 ? "finger" : "finger " + std::to_string(finger);
     const std::string whose = finger == 0 ? "a finger" : who + "'s";
     d.causes.push_back(Format("wrong probe radius or object size: during contact the measured %s stays %.1f mm %s the "
-                              "object's surface (median over %d samples); %s radius %.1f mm %s would touch",
+                              "object's surface (median over %d samples); %s radius %.1f mm %s would touch%s",
                               who.c_str(), std::abs(median) * 1e3, median > 0 ? "off" : "inside", samples, whose.c_str(),
-                              std::abs(median) * 1e3, median > 0 ? "larger" : "smaller"));
+                              std::abs(median) * 1e3, median > 0 ? "larger" : "smaller", misfit_left ? misfit_note : ""));
   };
   wrong_size(0, d.measured_gap_median, d.measured_gap_mad, d.measured_samples);
   for (std::size_t k = 0; k < d.other_finger_gaps.size(); ++k) {

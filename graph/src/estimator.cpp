@@ -164,33 +164,42 @@ EstimationResult EstimateBatch(const push::Trajectory& traj, Model model, const 
 
 namespace {
 
-std::string TransformText(const ShapeTransform& t) {
-  char buf[128];
-  std::snprintf(buf, sizeof buf, "%.6g,%.6g,%.6g", t.pose.x, t.pose.y, t.pose.theta);
-  std::string s = std::string("--transform ") + buf;
+// `pushgraph footprint` options for a file's units and mirror ("--mirror --scale 0.001"; empty
+// when neither), and with the placement after them.
+std::string UnitsText(const ShapeTransform& t) {
+  std::string s = t.mirrored ? "--mirror" : "";
   if (t.scale != 1.0) {
-    std::snprintf(buf, sizeof buf, "%.6g", t.scale);
-    s = std::string("--scale ") + buf + " " + s;
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "--scale %.6g", t.scale);
+    s += (s.empty() ? "" : " ") + std::string(buf);
   }
-  if (t.mirrored) s = "--mirror " + s;
   return s;
 }
 
-// "(to save it: pushgraph footprint SHAPE_FILE ...)". A file whose units (or mirror) were wrong
-// often comes back with a small turn and shift too, within their sigmas: saving those bakes an
-// error into the file that later recordings then accept (a rect1 mesh in millimetres came back
-// turned by 12 degrees, which the saved file kept), so the units alone are offered as well.
-std::string SaveAdvice(const ShapeTransform& t, const Eigen::Vector3d& sigma, bool rotation_observable) {
-  std::string s = "(to save it: pushgraph footprint SHAPE_FILE " + TransformText(t);
-  const bool units = t.scale != 1.0 || t.mirrored;
-  const bool turn_within = !rotation_observable || std::abs(t.pose.theta) <= 3.0 * sigma.z();
+std::string TransformText(const ShapeTransform& t) {
+  char buf[128];
+  std::snprintf(buf, sizeof buf, "--transform %.6g,%.6g,%.6g", t.pose.x, t.pose.y, t.pose.theta);
+  const std::string units = UnitsText(t);
+  return units.empty() ? buf : units + " " + buf;
+}
+
+// "aligned it: turned by ... (to save it: pushgraph footprint SHAPE_FILE ...)". A file whose
+// units (or mirror) were wrong often comes back with a small turn and shift too, within their
+// sigmas: saving those bakes an error into the file that later recordings then accept (a rect1
+// mesh in millimetres came back turned by 12 degrees, which the saved file kept), so the units
+// alone are offered as well.
+std::string AlignedText(const RegistrationResult& registration, const ShapeAlignment& alignment) {
+  RegistrationResult final_transform = registration;
+  final_transform.transform = alignment.transform;
+  final_transform.sigma = alignment.sigma;
+  const ShapeTransform& t = alignment.transform;
+  const Eigen::Vector3d& sigma = alignment.sigma;
+  std::string s = "aligned it: " + final_transform.Describe() + " (to save it: pushgraph footprint SHAPE_FILE " + TransformText(t);
+  const bool turn_within = !alignment.rotation_observable || std::abs(t.pose.theta) <= 3.0 * sigma.z();
   const bool shift_within = std::abs(t.pose.x) <= 3.0 * sigma.x() && std::abs(t.pose.y) <= 3.0 * sigma.y();
-  if (units && turn_within && shift_within) {
-    char scale[64] = "";
-    if (t.scale != 1.0) std::snprintf(scale, sizeof scale, "--scale %.6g", t.scale);
-    const std::string text = std::string(t.mirrored ? "--mirror" : "") + (t.mirrored && t.scale != 1.0 ? " " : "") + scale;
+  if (!UnitsText(t).empty() && turn_within && shift_within) {
     s += "; the turn and shift are within three sigmas of none: if the file's frame is otherwise right, "
-         "pushgraph footprint SHAPE_FILE " + text + " alone";
+         "pushgraph footprint SHAPE_FILE " + UnitsText(t) + " alone";
   }
   return s + ")";
 }
@@ -482,9 +491,6 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
                                    "keeps the finger as given)"
                                  : "(the estimate uses the finger as given)"));
     } else if (align) {
-      RegistrationResult final_transform = *registration;
-      final_transform.transform = alignment.transform;
-      final_transform.sigma = alignment.sigma;
       std::string also;
       if (size_ties) {
         char size[360];
@@ -494,8 +500,7 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
                       registration->size_offset > 0 ? "larger" : "smaller", sized_radius * 1e3, size_cost, placement_cost);
         also = size;
       }
-      warnings.push_back(what + "; aligned it: " + final_transform.Describe() + " " +
-                         SaveAdvice(alignment.transform, alignment.sigma, alignment.rotation_observable) + also);
+      warnings.push_back(what + "; " + AlignedText(*registration, alignment) + also);
     } else if (misfit) {
       warnings.push_back(what + "; estimates may be worse than the raw measurements. The contacts suggest " +
                          registration->Describe() + ": --align-shape auto or on aligns it");
@@ -505,16 +510,12 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
   }
 
   if (suspect && alignment.aligned) {
-    RegistrationResult final_transform = *registration;
-    final_transform.transform = alignment.transform;
-    final_transform.sigma = alignment.sigma;
     char text[200];
     std::snprintf(text, sizeof text,
                   "the object's shape fits this recording within the tolerance, but the contacts (log-likelihood +%.1f) "
-                  "and the whole graph fit it clearly better elsewhere; aligned it: ",
+                  "and the whole graph fit it clearly better elsewhere; ",
                   registration->identity_cost - registration->aligned_cost);
-    warnings.push_back(text + final_transform.Describe() + " " +
-                       SaveAdvice(alignment.transform, alignment.sigma, alignment.rotation_observable));
+    warnings.push_back(text + AlignedText(*registration, alignment));
   }
   if (registration && registration->fits_as_given && registration->better_elsewhere && !alignment.aligned) {
     // The gaps are within tolerance, but a different placement explains the contacts clearly
@@ -531,17 +532,7 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
   if (config.diagnostics) {
     result.diagnostics =
         internal::Diagnose(*working, model, config, result, frame_state ? &*frame_state : nullptr, querier);
-    // With a misfit left in place (align_shape "off", or no placement won) the measured gap is the
-    // frame's or the units' as much as the probe's: a mesh in millimetres estimated as given was
-    // told "a finger radius 5748.5 mm smaller would touch".
-    const bool frame_left_off = alignment.checked && !alignment.check.fits && !alignment.aligned && !size_wins;
-    for (const std::string& cause : result.diagnostics->causes) {
-      const bool radius = cause.rfind("wrong probe radius or object size", 0) == 0;
-      warnings.push_back("diagnostics: " + cause +
-                         (radius && frame_left_off ? " (or the shape file's frame or units, which the shape check above "
-                                                     "found off: fix those first)"
-                                                   : ""));
-    }
+    for (const std::string& cause : result.diagnostics->causes) warnings.push_back("diagnostics: " + cause);
   }
   result.warnings.insert(result.warnings.begin(), warnings.begin(), warnings.end());
   return result;

@@ -4,6 +4,7 @@
 #include "graph_builder.h"
 #include "text.h"
 
+#include <pushgraph/geometry/shape.h>
 #include <pushgraph/geometry/shape_pair.h>
 
 #include <algorithm>
@@ -82,15 +83,6 @@ void CheckNoClockJump(const std::vector<Sample>& s, const std::string& stream, d
   }
 }
 
-// Largest distance of a shape's core (its polygons) from its own origin (m).
-double CoreReach(const geometry::Shape& shape) {
-  double reach = 0.0;
-  for (const auto& polygon : shape.polygons()) {
-    for (const geometry::Vec2& v : polygon.outer) reach = std::max(reach, v.norm());
-  }
-  return reach;
-}
-
 // A rounded finger whose rounding radius exceeds every finger-object distance of the recording
 // plus both shapes' reach would hold the whole object inside it at every sample: its file is in
 // other units (a probe of radius 4.7 given in millimetres was read as 4.7 m, and the shape check
@@ -104,7 +96,10 @@ void CheckFingerSize(const geometry::Shape& finger, const std::vector<push::Pose
     while (k + 1 < object_pose.size() && std::abs(object_pose[k + 1].t - f.t) <= std::abs(object_pose[k].t - f.t)) ++k;
     farthest = std::max(farthest, (f.pose.translation() - object_pose[k].pose.translation()).norm());
   }
-  const double bound = farthest + CoreReach(finger) + CoreReach(object);
+  // The finger's core (its radius aside) and the object reach this far from their origins.
+  const double finger_core = geometry::RadiusAbout(finger, geometry::Vec2::Zero()) - finger.radius();
+  const double object_reach = geometry::RadiusAbout(object, geometry::Vec2::Zero());
+  const double bound = farthest + finger_core + object_reach;
   if (finger.radius() <= bound) return;
   char text[600];
   std::snprintf(text, sizeof text,
@@ -112,7 +107,7 @@ void CheckFingerSize(const geometry::Shape& finger, const std::vector<push::Pose
                 "the object's origin and the object within %.3g m of it, so at every sample the finger would hold the whole "
                 "object inside it. Is the finger's shape file in millimetres? Shape files are in metres (pushgraph footprint "
                 "FILE --scale 0.001 converts one)",
-                who.c_str(), finger.radius(), farthest, CoreReach(object));
+                who.c_str(), finger.radius(), farthest, object_reach);
   throw GraphError(text);
 }
 
