@@ -5,7 +5,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ccache
   libcgal-dev libgmp-dev libmpfr-dev libeigen3-dev libboost-dev
-  libceres-dev libsuitesparse-dev
+  libceres-dev libsuitesparse-dev liblapack-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libtinyobjloader-dev nlohmann-json3-dev libcli11-dev libhdf5-dev
   python3  # scripts/check-docs.py, run by the docs tests

@@ -11,15 +11,28 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 #include <limits>
 #include <numeric>
 #include <unordered_map>
 #include <unordered_set>
 
+// LAPACK's banded Cholesky (Fortran ABI; the reference LAPACK and every optimized one export it).
+extern "C" {
+void dpbtrf_(const char* uplo, const int* n, const int* kd, double* ab, const int* ldab, int* info);
+void dpbtrs_(const char* uplo, const int* n, const int* kd, const int* nrhs, const double* ab, const int* ldab, double* b,
+             const int* ldb, int* info);
+}
+
 namespace pushgraph::graph {
 
 namespace {
+
+// The banded factorization is used while its flops (n kd^2) stay within this many times the
+// sparse one's estimate (n times the mean column count squared): at 1000 QS steps kd is 29 and
+// the band's 8.4 Mflop take 1.8 ms against Eigen's 2.2 ms for 3 Mflop.
+constexpr double kMaxBandWidth = 64;
 
 // A hint to load the cache line at p (GCC and Clang; nothing elsewhere).
 inline void PrefetchForRead(const void* p) {
@@ -156,6 +169,20 @@ ChainSolver::Impl::Impl(ceres::Problem& p) : problem(&p) {
   }
   values.assign(H.nonZeros(), 0.0);
   trial_values.assign(H.nonZeros(), 0.0);
+  for (int j = 0; j < n; ++j) {
+    const int last = H.outerIndexPtr()[j + 1] - 1;
+    if (last >= H.outerIndexPtr()[j]) band_width = std::max(band_width, H.innerIndexPtr()[last] - j);
+  }
+  const char* band_env = std::getenv("PUSHGRAPH_BAND");
+  banded = band_width <= kMaxBandWidth && !(band_env && band_env[0] == '0');
+  if (banded) {
+    band_index.resize(H.nonZeros());
+    const int ld = band_width + 1;
+    for (int j = 0; j < n; ++j) {
+      for (int k = H.outerIndexPtr()[j]; k < H.outerIndexPtr()[j + 1]; ++k) band_index[k] = j * ld + (H.innerIndexPtr()[k] - j);
+    }
+    band.assign(static_cast<std::size_t>(ld) * n, 0.0);
+  }
   gradient = Eigen::VectorXd::Zero(n);
   trial_gradient = Eigen::VectorXd::Zero(n);
 }
@@ -309,6 +336,31 @@ bool ChainSolver::Impl::Factorize(const std::vector<double>& h, double lambda) {
   return llt.info() == Eigen::Success;
 }
 
+bool ChainSolver::Impl::FactorizeIteration(const std::vector<double>& h, double lambda) {
+  if (!banded) return Factorize(h, lambda);
+  std::fill(band.begin(), band.end(), 0.0);
+  for (std::size_t k = 0; k < h.size(); ++k) band[band_index[k]] = h[k];
+  const int ld = band_width + 1;
+  if (lambda > 0.0) {
+    for (int j = 0; j < n; ++j) {
+      double& d = band[static_cast<std::size_t>(j) * ld];
+      d += lambda * std::clamp(d, kMinDiagonal, kMaxDiagonal);
+    }
+  }
+  int info = 0;
+  dpbtrf_("L", &n, &band_width, band.data(), &ld, &info);
+  return info == 0;
+}
+
+Eigen::VectorXd ChainSolver::Impl::SolveIteration(const Eigen::VectorXd& rhs) {
+  if (!banded) return llt.solve(rhs);
+  Eigen::VectorXd x = rhs;
+  const int ld = band_width + 1, one = 1;
+  int info = 0;
+  dpbtrs_("L", &n, &band_width, &one, band.data(), &ld, x.data(), &n, &info);
+  return x;
+}
+
 ChainSolver::ChainSolver(ceres::Problem& problem) : impl_(std::make_unique<Impl>(problem)) {}
 ChainSolver::~ChainSolver() = default;
 ChainSolver::ChainSolver(ChainSolver&&) noexcept = default;
@@ -361,18 +413,26 @@ ChainSolverSummary ChainSolver::Solve(const ChainSolverOptions& options) {
   while (!summary.converged && summary.iterations < options.max_iterations) {
     ++summary.iterations;
     const auto t_linear = Clock::now();
-    const bool factorized = s.Factorize(s.values, lambda);
-    if (factorized) step = -s.llt.solve(s.gradient);
+    const bool factorized = s.FactorizeIteration(s.values, lambda);
+    if (factorized) step = -s.SolveIteration(s.gradient);
     summary.linear_solve_s += SecondsSince(t_linear);
     if (summary.factor_flops == 0.0 && factorized) {
-      const auto& L = s.llt.matrixL().nestedExpression();
-      double flops = 0.0;
+      // Per column j with c_j entries below the diagonal: c_j^2 + 3 c_j for the factorization,
+      // 4 per entry of the factor for the two triangular solves.
+      double flops = 0.0, nonzeros = 0.0;
       for (int j = 0; j < s.n; ++j) {
-        const double c = L.outerIndexPtr()[j + 1] - L.outerIndexPtr()[j] - 1;
+        double c = 0.0;
+        if (s.banded) {
+          c = std::min(s.band_width, s.n - 1 - j);
+        } else {
+          const auto& L = s.llt.matrixL().nestedExpression();
+          c = L.outerIndexPtr()[j + 1] - L.outerIndexPtr()[j] - 1;
+        }
         flops += c * c + 3.0 * c;
+        nonzeros += c + 1.0;
       }
-      summary.factor_nonzeros = L.nonZeros();
-      summary.factor_flops = flops + 4.0 * static_cast<double>(L.nonZeros());
+      summary.factor_nonzeros = static_cast<long>(nonzeros);
+      summary.factor_flops = flops + 4.0 * nonzeros;
     }
     if (!factorized || !step.allFinite()) {
       // Not positive definite under this damping: more damping (a gradient-descent-like step).
@@ -442,8 +502,10 @@ ChainSolverSummary ChainSolver::Solve(const ChainSolverOptions& options) {
 }
 
 Eigen::VectorXd ChainSolver::Impl::H_undamped_times(const Eigen::VectorXd& v) {
-  std::copy(values.begin(), values.end(), H.valuePtr());
-  return H.selfadjointView<Eigen::Lower>() * v;
+  // `values` on H's pattern, without copying them into H.
+  const Eigen::Map<const Eigen::SparseMatrix<double>> undamped(n, n, static_cast<Eigen::Index>(values.size()),
+                                                               H.outerIndexPtr(), H.innerIndexPtr(), values.data());
+  return undamped.selfadjointView<Eigen::Lower>() * v;
 }
 
 bool ChainSolver::Impl::FactorizeAtCurrentValues(std::string* error) {

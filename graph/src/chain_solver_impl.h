@@ -74,6 +74,18 @@ struct ChainSolver::Impl {
   Eigen::VectorXd gradient, trial_gradient;
   Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> llt;
   bool analyzed = false;
+  // The iterations' factorization when the time-ordered band is narrow (every factor within a
+  // few consecutive steps, no block shared by the whole trajectory): LAPACK's banded Cholesky
+  // (dpbtrf/dpbtrs) on the lower band, kd + 1 rows by n columns, column-major. Its flops,
+  // n kd^2, exceed the sparse factor's, but it runs them at dense-kernel rate with no
+  // permutation copy. The covariances keep the sparse factor (its selected inversion).
+  int band_width = 0;                // kd: the largest row - column of the pattern, time order
+  bool banded = false;
+  std::vector<int> band_index;       // H's nonzero k -> its place in band
+  std::vector<double> band;          // the factor after FactorizeIteration
+  // The iterations' factorization (banded or sparse) and solve of (J^T J + damping) x = rhs.
+  bool FactorizeIteration(const std::vector<double>& h, double lambda);
+  Eigen::VectorXd SolveIteration(const Eigen::VectorXd& rhs);
   Eigen::VectorXd x_evaluated;  // where `values` and `gradient` were computed
   bool evaluated_at_current = false;
 };
