@@ -136,6 +136,11 @@ std::string ResultToJson(const graph::EstimationResult& r, int indent) {
         shape["suggested_mirrored"] = a.transform.mirrored;
       }
       shape["rotation_observable"] = a.rotation_observable;
+      if (!a.ties.empty()) {
+        Json ties = Json::array();
+        for (const graph::ShapeTransform& t : a.ties) ties.push_back({t.pose.x, t.pose.y, t.pose.theta});
+        shape["tied_transforms"] = ties;
+      }
       shape["refined_in_graph"] = a.refined;
     }
     if (a.finger_radius) parameters["finger_radius"] = *a.finger_radius;

@@ -30,6 +30,14 @@ const char* UnitName(double scale) {
   return "metres";
 }
 
+std::string UnitPhrase(double scale) {
+  if (scale == 100.0 || scale == 1000.0) {
+    return "the file is " + std::to_string(static_cast<int>(scale)) + " times too small (converted from " +
+           (scale == 100.0 ? "centimetres" : "millimetres") + " to metres twice?)";
+  }
+  return std::string("the file is in ") + UnitName(scale);
+}
+
 // The outer rings of the core polygons as one shape without holes: what a finger can touch
 // from outside, and what symmetry is judged on.
 Shape OutlineOf(const Shape& shape) {

@@ -13,6 +13,7 @@
 
 #include <cmath>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace pushgraph::graph::internal::registration {
@@ -27,6 +28,9 @@ inline constexpr double kPi = 3.14159265358979323846;
 Vec2 Rotate(const Vec2& p, double angle);
 /// "millimetres", "centimetres", "inches" or "metres" for a unit scale.
 const char* UnitName(double scale);
+// "the file is in millimetres", or for scales 100 and 1000 "the file is 1000 times too small
+// (converted from millimetres to metres twice?)".
+std::string UnitPhrase(double scale);
 /// The outer rings of the core polygons as one shape without holes: what a finger can touch
 /// from outside, and what symmetry is judged on.
 Shape OutlineOf(const Shape& shape);

@@ -194,12 +194,26 @@ std::string AlignedText(const RegistrationResult& registration, const ShapeAlign
   final_transform.sigma = alignment.sigma;
   const ShapeTransform& t = alignment.transform;
   const Eigen::Vector3d& sigma = alignment.sigma;
-  std::string s = "aligned it: " + final_transform.Describe() + " (to save it: pushgraph footprint SHAPE_FILE " + TransformText(t);
+  std::string s = "aligned it: " + final_transform.Describe();
+  // Placements the whole graph fits as well: the sigmas above are the curvature at the chosen
+  // one and do not show them (rect2 given in millimetres, one sticking push: turned by -88.7
+  // degrees "sigma 1.0 deg", with turns of 35 and 63 degrees within 2 in cost; the truth is 0).
+  if (!alignment.ties.empty()) {
+    s += "; the whole graph fits it about as well";
+    for (std::size_t k = 0; k < alignment.ties.size() && k < 3; ++k) {
+      char buf[96];
+      std::snprintf(buf, sizeof buf, "%s turned by %.1f deg, shifted by (%.1f, %.1f) mm", k == 0 ? "" : ",",
+                    alignment.ties[k].pose.theta * 180.0 / M_PI, alignment.ties[k].pose.x * 1e3, alignment.ties[k].pose.y * 1e3);
+      s += buf;
+    }
+    s += ": this recording does not settle the placement";
+  }
+  s += " (to save it: pushgraph footprint SHAPE_FILE " + TransformText(t);
   const bool turn_within = !alignment.rotation_observable || std::abs(t.pose.theta) <= 3.0 * sigma.z();
   const bool shift_within = std::abs(t.pose.x) <= 3.0 * sigma.x() && std::abs(t.pose.y) <= 3.0 * sigma.y();
-  if (!UnitsText(t).empty() && turn_within && shift_within) {
-    s += "; the turn and shift are within three sigmas of none: if the file's frame is otherwise right, "
-         "pushgraph footprint SHAPE_FILE " + UnitsText(t) + " alone";
+  if (!UnitsText(t).empty() && ((turn_within && shift_within) || !alignment.ties.empty())) {
+    s += alignment.ties.empty() ? "; the turn and shift are within three sigmas of none" : "; the turn and shift are unsettled";
+    s += ": if the file's frame is otherwise right, pushgraph footprint SHAPE_FILE " + UnitsText(t) + " alone";
   }
   return s + ")";
 }
@@ -353,6 +367,7 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
     };
     ShapeTransform best, refined;
     double best_cost = framed_cost(registration->transform, &best, quick);
+    std::vector<std::pair<ShapeTransform, double>> ranked{{best, best_cost}};  // every placement's graph cost
     // The shape as given competes too: the contacts alone can misjudge a push the model does
     // not describe (a finger wedged between two walls under bimodal noise misfired so). As
     // given means without the graph's frame: that is what is estimated when it wins (with the
@@ -373,6 +388,7 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
     char text[240];
     for (const ShapeTransform& alt : registration->alternatives) {
       const double cost = framed_cost(alt, &refined, quick);
+      ranked.emplace_back(refined, cost);
       std::snprintf(text, sizeof text, "alternative placement turned by %.1f deg, shifted by (%.1f, %.1f) mm: graph cost %.1f "
                     "against %.1f", alt.pose.theta * 180.0 / M_PI, alt.pose.x * 1e3, alt.pose.y * 1e3, cost, best_cost);
       alignment.notes.push_back(text);
@@ -390,6 +406,21 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
     if (identity_wins) {
       registration->fits_as_given = true;
       alignment.check.fits = true;
+      // "on" aligns from the shape as given when the graph prefers it (it applied the placement
+      // that lost: the true tri1 shape was turned by 134 degrees, cost 551.8 against 541.3).
+      if (config.align_shape == Align::kOn) {
+        registration->transform = ShapeTransform{};
+        registration->transform.scale = 1.0;
+      }
+    } else {
+      const double winner = best_cost;
+      for (const auto& [t, cost] : ranked) {
+        const ShapeTransform c = CanonicalTransform(t, trajectory.object.shape, registration->symmetry_order);
+        const double turn = std::abs(geometry::WrapAngle(c.pose.theta - registration->transform.pose.theta));
+        const double shift = std::hypot(c.pose.x - registration->transform.pose.x, c.pose.y - registration->transform.pose.y);
+        const bool differs = (registration->rotation_observable && turn > 3.0 * M_PI / 180.0) || shift > 3e-3;
+        if (cost < winner + kTieMargin && differs) alignment.ties.push_back(c);
+      }
     }
     if (size_candidate) {
       push::Trajectory sized = trajectory;
@@ -404,7 +435,11 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
       // Named beside the placement also where the contacts alone cannot tell the two apart (one
       // side of a block: a shift along its normal is a size change): a 1 mm probe given for the
       // 4.7 mm one was aligned by 4 mm shifts on rect1 recordings and the radius never named.
-      size_ties = !identity_wins && !size_wins && (sized_cost < best_cost + kTieMargin || registration->size_explains);
+      // (Not where the whole graph rejects the size outright: "explains the contacts about as
+      // well (whole-graph cost 3692.1 against 522.0)" read as a contradiction.)
+      size_ties = !identity_wins && !size_wins &&
+                  (sized_cost < best_cost + kTieMargin ||
+                   (registration->size_explains && sized_cost < best_cost + std::max(10.0, 0.02 * std::abs(best_cost))));
       size_cost = sized_cost;
       placement_cost = best_cost;
       std::snprintf(text, sizeof text, "frame or size: graph cost %.1f with the shape %s, %.1f with the finger %.1f mm %s",
@@ -480,7 +515,14 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
     result = inc.Finish();
   }
   if (alignment.checked && !alignment.check.fits) {
-    const std::string what = "the object's shape does not fit this recording as given (" + alignment.check.Describe() + ")";
+    std::string what = "the object's shape does not fit this recording as given (" + alignment.check.Describe() + ")";
+    if (registration->size_mismatch) {
+      char size[320];
+      std::snprintf(size, sizeof size, ": it is %.3g times the size of the finger's path around the object's origin, and "
+                    "no unit tried (metres, centimetres, millimetres, inches, 100 or 1000 times larger) makes it fit: "
+                    "check the shape file's size and units (and the object pose stream's frame)", registration->size_ratio);
+      what += size;
+    }
     if (size_wins) {
       char size[160];
       std::snprintf(size, sizeof size, "the finger %.1f mm %s than given (radius %.1f mm instead of %.1f mm)",
@@ -516,6 +558,12 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
                   "and the whole graph fit it clearly better elsewhere; ",
                   registration->identity_cost - registration->aligned_cost);
     warnings.push_back(text + AlignedText(*registration, alignment));
+  }
+  if (alignment.aligned && alignment.check.fits && !suspect) {
+    // Asked for (align_shape "on") on a shape that fits: say what was applied, it was silent.
+    warnings.push_back(std::string("the object's shape fits this recording as given") +
+                       (identity_wins ? " and the whole graph prefers it to every other placement" : "") +
+                       "; align_shape \"on\" " + AlignedText(*registration, alignment));
   }
   if (registration && registration->fits_as_given && registration->better_elsewhere && !alignment.aligned) {
     // The gaps are within tolerance, but a different placement explains the contacts clearly

@@ -2,6 +2,7 @@
 // candidates, a global search over rotations with robust Gauss-Newton over the translation,
 // exact refinement with a calibration gap per recording, symmetry and observability, and the
 // "does the shape fit as given" check.
+#include <pushgraph/geometry/errors.h>
 #include <pushgraph/geometry/point_query.h>
 #include <pushgraph/geometry/shape_pair.h>
 #include <pushgraph/graph/factors.h>
@@ -56,8 +57,10 @@ std::string RegistrationResult::Describe() const {
   if (transform.mirrored) s = "mirrored (y -> -y), " + s;
   if (transform.scale != 1.0) {
     s += Format(", scale %.6g", transform.scale);
-    const std::string unit = UnitName(transform.scale);
-    if (unit != "metres") s += " (the file is in " + unit + ")";
+    if (transform.scale == 0.001 || transform.scale == 0.01 || transform.scale == 0.0254 || transform.scale == 100.0 ||
+        transform.scale == 1000.0) {
+      s += " (" + UnitPhrase(transform.scale) + ")";
+    }
   }
   if (!rotation_observable) s += "; rotation unobservable (circular outline)";
   return s;
@@ -277,7 +280,9 @@ RegistrationResult RegisterShape(const std::vector<const push::Trajectory*>& rec
 
   // Candidate files: units whose size matches the finger path, each as given and mirrored.
   std::vector<double> scales{1.0};
-  if (o.detect_units) scales = {1.0, 0.01, 0.001, 0.0254};
+  // 100 and 1000: a file converted to metres twice (--scale 0.001 on a file already in metres
+  // gave a rect2 footprint 1000 times too small; it "fit", being smaller than the fit tolerance).
+  if (o.detect_units) scales = {1.0, 0.01, 0.001, 0.0254, 100.0, 1000.0};
   const Vec2 file_centroid = geometry::CoreCentroid(file_shape);
   const double file_radius = geometry::RadiusAbout(file_shape, file_centroid);
   std::vector<double> plausible;
@@ -287,6 +292,8 @@ RegistrationResult RegisterShape(const std::vector<const push::Trajectory*>& rec
   }
   if (plausible.empty()) {
     plausible = scales;
+    result.size_mismatch = true;
+    result.size_ratio = file_radius / std::max(path_radius, 1e-9);
     result.notes.push_back(Format("no unit makes the shape (radius %.4g in file units) the size of the finger's path "
                                   "(%.4g m from the object origin): every unit tried",
                                   file_radius, path_radius));
@@ -309,8 +316,12 @@ RegistrationResult RegisterShape(const std::vector<const push::Trajectory*>& rec
       FileCandidate f;
       f.scale = s;
       f.mirrored = mirror;
-      f.shape = std::make_shared<Shape>(s == 1.0 && !mirror ? file_shape
-                                                            : geometry::TransformShape(file_shape, Pose2{}, s, mirror));
+      try {
+        f.shape = std::make_shared<Shape>(s == 1.0 && !mirror ? file_shape
+                                                              : geometry::TransformShape(file_shape, Pose2{}, s, mirror));
+      } catch (const geometry::GeometryError&) {
+        continue;  // a unit that makes the shape smaller than the geometry supports (tried when none fits)
+      }
       const Vec2 centroid = geometry::CoreCentroid(*f.shape);
       f.radius = geometry::RadiusAbout(*f.shape, centroid);
       f.symmetry = OutlineSymmetryOrder(*f.shape, centroid, std::max(2.5e-4, 3e-3 * f.radius));
@@ -445,7 +456,9 @@ RegistrationResult RegisterShape(const std::vector<const push::Trajectory*>& rec
   // a better fit can come from samples that were never in contact (a finger sliding past the
   // end of a side makes the side look longer).
   result.check = CheckContacts(file_shape, finger, refine, o);
-  const bool equivalent = result.displacement <= o.min_displacement;  // e.g. a quarter turn of a square
+  // e.g. a quarter turn of a square; not a shape of no size for the data (one 1000 times too
+  // small moves by less than the tolerance under any placement).
+  const bool equivalent = result.displacement <= o.min_displacement && !result.size_mismatch;
   // Besides the gaps, the likelihood ratio: a placement that explains the contacts much better
   // (misfit_evidence in log-likelihood, the samples weighted by their correlation) and moves the
   // outline by more than the fit tolerance. On the 20 MIT recordings with their meshes as
@@ -481,6 +494,7 @@ RegistrationResult RegisterShape(const std::vector<const push::Trajectory*>& rec
     const double spread = identity.gap.size() > 0 ? (identity.gap.array() - result.size_offset).abs().maxCoeff() : 0.0;
     result.size_explains = sized_cost <= placed_cost + std::log(std::max(2.0, independent)) &&
                            std::abs(result.size_offset) <= plausible && spread <= o.fit_tolerance &&
+                           disk.radius + result.size_offset > 0.0 &&  // a finger, not a negative radius
                            std::abs(result.size_offset) >= 0.5 * o.gap_sigma;
     if (result.size_explains) {
       result.notes.push_back(Format("the shape as given fits as well with the finger %.1f mm %s (cost %.1f against %.1f for the "
@@ -560,7 +574,7 @@ RegistrationResult RegisterShape(const std::vector<const push::Trajectory*>& rec
     }
   }
   if (f.scale != 1.0) {
-    result.notes.push_back(std::string("units: the shape file is in ") + UnitName(f.scale) +
+    result.notes.push_back("units: " + UnitPhrase(f.scale) +
                            Format(": at scale 1 it is %.3g times the size of the finger's path", file_radius / path_radius));
   }
   if (f.mirrored) result.notes.push_back("the shape file is mirrored (y -> -y): a footprint seen from below?");

@@ -294,7 +294,8 @@ TEST_F(EstimateCli, AMeshInMillimetresIsOfferedItsUnitsAlone) {
   const pushgraph::testing::ToolRun r = EstimateMit(h5, "rect1.obj", "--scale 1000", kProbe, kRect1Mass, dir() + "/mm.json");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("the file is in millimetres"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("pushgraph footprint SHAPE_FILE --scale 0.001 alone"), std::string::npos) << r.err;
+  // The file the user gave, not a placeholder.
+  EXPECT_NE(r.err.find("pushgraph footprint " + dir() + "/user_shape.json --scale 0.001 alone"), std::string::npos) << r.err;
   // Estimated as given (alignment off), the self-diagnosis' gap of 5748.5 mm was put on the probe
   // alone ("a finger radius 5748.5 mm smaller would touch"); it now points at the shape check's finding.
   const pushgraph::testing::ToolRun off =
@@ -302,6 +303,27 @@ TEST_F(EstimateCli, AMeshInMillimetresIsOfferedItsUnitsAlone) {
   ASSERT_EQ(off.status, 0) << off.err;
   EXPECT_NE(off.err.find("the file is in millimetres"), std::string::npos) << off.err;
   EXPECT_NE(off.err.find("the shape check above found the shape as given off"), std::string::npos) << off.err;
+}
+
+// A mesh converted from millimetres to metres twice (footprint --scale 0.001 on a file already in
+// metres): 1000 times too small, it "fit as given" (every placement of a shape that small moves
+// it by less than the fit tolerance), and the estimate was 25.2 mm off against 1.21 mm (raw 7.27).
+// Units of 100 and 1000 are tried now. 100000 times too small no unit explains: it is named.
+TEST_F(EstimateCli, AMeshConvertedToMetresTwiceIsFoundSo) {
+  if (Mit().empty()) GTEST_SKIP() << "no MIT data";
+  const std::string h5 = Mit() + "abs/rect1/motion_surface=abs_shape=rect1_a=0_v=75_i=2.000_s=0.800_t=0.000.h5";
+  const std::string out = dir() + "/tiny.json";
+  const pushgraph::testing::ToolRun r = EstimateMit(h5, "rect1.obj", "--scale 0.001", kProbe, kRect1Mass, out);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("the file is 1000 times too small"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("pushgraph footprint " + dir() + "/user_shape.json --scale 1000 alone"), std::string::npos) << r.err;
+  const double rms = Load(out)["metrics"]["object_position_rms"].get<double>();
+  std::printf("[registration] rect1 1000 times too small: object RMS %.2f mm\n", rms * 1e3);
+  EXPECT_LT(rms, 1.6e-3);
+  const pushgraph::testing::ToolRun far = EstimateMit(h5, "rect1.obj", "--scale 0.00001", kProbe, kRect1Mass, dir() + "/far.json");
+  ASSERT_EQ(far.status, 0) << far.err;
+  EXPECT_NE(far.err.find("no unit tried"), std::string::npos) << far.err;
+  EXPECT_NE(far.err.find("check the shape file's size and units"), std::string::npos) << far.err;
 }
 
 // A 1 mm probe given for the 4.7 mm one, on a rect1 recording: one side's contacts cannot tell a
@@ -317,13 +339,15 @@ TEST_F(EstimateCli, AProbeTooSmallIsNamedBesideThePlacement) {
 }
 
 // A 9 mm probe given for the 4.7 mm one: on two ellip1 recordings the whole graph prefers the
-// finger 3.5 and 4.4 mm smaller to any placement by 8 and 5 in cost. Estimated with the probe as
-// given, against a shape it does not touch, they were 1.49 and 2.50 mm off; with the preferred
-// radius 0.88 and 0.96 mm (with the right probe 1.13 and 0.97 mm). On other recordings a
-// placement wins (the contacts of one push cannot tell a shift from a size), also near 1 mm.
+// finger 3.5 and 4.5 mm smaller to any placement by 8 and 43 in cost. Estimated with the probe as
+// given, against a shape it does not touch, they were 1.49 and 2.43 mm off; with the preferred
+// radius 0.88 and 0.80 mm (with the right probe 1.13 and 0.82 mm). On other recordings a
+// placement wins (the contacts of one push cannot tell a shift from a size), also near 1 mm; a
+// third recording where the size won by 5 (t=0.349 at 100 mm/s) is such a tie: the placement's
+// solve reaches 928.0 with the banded factorization and 935.7 without, against 930.6 for the size.
 TEST_F(EstimateCli, AFingerSizeTheGraphPrefersIsUsedAndNamed) {
   if (Mit().empty()) GTEST_SKIP() << "no MIT data";
-  for (const char* rec : {"100_i=0.000_s=0.075_t=0.000.h5", "100_i=0.000_s=0.075_t=0.349.h5"}) {
+  for (const char* rec : {"100_i=0.000_s=0.075_t=0.000.h5", "20_i=0.000_s=0.675_t=0.698.h5"}) {
     const std::string out = dir() + "/sized.json";
     const pushgraph::testing::ToolRun r = EstimateMit(Mit() + "abs/ellip1/motion_surface=abs_shape=ellip1_a=0_v=" + rec,
                                                       "ellip1.obj", "", 0.009, kEllip1Mass, out);
@@ -333,7 +357,7 @@ TEST_F(EstimateCli, AFingerSizeTheGraphPrefersIsUsedAndNamed) {
     ASSERT_TRUE(j["parameters"].contains("finger_radius")) << rec;
     const double radius = j["parameters"]["finger_radius"].get<double>(), rms = j["metrics"]["object_position_rms"].get<double>();
     std::printf("[registration] ellip1 with a 9 mm probe: radius used %.2f mm, object RMS %.2f mm\n", radius * 1e3, rms * 1e3);
-    EXPECT_NEAR(radius, kProbe, 1.2e-3) << rec;  // 5.49 and 4.60 mm
+    EXPECT_NEAR(radius, kProbe, 1.2e-3) << rec;  // 5.49 and 4.53 mm
     EXPECT_LT(rms, 1.3e-3) << rec;
   }
 }

@@ -86,6 +86,15 @@ void RunEstimate(const EstimateOptions& o) {
   } catch (const graph::GraphError& e) {
     throw CliError(o.input + ": " + e.what());
   }
+  // The library names the shape file SHAPE_FILE in its "to save it" commands; here it is known.
+  if (!o.object.empty()) {
+    const std::string file = o.object.find_first_of(" '\"") == std::string::npos ? o.object : "'" + o.object + "'";
+    for (std::string& w : result.warnings) {
+      for (std::size_t at = w.find("SHAPE_FILE"); at != std::string::npos; at = w.find("SHAPE_FILE", at + file.size())) {
+        w.replace(at, 10, file);
+      }
+    }
+  }
   for (const std::string& w : result.warnings) std::cerr << "estimate: warning: " << w << "\n";
   evaluation::SaveResultJson(result, o.output);
   if (!o.svg.empty()) {

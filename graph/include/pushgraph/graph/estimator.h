@@ -113,6 +113,10 @@ struct ShapeAlignment {
   /// fit, and the shape as given with this finger fitted the whole graph clearly better than any
   /// placement (a wrong probe radius or object size; align_shape "auto" only).
   std::optional<double> finger_radius;
+  /// Other placements the whole graph fits within 2 in cost of `transform` (graph-refined,
+  /// turned or shifted by more than 3 degrees or 3 mm): one push often cannot tell them apart,
+  /// and `sigma` (the curvature at the chosen one) does not say so.
+  std::vector<ShapeTransform> ties;
   std::vector<std::string> notes;  ///< registration's notes: symmetry, weak directions, ambiguity
 };
 

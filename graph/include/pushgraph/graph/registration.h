@@ -13,8 +13,9 @@
 // centre is at its radius r outside it, sd(T s S, q_i) = r (other fingers: approximated by a
 // disk in the global search, exact shape-pair separations in the refinement).
 //
-// 1. Units: s is tried among 1 (metres), 0.01, 0.001 and 0.0254 (cm, mm, inch files) where the
-//    scaled shape is of the size of the finger path (options.detect_units).
+// 1. Units: s is tried among 1 (metres), 0.01, 0.001 and 0.0254 (cm, mm, inch files), 100 and
+//    1000 (a file converted to metres twice) where the scaled shape is of the size of the
+//    finger path (options.detect_units).
 // 2. Global search, so that no quarter turn or symmetry traps it: for every rotation on a grid
 //    (options.rotation_step; only one turn of the outline's symmetry), robust Gauss-Newton
 //    over the translation from two starts, scored by the Cauchy cost sum log(1 + (d_i/c)^2).
@@ -58,7 +59,7 @@ struct ShapeTransform {
 };
 
 struct RegistrationOptions {
-  /// Also try the shape file in centimetres, millimetres and inches.
+  /// Also try the shape file in centimetres, millimetres and inches, and 100 and 1000 times larger.
   bool detect_units = true;
   /// Also try the shape file mirrored (seen from below); chosen only when it fits clearly better.
   bool detect_mirror = true;
@@ -159,6 +160,11 @@ struct RegistrationResult {
   bool size_explains = false;
   double size_offset = 0.0;
   std::string ambiguity;       ///< what it is, when ambiguous
+  /// No unit tried (metres, centimetres, millimetres, inches; 100 and 1000 times too small)
+  /// makes the shape the size of the finger's path (its median distance from the object's
+  /// origin in the contacts): the shape file's size or the pose stream's frame is wrong.
+  bool size_mismatch = false;
+  double size_ratio = 0.0;     ///< with size_mismatch: the shape's radius over the path's, as given
   ShapeFitCheck check;  ///< the shape as given (fits_as_given also accepts equivalent placements)
   double identity_gap_rms = 0.0;  ///< robust RMS (m) of sd - r over the contact samples, as given
   double aligned_gap_rms = 0.0;   ///< the same with the transform
