@@ -249,6 +249,62 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
     }
   }
   rep.faces_used = static_cast<int>(triangles.size());
+  {
+    std::vector<std::string> with_faces;
+    std::vector<char> used(nv, 0);
+    for (const tinyobj::shape_t& s : reader.GetShapes()) {
+      if (!options.object.empty() && s.name != options.object) continue;
+      if (!s.mesh.indices.empty()) with_faces.push_back(s.name.empty() ? "(unnamed)" : s.name);
+      for (const auto& index : s.mesh.indices) {
+        if (index.vertex_index >= 0 && index.vertex_index < nv) used[index.vertex_index] = 1;
+      }
+    }
+    if (options.object.empty() && with_faces.size() > 1) {
+      std::string names;
+      for (std::size_t k = 0; k < with_faces.size() && k < 6; ++k) names += (k ? ", " : "") + with_faces[k];
+      if (with_faces.size() > 6) names += ", ...";
+      rep.warnings.push_back("the file holds " + std::to_string(with_faces.size()) + " objects or groups (" + names +
+                             "): their footprints are united; if they are separate objects, --object NAME takes one");
+    }
+    // A prism along an axis has every vertex on its two end planes (an extruded outline: the
+    // MIT blocks along z, the probe's cylinder along y). Along another axis than `up`, the
+    // footprint is the prism's side view.
+    const char* axis_names[3] = {"x", "y", "z"};
+    const int up = options.up == UpAxis::kX ? 0 : options.up == UpAxis::kY ? 1 : 2;
+    std::vector<int> prism_axes;
+    for (int a = 0; a < 3; ++a) {
+      double lo = INFINITY, hi = -INFINITY, extent = 0.0;
+      for (int v = 0; v < nv; ++v) {
+        if (!used[v]) continue;
+        lo = std::min(lo, coordinates[3 * v + a]);
+        hi = std::max(hi, coordinates[3 * v + a]);
+      }
+      for (int b = 0; b < 3; ++b) {
+        double blo = INFINITY, bhi = -INFINITY;
+        for (int v = 0; v < nv; ++v) {
+          if (!used[v]) continue;
+          blo = std::min(blo, coordinates[3 * v + b]);
+          bhi = std::max(bhi, coordinates[3 * v + b]);
+        }
+        extent = std::max(extent, bhi - blo);
+      }
+      if (!(hi > lo)) continue;
+      const double tolerance = 1e-9 * extent;
+      bool on_ends = true;
+      for (int v = 0; v < nv && on_ends; ++v) {
+        if (!used[v]) continue;
+        const double c = coordinates[3 * v + a];
+        on_ends = std::abs(c - lo) <= tolerance || std::abs(c - hi) <= tolerance;
+      }
+      if (on_ends) prism_axes.push_back(a);
+    }
+    if (!prism_axes.empty() && std::find(prism_axes.begin(), prism_axes.end(), up) == prism_axes.end()) {
+      const char* axis = axis_names[prism_axes.front()];
+      rep.warnings.push_back(std::string("every vertex lies on one of two planes across ") + axis + ": the mesh is a prism along " +
+                             axis + ", and seen along " + axis_names[up] + " its footprint is its side view; --up " + axis +
+                             " gives its cross-section");
+    }
+  }
   if (rep.faces == 0) throw IoError(path + ": the mesh has no faces");
   if (triangles.empty()) throw IoError(path + ": every face has zero area seen along the up axis (wrong --up?)");
   CGAL::Polygon_set_2<K> set;

@@ -90,6 +90,35 @@ TEST_F(Footprint, SeveralObjectsInOneFile) {
   }
 }
 
+// Footprints that are probably not what was meant are named (a hostile-user session: tip.obj
+// along z gave a 9.4 x 20 mm rectangle silently, and estimates then blamed the object's frame and
+// the sensors; tri3.obj's two blocks were united into a 5-vertex outline of neither).
+TEST_F(Footprint, SideViewsAndSeveralObjectsAreWarned) {
+  if (!SharedAvailable()) GTEST_SKIP() << "shared MIT meshes not found at " << kObj;
+  auto warnings = [](const std::string& mesh, io::UpAxis up) {
+    io::FootprintOptions options;
+    options.up = up;
+    io::FootprintReport report;
+    io::MeshFootprint(kObj + mesh, options, &report);
+    std::string all;
+    for (const std::string& w : report.warnings) all += w + "\n";
+    return all;
+  };
+  EXPECT_EQ(warnings("rect1.obj", io::UpAxis::kZ), "");
+  EXPECT_EQ(warnings("ellip2.obj", io::UpAxis::kZ), "");
+  EXPECT_EQ(warnings("tip.obj", io::UpAxis::kY), "");
+  EXPECT_NE(warnings("tip.obj", io::UpAxis::kZ).find("a prism along y"), std::string::npos);
+  EXPECT_NE(warnings("rect2.obj", io::UpAxis::kY).find("--up z gives its cross-section"), std::string::npos);
+  const std::string tri3 = warnings("tri3.obj", io::UpAxis::kZ);
+  EXPECT_NE(tri3.find("holds 2 objects"), std::string::npos) << tri3;
+  EXPECT_NE(tri3.find("--object NAME"), std::string::npos) << tri3;
+  // A 3-D body that is no prism along any axis: nothing to say.
+  const std::string tetra = Write("t.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
+  io::FootprintReport report;
+  io::MeshFootprint(tetra, {}, &report);
+  EXPECT_TRUE(report.warnings.empty());
+}
+
 TEST_F(Footprint, UnionOfOverlappingAndOpenNonManifoldMeshes) {
   // Two overlapping squares (each two triangles, no shared vertices) and a detached triangle
   // sharing one corner with them: an exact union with two parts touching at a vertex.

@@ -259,6 +259,12 @@ TEST_F(CliTest, OutputsThatAreInputsAreRefusedAndInputsKept) {
   ASSERT_EQ(Exec("footprint " + shape + " --scale 2 -o " + out + " -q").status, 0);
   for (const auto& entry : fs::directory_iterator(dir_))
     EXPECT_EQ(entry.path().filename().string().find(".tmp-"), std::string::npos) << entry.path();
+  // A turn given in degrees is taken as radians, and said so (90 rad = 116.6 degrees modulo 360).
+  const ToolRun degrees = Exec("footprint " + shape + " --transform 0,0,90 -o " + (dir_ / "turned.json").string() + " -q");
+  EXPECT_EQ(degrees.status, 0) << degrees.err;
+  EXPECT_NE(degrees.err.find("THETA 90 is in radians"), std::string::npos) << degrees.err;
+  EXPECT_NE(degrees.err.find("for degrees give 1.5707963267948966"), std::string::npos) << degrees.err;
+  EXPECT_EQ(Exec("footprint " + shape + " --transform 0,0,1.5 -o " + (dir_ / "t2.json").string() + " -q").err, "");
 }
 
 TEST_F(CliTest, UnknownSubcommandsSeedsAndIgnoredSigmasAreNamed) {

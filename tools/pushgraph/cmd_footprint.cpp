@@ -7,6 +7,7 @@
 #include <pushgraph/geometry/pose.h>
 #include <pushgraph/io/footprint.h>
 
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 
@@ -47,6 +48,11 @@ void RegisterFootprint(CLI::App& app) {
     }
     if (args->mirror || !args->transform.empty()) {
       const geometry::Pose2 pose = args->transform.empty() ? geometry::Pose2{} : ParsePose(args->transform, "--transform");
+      if (std::abs(pose.theta) > 2.0 * M_PI) {
+        std::cerr << "footprint: warning: --transform's THETA " << FormatDouble(pose.theta)
+                  << " is in radians (more than a full turn): for degrees give " << FormatDouble(pose.theta * M_PI / 180.0)
+                  << "\n";
+      }
       shape = geometry::TransformShape(shape, pose, 1.0, args->mirror);
     }
     if (args->output.empty()) {
@@ -54,6 +60,7 @@ void RegisterFootprint(CLI::App& app) {
     } else {
       geometry::SaveShapeJson(shape, args->output);
     }
+    for (const std::string& w : report.warnings) std::cerr << "footprint: warning: " << args->mesh << ": " << w << "\n";
     if (!args->quiet && !json) {
       int holes = 0;
       for (const geometry::Polygon& p : shape.polygons()) holes += static_cast<int>(p.holes.size());

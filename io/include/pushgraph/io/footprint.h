@@ -32,6 +32,10 @@ struct FootprintReport {
   int faces = 0;                     ///< triangles read (after triangulation)
   int faces_used = 0;                ///< with non-zero projected area
   int vertices_removed = 0;          ///< collinear or duplicate vertices dropped from the outline
+  /// What the footprint may not be what was meant: several objects united (tri3.obj holds two
+  /// blocks), or a prism along another axis than `up` (its side view, e.g. tip.obj without
+  /// --up y: every vertex on the two end planes of another axis).
+  std::vector<std::string> warnings;
 };
 
 /// Throws IoError naming the file for unreadable, empty or broken meshes, an unknown object name,
