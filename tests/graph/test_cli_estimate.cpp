@@ -323,6 +323,28 @@ TEST_F(EstimateCli, AMeshShiftedAlongThePushedSideIsPlacedByTheMechanics) {
   EXPECT_LT(rms, 1.3e-3);
 }
 
+// A mesh in millimetres and otherwise right: the units alone compete in the whole graph with the
+// placements found with them, and win ties as the shape as given does. On this recording the
+// placement had a turn of 3.9 degrees and a 1.7 mm shift (0.942 mm, saved with the file); now the estimate is the one
+// with the mesh as shipped, and the command to save it is the units alone.
+TEST_F(EstimateCli, AMeshInMillimetresAloneIsEstimatedAsTheRightOne) {
+  if (Mit().empty()) GTEST_SKIP() << "no MIT data";
+  const std::string h5 = Mit() + "abs/rect1/motion_surface=abs_shape=rect1_a=0_v=75_i=2.000_s=0.700_t=-1.047.h5";
+  const pushgraph::testing::ToolRun r = EstimateMit(h5, "rect1.obj", "--scale 1000", kProbe, kRect1Mass, dir() + "/mm.json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("(to save it: pushgraph footprint " + dir() + "/user_shape.json --scale 0.001)"), std::string::npos)
+      << r.err;
+  const nlohmann::json j = Load(dir() + "/mm.json");
+  ASSERT_TRUE(j["parameters"].contains("shape_transform"));
+  for (int k = 0; k < 3; ++k) EXPECT_EQ(j["parameters"]["shape_transform"][k].get<double>(), 0.0);
+  const pushgraph::testing::ToolRun shipped = EstimateMit(h5, "rect1.obj", "", kProbe, kRect1Mass, dir() + "/m.json");
+  ASSERT_EQ(shipped.status, 0) << shipped.err;
+  const double rms = j["metrics"]["object_position_rms"].get<double>();
+  const double rms_shipped = Load(dir() + "/m.json")["metrics"]["object_position_rms"].get<double>();
+  std::printf("[registration] rect1 in millimetres: object RMS %.3f mm (as shipped %.3f mm)\n", rms * 1e3, rms_shipped * 1e3);
+  EXPECT_NEAR(rms, rms_shipped, 1e-5);
+}
+
 // A mesh converted from millimetres to metres twice (footprint --scale 0.001 on a file already in
 // metres): 1000 times too small, it "fit as given" (every placement of a shape that small moves
 // it by less than the fit tolerance), and the estimate was 25.2 mm off against 1.21 mm (raw 7.27).

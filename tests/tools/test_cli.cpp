@@ -262,9 +262,14 @@ TEST_F(CliTest, OutputsThatAreInputsAreRefusedAndInputsKept) {
   // A turn given in degrees is taken as radians, and said so (90 rad = 116.6 degrees modulo 360).
   const ToolRun degrees = Exec("footprint " + shape + " --transform 0,0,90 -o " + (dir_ / "turned.json").string() + " -q");
   EXPECT_EQ(degrees.status, 0) << degrees.err;
-  EXPECT_NE(degrees.err.find("THETA 90 is in radians"), std::string::npos) << degrees.err;
+  EXPECT_NE(degrees.err.find("THETA 90 is taken as radians"), std::string::npos) << degrees.err;
   EXPECT_NE(degrees.err.find("for degrees give 1.5707963267948966"), std::string::npos) << degrees.err;
   EXPECT_EQ(Exec("footprint " + shape + " --transform 0,0,1.5 -o " + (dir_ / "t2.json").string() + " -q").err, "");
+  EXPECT_EQ(Exec("footprint " + shape + " --transform 0,0,6.2832 -o " + (dir_ / "t3.json").string() + " -q").err, "");
+  const ToolRun millimetres = Exec("footprint " + shape + " --transform 20,0,0 -o " + (dir_ / "t4.json").string() + " -q");
+  EXPECT_NE(millimetres.err.find("taken as metres"), std::string::npos) << millimetres.err;
+  const ToolRun huge = Exec("footprint " + shape + " --scale 1000 -o " + (dir_ / "t5.json").string() + " -q");
+  EXPECT_NE(huge.err.find("is the file in millimetres?"), std::string::npos) << huge.err;
 }
 
 TEST_F(CliTest, UnknownSubcommandsSeedsAndIgnoredSigmasAreNamed) {

@@ -48,10 +48,16 @@ void RegisterFootprint(CLI::App& app) {
     }
     if (args->mirror || !args->transform.empty()) {
       const geometry::Pose2 pose = args->transform.empty() ? geometry::Pose2{} : ParsePose(args->transform, "--transform");
-      if (std::abs(pose.theta) > 2.0 * M_PI) {
+      // Degrees and millimetres where radians and metres are meant (a full turn, 6.2832, is fine).
+      if (std::abs(pose.theta) > 1.01 * 2.0 * M_PI) {
         std::cerr << "footprint: warning: --transform's THETA " << FormatDouble(pose.theta)
-                  << " is in radians (more than a full turn): for degrees give " << FormatDouble(pose.theta * M_PI / 180.0)
+                  << " is taken as radians (more than a full turn): for degrees give " << FormatDouble(pose.theta * M_PI / 180.0)
                   << "\n";
+      }
+      if (std::hypot(pose.x, pose.y) > 1.0) {
+        std::cerr << "footprint: warning: --transform's X,Y (" << FormatDouble(pose.x) << ", " << FormatDouble(pose.y)
+                  << ") are taken as metres (more than 1 m): for millimetres give " << FormatDouble(pose.x * 1e-3) << ","
+                  << FormatDouble(pose.y * 1e-3) << "\n";
       }
       shape = geometry::TransformShape(shape, pose, 1.0, args->mirror);
     }
@@ -61,6 +67,14 @@ void RegisterFootprint(CLI::App& app) {
       geometry::SaveShapeJson(shape, args->output);
     }
     for (const std::string& w : report.warnings) std::cerr << "footprint: warning: " << args->mesh << ": " << w << "\n";
+    // Shapes are in metres: a pushed object outside 1 mm to 2 m across is probably in other units.
+    const geometry::Box2 box = shape.bounds();
+    const double across = std::max(box.max.x() - box.min.x(), box.max.y() - box.min.y());
+    if (across > 2.0 || across < 1e-3) {
+      std::cerr << "footprint: warning: the shape is " << FormatDouble(across) << " m across: shapes are in metres ("
+                << (across > 2.0 ? "is the file in millimetres? --scale 0.001" : "was it scaled twice, or is it in other units?")
+                << ")\n";
+    }
     if (!args->quiet && !json) {
       int holes = 0;
       for (const geometry::Polygon& p : shape.polygons()) holes += static_cast<int>(p.holes.size());
