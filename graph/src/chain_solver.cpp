@@ -29,10 +29,12 @@ namespace pushgraph::graph {
 
 namespace {
 
-// The banded factorization is used while its flops (n kd^2) stay within this many times the
-// sparse one's estimate (n times the mean column count squared): at 1000 QS steps kd is 29 and
-// the band's 8.4 Mflop take 1.8 ms against Eigen's 2.2 ms for 3 Mflop.
-constexpr double kMaxBandWidth = 64;
+// The iterations factorize with LAPACK's banded Cholesky up to this band width kd (n kd^2 flops:
+// at 1000 QS steps kd is 22, 6.4 Mflop in about 1.7 ms an iteration against the sparse factor's
+// 3.0 Mflop in 2.7 ms); a block shared by the whole trajectory (shape frame, c, mu) makes the band
+// as wide as the problem, and the sparse factor stays. PUSHGRAPH_BAND=0 selects the sparse factor
+// always (for comparing the two, docs/estimation.md's Speed).
+constexpr int kMaxBandWidth = 64;
 
 // A hint to load the cache line at p (GCC and Clang; nothing elsewhere).
 inline void PrefetchForRead(const void* p) {

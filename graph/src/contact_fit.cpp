@@ -35,7 +35,8 @@ std::string UnitPhrase(double scale) {
     return "the file is " + std::to_string(static_cast<int>(scale)) + " times too small (converted from " +
            (scale == 100.0 ? "centimetres" : "millimetres") + " to metres twice?)";
   }
-  return std::string("the file is in ") + UnitName(scale);
+  if (scale == 0.001 || scale == 0.01 || scale == 0.0254) return std::string("the file is in ") + UnitName(scale);
+  return "";
 }
 
 // The outer rings of the core polygons as one shape without holes: what a finger can touch

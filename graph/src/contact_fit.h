@@ -29,7 +29,7 @@ Vec2 Rotate(const Vec2& p, double angle);
 /// "millimetres", "centimetres", "inches" or "metres" for a unit scale.
 const char* UnitName(double scale);
 // "the file is in millimetres", or for scales 100 and 1000 "the file is 1000 times too small
-// (converted from millimetres to metres twice?)".
+// (converted from millimetres to metres twice?)"; empty for a scale that is no unit.
 std::string UnitPhrase(double scale);
 /// The outer rings of the core polygons as one shape without holes: what a finger can touch
 /// from outside, and what symmetry is judged on.

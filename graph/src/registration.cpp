@@ -57,10 +57,8 @@ std::string RegistrationResult::Describe() const {
   if (transform.mirrored) s = "mirrored (y -> -y), " + s;
   if (transform.scale != 1.0) {
     s += Format(", scale %.6g", transform.scale);
-    if (transform.scale == 0.001 || transform.scale == 0.01 || transform.scale == 0.0254 || transform.scale == 100.0 ||
-        transform.scale == 1000.0) {
-      s += " (" + UnitPhrase(transform.scale) + ")";
-    }
+    const std::string unit = UnitPhrase(transform.scale);
+    if (!unit.empty()) s += " (" + unit + ")";
   }
   if (!rotation_observable) s += "; rotation unobservable (circular outline)";
   return s;

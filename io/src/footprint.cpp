@@ -271,30 +271,21 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
     // footprint is the prism's side view.
     const char* axis_names[3] = {"x", "y", "z"};
     const int up = options.up == UpAxis::kX ? 0 : options.up == UpAxis::kY ? 1 : 2;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int v = 0; v < nv; ++v) {
+      if (!used[v]) continue;
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::min(lo[a], coordinates[3 * v + a]);
+        hi[a] = std::max(hi[a], coordinates[3 * v + a]);
+      }
+    }
+    const double tolerance = 1e-9 * std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 0.0});
     std::vector<int> prism_axes;
     for (int a = 0; a < 3; ++a) {
-      double lo = INFINITY, hi = -INFINITY, extent = 0.0;
-      for (int v = 0; v < nv; ++v) {
-        if (!used[v]) continue;
-        lo = std::min(lo, coordinates[3 * v + a]);
-        hi = std::max(hi, coordinates[3 * v + a]);
-      }
-      for (int b = 0; b < 3; ++b) {
-        double blo = INFINITY, bhi = -INFINITY;
-        for (int v = 0; v < nv; ++v) {
-          if (!used[v]) continue;
-          blo = std::min(blo, coordinates[3 * v + b]);
-          bhi = std::max(bhi, coordinates[3 * v + b]);
-        }
-        extent = std::max(extent, bhi - blo);
-      }
-      if (!(hi > lo)) continue;
-      const double tolerance = 1e-9 * extent;
-      bool on_ends = true;
+      bool on_ends = hi[a] > lo[a];
       for (int v = 0; v < nv && on_ends; ++v) {
-        if (!used[v]) continue;
         const double c = coordinates[3 * v + a];
-        on_ends = std::abs(c - lo) <= tolerance || std::abs(c - hi) <= tolerance;
+        on_ends = !used[v] || std::abs(c - lo[a]) <= tolerance || std::abs(c - hi[a]) <= tolerance;
       }
       if (on_ends) prism_axes.push_back(a);
     }
