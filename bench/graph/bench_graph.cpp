@@ -4,6 +4,7 @@
 // fed sample by sample (OnlineEstimator).
 #include <pushgraph/graph/estimator.h>
 #include <pushgraph/graph/incremental.h>
+#include <pushgraph/graph/registration.h>
 
 #include "graph/online_feed.h"
 #include "graph/push_generator.h"
@@ -91,6 +92,19 @@ void BM_BatchQsDetailedObject(benchmark::State& state) {
   state.counters["object_rms_m"] = rms;
 }
 BENCHMARK(BM_BatchQsDetailedObject)->Arg(4)->Arg(1000)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond)->Iterations(1);
+
+// The shape check every estimate runs (RegisterShape: the units, mirror and rotation search over
+// the contacts, then the refinement): part of BM_BatchQs' time for either solver.
+void BM_RegisterShape(benchmark::State& state) {
+  const auto& traj = Push(static_cast<int>(state.range(0)));
+  graph::EstimatorConfig cfg;
+  const graph::RegistrationOptions options = graph::RegistrationOptionsFor(cfg);
+  for (auto _ : state) {
+    const graph::RegistrationResult r = graph::RegisterShape(traj, options);
+    benchmark::DoNotOptimize(r.transform.pose.x);
+  }
+}
+BENCHMARK(BM_RegisterShape)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 void BM_BatchQs(benchmark::State& s) { Batch(s, graph::Model::kQs, false); }
 void BM_BatchQsWithCovariance(benchmark::State& s) { Batch(s, graph::Model::kQs, true); }

@@ -283,8 +283,8 @@ PointQuery QueryPoint(const Shape& shape, const Pose2& pose, const Vec2& point, 
     N = (outside_core ? 1.0 : -1.0) * P / core_distance;
     M = m.radius * N;
   }
-  Eigen::Matrix2d dR;
-  dR << -std::sin(pose.theta), -std::cos(pose.theta), std::cos(pose.theta), -std::sin(pose.theta);
+  Eigen::Matrix2d dR;  // d R / d theta from R's own cos and sin
+  dR << -R(1, 0), -R(0, 0), R(0, 0), -R(1, 0);
   J->J_sd_point = w.normal.transpose();
   J->J_sd_pose = q.normal.transpose() * J_local_pose;
   J->J_closest_point = R * M * R.transpose();

@@ -6,11 +6,7 @@
 
 namespace pushgraph::geometry::internal {
 
-Eigen::Matrix2d RotationDerivative(double theta) {
-  Eigen::Matrix2d dR;
-  dR << -std::sin(theta), -std::cos(theta), std::cos(theta), -std::sin(theta);
-  return dR;
-}
+Eigen::Matrix2d RotationDerivative(double theta) { return RotationDerivativeOf(Pose2{0.0, 0.0, theta}.rotation()); }
 
 Eigen::Matrix2d RotationDerivativeOf(const Eigen::Matrix2d& R) {
   Eigen::Matrix2d dR;

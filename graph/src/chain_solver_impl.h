@@ -35,8 +35,24 @@ struct ChainSolver::Impl {
   };
   // One block pair (row >= column in the ordering) of a residual block's J^T J contribution:
   // column c of it starts at values[column_offsets[offsets_begin + c]] (contiguous rows).
+  // Adds weight * Ja^T Jb (Ja m x rows, Jb m x cols, row-major) to the stored lower triangle:
+  // column c's entries start at h[offsets[c]] (from row c on a diagonal block).
+  using PairKernel = void (*)(const double* Ja, const double* Jb, double weight, int m, int rows, int cols,
+                              const int* offsets, double* h);
   struct Pair {
     int row_param = 0, col_param = 0, offsets_begin = 0;
+    int rows = 0, cols = 0;       // the two blocks' sizes
+    PairKernel kernel = nullptr;  // sized at compile time for the common m, rows, cols
+  };
+  // What Evaluate reads of a residual block on some variable block, in flat arrays (a
+  // Residual's own vectors are separate heap objects: their loads missed the cache a third of
+  // the evaluation loop's time). param_begin indexes eval_params, eval_jacobians, eval_offset
+  // and eval_size.
+  struct EvalResidual {
+    const ceres::CostFunction* cost = nullptr;
+    const ceres::LossFunction* loss = nullptr;
+    int index = 0;  // into residuals
+    int m = 0, residual_offset = 0, param_begin = 0, num_params = 0, pair_begin = 0, pair_end = 0;
   };
 
   explicit Impl(ceres::Problem& problem);
@@ -61,6 +77,10 @@ struct ChainSolver::Impl {
   std::unordered_map<const double*, int> index;       // block pointer -> blocks index
   std::unordered_map<const double*, int> fixed;       // constant or unused: size
   std::vector<Residual> residuals;
+  std::vector<EvalResidual> evaluated;  // the residual blocks Evaluate computes, in order
+  std::vector<const double*> eval_params;
+  std::vector<double*> eval_jacobians;  // nullptr for a fixed block
+  std::vector<int> eval_offset, eval_size;  // the block's place in x and size (-1 and 0 if fixed)
   std::vector<Pair> pairs;
   std::vector<int> column_offsets, diagonal;
   std::vector<double> jacobian_values, residual_values;

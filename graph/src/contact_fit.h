@@ -186,17 +186,29 @@ class ContactFit {
       g->setZero(n);
       double f = 0.0;
       Eigen::Vector4d J4;
-      Eigen::VectorXd J(n);
+      // A sample's Jacobian row: the active placement parameters, and -1 at its recording's gap;
+      // w J J^T accumulated on those entries only (the gaps' rows are otherwise zero).
+      double J[4];
       for (std::size_t i = 0; i < size(); ++i) {
         const double d = RawGap(i, pl, &J4) - pl.gap(c_.recording[i]);
         const double z2 = (d / cauchy_) * (d / cauchy_);
         f += c_.weight[i] * a_ * std::log1p(z2);
         const double w = c_.weight[i] / (noise_ * noise_ * (1.0 + z2));  // IRLS weight of the Cauchy loss
-        J.setZero();
-        for (int k = 0; k < np; ++k) J(k) = J4(idx[k]);
-        if (ng > 0) J(np + c_.recording[i]) = -1.0;
-        H->noalias() += w * J * J.transpose();
-        *g += w * d * J;
+        for (int k = 0; k < np; ++k) J[k] = J4(idx[k]);
+        for (int a = 0; a < np; ++a) {
+          const double wa = w * J[a];
+          for (int b = 0; b < np; ++b) (*H)(a, b) += wa * J[b];
+          (*g)(a) += w * d * J[a];
+        }
+        if (ng > 0) {
+          const int r = np + c_.recording[i];
+          for (int a = 0; a < np; ++a) {
+            (*H)(a, r) -= w * J[a];
+            (*H)(r, a) -= w * J[a];
+          }
+          (*H)(r, r) += w;
+          (*g)(r) -= w * d;
+        }
       }
       Eigen::Matrix<double, 2, 4> Jp;
       const Vec2 rp = Prior(pl, &Jp);

@@ -559,9 +559,7 @@ QuasiStaticTerms ComputeQuasiStaticTerms(const QuasiStaticGeometry& geo, const P
   t.J_V_x = J_V_l * J_l_d * J_d_x;
 
   // Load in the object frame: f_b = R^T f, moment arm q = x^-1 p - r, tau = q x f_b.
-  const double cs = std::cos(x.theta), sn = std::sin(x.theta);
-  Eigen::Matrix2d Rt;
-  Rt << cs, sn, -sn, cs;
+  const Eigen::Matrix2d Rt = x.rotation().transpose();
   const Vec2 fb = Rt * f;
   Eigen::Matrix<double, 2, 3> J_fb_x = Eigen::Matrix<double, 2, 3>::Zero();
   J_fb_x(0, 2) = fb.y();

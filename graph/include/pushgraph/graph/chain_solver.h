@@ -4,10 +4,11 @@
 // losses, constant blocks and bounds: one copy of every residual and Jacobian) and accumulates
 // the normal equations J^T J straight into a sparse matrix whose pattern is fixed once: every
 // factor touches at most three consecutive steps, so the matrix is block-banded (plus a dense
-// border for the blocks shared by the whole trajectory: c, mu, the shape frame). The
-// factorization is Eigen's SimplicialLLT with an AMD ordering (which keeps the factor within the
-// band and its border) and its symbolic analysis done once per problem, reused by every
-// iteration and by the covariances (SparseMarginals::Compute(ChainSolver&)).
+// border for the blocks shared by the whole trajectory: c, mu, the shape frame). The iterations
+// factorize the band with LAPACK's banded Cholesky (dpbtrf) where it is at most 64 wide, and
+// otherwise (a border) with Eigen's SimplicialLLT, AMD-ordered, its symbolic analysis done once
+// per problem; the covariances take that sparse factor at the solution
+// (SparseMarginals::Compute(ChainSolver&)).
 //
 //   ceres::Problem problem;                  // residual blocks added step by step, in time order
 //   ...
