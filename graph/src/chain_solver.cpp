@@ -108,8 +108,8 @@ ChainSolver::Impl::PairKernel KernelFor(int m, int rows, int cols, bool diagonal
 }
 
 std::string DefaultDescription(int index, const ChainSolver::Impl::Residual& r) {
-  return "residual block " + std::to_string(index) + " (" + std::to_string(r.cost->num_residuals()) + " residuals, " +
-         std::to_string(r.params.size()) + " parameter blocks)";
+  return "residual block " + std::to_string(index) + " (" + std::to_string(r.m) + " residuals, " +
+         std::to_string(r.num_params) + " parameter blocks)";
 }
 
 }  // namespace
@@ -120,14 +120,17 @@ ChainSolver::Impl::Impl(ceres::Problem& p) : problem(&p) {
   std::vector<ceres::ResidualBlockId> ids;
   problem->GetResidualBlocks(&ids);
   std::unordered_set<const double*> used;
-  std::vector<std::vector<double*>> params(ids.size());
+  residuals.resize(ids.size());
+  std::vector<double*> params;
   for (std::size_t k = 0; k < ids.size(); ++k) {
-    problem->GetParameterBlocksForResidualBlock(ids[k], &params[k]);
-    used.insert(params[k].begin(), params[k].end());
+    problem->GetParameterBlocksForResidualBlock(ids[k], &params);
+    residuals[k].param_begin = static_cast<int>(param_ptrs.size());
+    residuals[k].num_params = static_cast<int>(params.size());
+    param_ptrs.insert(param_ptrs.end(), params.begin(), params.end());
+    used.insert(params.begin(), params.end());
   }
-  // Offsets in the order the blocks were added (time order for the estimator); the elimination
-  // order is AMD's, chosen once with the symbolic analysis.
-  std::vector<double*> variable;
+  // Offsets in the order the blocks were added (time order for the estimator: the band).
+  int offset = 0;
   for (double* b : all) {
     const int size = problem->ParameterBlockSize(b);
     if (problem->IsParameterBlockConstant(b) || !used.count(b) || size == 0) {
@@ -135,118 +138,112 @@ ChainSolver::Impl::Impl(ceres::Problem& p) : problem(&p) {
       continue;
     }
     if (problem->GetManifold(b) != nullptr) throw GraphError("ChainSolver: a parameter block has a manifold (not supported)");
-    variable.push_back(b);
-  }
-  int offset = 0;
-  for (double* b : variable) {
     Block block;
     block.ptr = b;
     block.offset = offset;
-    block.size = problem->ParameterBlockSize(b);
-    for (int i = 0; i < block.size; ++i) {
-      block.lower.push_back(problem->GetParameterLowerBound(b, i));
-      block.upper.push_back(problem->GetParameterUpperBound(b, i));
-      block.bounded |= block.lower.back() > -std::numeric_limits<double>::max() ||
-                       block.upper.back() < std::numeric_limits<double>::max();
+    block.size = size;
+    for (int i = 0; i < size; ++i) {
+      lower.push_back(problem->GetParameterLowerBound(b, i));
+      upper.push_back(problem->GetParameterUpperBound(b, i));
+      block.bounded |= lower.back() > -std::numeric_limits<double>::max() || upper.back() < std::numeric_limits<double>::max();
     }
     index[b] = static_cast<int>(blocks.size());
-    blocks.push_back(std::move(block));
-    offset += blocks.back().size;
+    blocks.push_back(block);
+    offset += size;
   }
   n = offset;
-  // Residual blocks, their Jacobian storage and the block pairs of J^T J they touch.
-  std::vector<std::pair<int, int>> block_pairs;  // (row block, column block), row >= column
+  // Residual blocks, their Jacobian storage, and for every variable block b the blocks a >= b
+  // it shares a residual block with (J^T J's block pattern, below the diagonal; a few per block
+  // in a chain: a linear search, where sorting every pair, setFromTriplets and a binary search
+  // per entry were 40 % of the constructor's time).
+  std::vector<std::vector<int>> below(blocks.size());
+  for (std::size_t b = 0; b < blocks.size(); ++b) below[b].push_back(static_cast<int>(b));
   int jacobian_size = 0, residual_size = 0;
-  residuals.reserve(ids.size());
+  param_block.resize(param_ptrs.size());
+  param_offset.resize(param_ptrs.size());
+  param_size.resize(param_ptrs.size());
+  std::vector<int> jacobian_offset(param_ptrs.size());
   for (std::size_t k = 0; k < ids.size(); ++k) {
-    Residual r;
+    Residual& r = residuals[k];
     r.id = ids[k];
     r.cost = problem->GetCostFunctionForResidualBlock(ids[k]);
     r.loss = problem->GetLossFunctionForResidualBlock(ids[k]);
-    r.params = params[k];
+    r.m = r.cost->num_residuals();
     r.residual_offset = residual_size;
-    residual_size += r.cost->num_residuals();
-    for (double* b : r.params) {
-      const auto it = index.find(b);
-      r.block.push_back(it == index.end() ? -1 : it->second);
-      r.jacobian_offset.push_back(jacobian_size);
-      if (it != index.end()) jacobian_size += r.cost->num_residuals() * blocks[it->second].size;
+    residual_size += r.m;
+    r.constant = true;
+    for (int q = r.param_begin; q < r.param_begin + r.num_params; ++q) {
+      const auto it = index.find(param_ptrs[q]);
+      const int b = it == index.end() ? -1 : it->second;
+      param_block[q] = b;
+      param_offset[q] = b < 0 ? -1 : blocks[b].offset;
+      param_size[q] = b < 0 ? 0 : blocks[b].size;
+      jacobian_offset[q] = jacobian_size;
+      jacobian_size += r.m * param_size[q];
+      // A residual block on constant blocks only adds a constant to the cost (Ceres' fixed
+      // cost): it is evaluated once per Solve, not in every iteration.
+      r.constant = r.constant && b < 0;
     }
-    for (std::size_t a = 0; a < r.block.size(); ++a) {
-      for (std::size_t b = 0; b < r.block.size(); ++b) {
-        if (r.block[a] < 0 || r.block[b] < 0 || r.block[a] < r.block[b]) continue;
-        block_pairs.emplace_back(r.block[a], r.block[b]);
+    for (int qa = r.param_begin; qa < r.param_begin + r.num_params; ++qa) {
+      for (int qb = r.param_begin; qb < r.param_begin + r.num_params; ++qb) {
+        const int a = param_block[qa], b = param_block[qb];
+        if (a < 0 || b < 0 || a < b || std::find(below[b].begin(), below[b].end(), a) != below[b].end()) continue;
+        below[b].push_back(a);
       }
     }
-    // A residual block on constant blocks only adds a constant to the cost (Ceres' fixed cost):
-    // it is evaluated once per Solve, not in every iteration.
-    r.constant = std::all_of(r.block.begin(), r.block.end(), [](int b) { return b < 0; });
-    residuals.push_back(std::move(r));
   }
   jacobian_values.assign(jacobian_size, 0.0);
   residual_values.assign(residual_size, 0.0);
-  std::sort(block_pairs.begin(), block_pairs.end());
-  block_pairs.erase(std::unique(block_pairs.begin(), block_pairs.end()), block_pairs.end());
-  // The pattern: the lower triangle of every touched block pair.
-  std::vector<Eigen::Triplet<double>> triplets;
-  for (const auto& [a, b] : block_pairs) {
-    const Block& ra = blocks[a];
+  param_jacobian.resize(param_ptrs.size());
+  for (std::size_t q = 0; q < param_ptrs.size(); ++q) {
+    param_jacobian[q] = param_block[q] < 0 ? nullptr : jacobian_values.data() + jacobian_offset[q];
+  }
+  // The pattern, column by column: block b's column k holds rows k.. of b itself, then every row
+  // of each block below it in order. rows_before[b][i]: the rows of below[b][1..i-1].
+  std::vector<std::vector<int>> rows_before(blocks.size());
+  std::vector<int> outer(n + 1, 0), inner;
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    std::vector<int>& rows = below[b];
+    std::sort(rows.begin() + 1, rows.end());
+    rows_before[b].assign(rows.size(), 0);
+    for (std::size_t i = 2; i < rows.size(); ++i) rows_before[b][i] = rows_before[b][i - 1] + blocks[rows[i - 1]].size;
     const Block& cb = blocks[b];
     for (int k = 0; k < cb.size; ++k) {
-      for (int u = (a == b ? k : 0); u < ra.size; ++u) triplets.emplace_back(ra.offset + u, cb.offset + k, 0.0);
+      for (std::size_t i = 0; i < rows.size(); ++i) {
+        const Block& ra = blocks[rows[i]];
+        for (int u = (i == 0 ? k : 0); u < ra.size; ++u) inner.push_back(ra.offset + u);
+      }
+      outer[cb.offset + k + 1] = static_cast<int>(inner.size());
     }
   }
-  H.resize(n, n);
-  H.setFromTriplets(triplets.begin(), triplets.end());
-  H.makeCompressed();
-  auto position = [&](int row, int col) {
-    const int* first = H.innerIndexPtr() + H.outerIndexPtr()[col];
-    const int* last = H.innerIndexPtr() + H.outerIndexPtr()[col + 1];
-    return static_cast<int>(std::lower_bound(first, last, row) - H.innerIndexPtr());
-  };
-  diagonal.resize(n);
-  for (int j = 0; j < n; ++j) diagonal[j] = position(j, j);
+  const std::vector<double> zeros(inner.size(), 0.0);
+  H = Eigen::Map<const Eigen::SparseMatrix<double>>(n, n, static_cast<Eigen::Index>(inner.size()), outer.data(),
+                                                     inner.data(), zeros.data());
+  diagonal.assign(outer.begin(), outer.end() - 1);  // each column starts at its diagonal
   for (Residual& r : residuals) {
     r.pair_begin = static_cast<int>(pairs.size());
-    for (std::size_t a = 0; a < r.block.size(); ++a) {
-      for (std::size_t b = 0; b < r.block.size(); ++b) {
-        if (r.block[a] < 0 || r.block[b] < 0 || r.block[a] < r.block[b]) continue;
+    for (int a = 0; a < r.num_params; ++a) {
+      for (int b = 0; b < r.num_params; ++b) {
+        const int row_block = param_block[r.param_begin + a], col_block = param_block[r.param_begin + b];
+        if (row_block < 0 || col_block < 0 || row_block < col_block) continue;
         Pair pair;
-        pair.row_param = static_cast<int>(a);
-        pair.col_param = static_cast<int>(b);
+        pair.row_param = a;
+        pair.col_param = b;
         pair.offsets_begin = static_cast<int>(column_offsets.size());
-        const Block& ra = blocks[r.block[a]];
-        const Block& cb = blocks[r.block[b]];
-        pair.kernel = KernelFor(r.cost->num_residuals(), ra.size, cb.size, a == b);
+        const Block& ra = blocks[row_block];
+        const Block& cb = blocks[col_block];
+        pair.kernel = KernelFor(r.m, ra.size, cb.size, a == b);
         pair.rows = ra.size;
         pair.cols = cb.size;
-        for (int k = 0; k < cb.size; ++k) column_offsets.push_back(position(ra.offset + (a == b ? k : 0), cb.offset + k));
+        const std::vector<int>& rows = below[col_block];
+        const std::size_t i = static_cast<std::size_t>(std::find(rows.begin(), rows.end(), row_block) - rows.begin());
+        for (int k = 0; k < cb.size; ++k) {
+          column_offsets.push_back(outer[cb.offset + k] + (i == 0 ? 0 : cb.size - k + rows_before[col_block][i]));
+        }
         pairs.push_back(pair);
       }
     }
     r.pair_end = static_cast<int>(pairs.size());
-  }
-  for (std::size_t k = 0; k < residuals.size(); ++k) {
-    const Residual& r = residuals[k];
-    if (r.constant) continue;
-    EvalResidual e;
-    e.cost = r.cost;
-    e.loss = r.loss;
-    e.index = static_cast<int>(k);
-    e.m = r.cost->num_residuals();
-    e.residual_offset = r.residual_offset;
-    e.param_begin = static_cast<int>(eval_params.size());
-    e.num_params = static_cast<int>(r.params.size());
-    e.pair_begin = r.pair_begin;
-    e.pair_end = r.pair_end;
-    for (std::size_t q = 0; q < r.params.size(); ++q) {
-      const bool variable = r.block[q] >= 0;
-      eval_params.push_back(r.params[q]);
-      eval_jacobians.push_back(variable ? jacobian_values.data() + r.jacobian_offset[q] : nullptr);
-      eval_offset.push_back(variable ? blocks[r.block[q]].offset : -1);
-      eval_size.push_back(variable ? blocks[r.block[q]].size : 0);
-    }
-    evaluated.push_back(e);
   }
   values.assign(H.nonZeros(), 0.0);
   trial_values.assign(H.nonZeros(), 0.0);
@@ -280,7 +277,7 @@ void ChainSolver::Impl::Scatter(const Eigen::VectorXd& x) {
 void ChainSolver::Impl::Project(Eigen::VectorXd& x) const {
   for (const Block& b : blocks) {
     if (!b.bounded) continue;
-    for (int i = 0; i < b.size; ++i) x[b.offset + i] = std::clamp(x[b.offset + i], b.lower[i], b.upper[i]);
+    for (int i = b.offset; i < b.offset + b.size; ++i) x[i] = std::clamp(x[i], lower[i], upper[i]);
   }
 }
 
@@ -288,17 +285,18 @@ bool ChainSolver::Impl::Evaluate(std::vector<double>& h, Eigen::VectorXd& g, dou
   std::fill(h.begin(), h.end(), 0.0);
   g.setZero();
   double total = 0.0;
-  for (std::size_t k = 0; k < evaluated.size(); ++k) {
-    const EvalResidual& r = evaluated[k];
+  for (std::size_t k = 0; k < residuals.size(); ++k) {
+    const Residual& r = residuals[k];
     // The cost functions are separate heap objects, each read once an iteration: without this,
     // the load of the next one's size was a third of this loop's own time (a cache miss).
-    if (k + 2 < evaluated.size()) PrefetchForRead(evaluated[k + 2].cost);
+    if (k + 2 < residuals.size()) PrefetchForRead(residuals[k + 2].cost);
+    if (r.constant) continue;
     const int m = r.m;
-    double* const* jacobians = eval_jacobians.data() + r.param_begin;
-    const int* offset = eval_offset.data() + r.param_begin;
-    const int* size = eval_size.data() + r.param_begin;
+    double* const* jacobians = param_jacobian.data() + r.param_begin;
+    const int* offset = param_offset.data() + r.param_begin;
+    const int* size = param_size.data() + r.param_begin;
     double* res = residual_values.data() + r.residual_offset;
-    bool ok = r.cost->Evaluate(eval_params.data() + r.param_begin, res, const_cast<double**>(jacobians));
+    bool ok = r.cost->Evaluate(param_ptrs.data() + r.param_begin, res, const_cast<double**>(jacobians));
     double sq = 0.0;
     for (int i = 0; ok && i < m; ++i) {
       ok = std::isfinite(res[i]);
@@ -309,7 +307,7 @@ bool ChainSolver::Impl::Evaluate(std::vector<double>& h, Eigen::VectorXd& g, dou
       for (int i = 0, count = m * size[q]; ok && i < count; ++i) ok = std::isfinite(J[i]);
     }
     if (!ok) {
-      *failed = r.index;
+      *failed = static_cast<int>(k);
       return false;
     }
     double weight = 1.0;
@@ -352,12 +350,12 @@ bool ChainSolver::Impl::FixedCost(double* cost, int* failed) {
     const Residual& r = residuals[k];
     if (!r.constant) continue;
     double* res = residual_values.data() + r.residual_offset;
-    if (!r.cost->Evaluate(r.params.data(), res, nullptr)) {
+    if (!r.cost->Evaluate(param_ptrs.data() + r.param_begin, res, nullptr)) {
       *failed = static_cast<int>(k);
       return false;
     }
     double sq = 0.0;
-    for (int i = 0; i < r.cost->num_residuals(); ++i) sq += res[i] * res[i];
+    for (int i = 0; i < r.m; ++i) sq += res[i] * res[i];
     if (r.loss != nullptr) {
       double rho[3];
       r.loss->Evaluate(sq, rho);

@@ -19,16 +19,19 @@ struct ChainSolver::Impl {
   struct Block {
     double* ptr = nullptr;
     int offset = 0, size = 0;
-    std::vector<double> lower, upper;
-    bool bounded = false;
+    bool bounded = false;  // its bounds are lower[offset..] and upper[offset..]
   };
+  // A residual block's parameter blocks are param_ptrs[param_begin .. param_begin + num_params),
+  // with param_block, param_jacobian, param_offset and param_size at the same places: flat
+  // arrays, read in order by every evaluation (a residual's own vectors were separate heap
+  // objects, whose loads missed the cache a third of the evaluation loop's time, and whose
+  // allocations were much of the constructor's).
   struct Residual {
     ceres::ResidualBlockId id = nullptr;
     const ceres::CostFunction* cost = nullptr;
     const ceres::LossFunction* loss = nullptr;
-    std::vector<double*> params;
-    std::vector<int> block;            // index into blocks, -1 for a block held fixed
-    std::vector<int> jacobian_offset;  // into jacobian_values (row-major, residuals x block size)
+    int m = 0;                         // residuals
+    int param_begin = 0, num_params = 0;
     int residual_offset = 0;
     int pair_begin = 0, pair_end = 0;  // into pairs
     bool constant = false;             // every block held fixed
@@ -44,17 +47,6 @@ struct ChainSolver::Impl {
     int rows = 0, cols = 0;       // the two blocks' sizes
     PairKernel kernel = nullptr;  // sized at compile time for the common m, rows, cols
   };
-  // What Evaluate reads of a residual block on some variable block, in flat arrays (a
-  // Residual's own vectors are separate heap objects: their loads missed the cache a third of
-  // the evaluation loop's time). param_begin indexes eval_params, eval_jacobians, eval_offset
-  // and eval_size.
-  struct EvalResidual {
-    const ceres::CostFunction* cost = nullptr;
-    const ceres::LossFunction* loss = nullptr;
-    int index = 0;  // into residuals
-    int m = 0, residual_offset = 0, param_begin = 0, num_params = 0, pair_begin = 0, pair_end = 0;
-  };
-
   explicit Impl(ceres::Problem& problem);
   void Gather(Eigen::VectorXd& x) const;
   void Scatter(const Eigen::VectorXd& x);
@@ -73,14 +65,15 @@ struct ChainSolver::Impl {
   std::string DescribeUnknown(int unknown) const;
 
   ceres::Problem* problem = nullptr;
-  std::vector<Block> blocks;                          // in elimination order
+  std::vector<Block> blocks;                          // in the order they were added (time order)
   std::unordered_map<const double*, int> index;       // block pointer -> blocks index
   std::unordered_map<const double*, int> fixed;       // constant or unused: size
   std::vector<Residual> residuals;
-  std::vector<EvalResidual> evaluated;  // the residual blocks Evaluate computes, in order
-  std::vector<const double*> eval_params;
-  std::vector<double*> eval_jacobians;  // nullptr for a fixed block
-  std::vector<int> eval_offset, eval_size;  // the block's place in x and size (-1 and 0 if fixed)
+  std::vector<const double*> param_ptrs;
+  std::vector<int> param_block;          // index into blocks, -1 for a block held fixed
+  std::vector<double*> param_jacobian;   // into jacobian_values (row-major, m x size); nullptr if fixed
+  std::vector<int> param_offset, param_size;  // the block's place in x and size (-1 and 0 if fixed)
+  std::vector<double> lower, upper;      // bounds of the unknowns
   std::vector<Pair> pairs;
   std::vector<int> column_offsets, diagonal;
   std::vector<double> jacobian_values, residual_values;
