@@ -16,8 +16,8 @@ namespace {
 // the shape registration. Keyed on the bits of theta, so the values are the same as computed.
 void CosSin(double theta, double* c, double* s) {
   struct Entry {
-    std::uint64_t bits = 0x7ff8000000000001ULL;  // a NaN pattern no angle asks for
-    double c = 0.0, s = 0.0;
+    std::uint64_t bits = 0;  // +0.0, whose cos and sin are exactly 1 and 0
+    double c = 1.0, s = 0.0;
   };
   thread_local Entry cache[2];
   thread_local int next = 0;

@@ -5,7 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
+#include <thread>
+#include <vector>
 
 #include "geometry/random_shapes.h"
 
@@ -39,6 +42,25 @@ TEST(Pose2, RotationIsOrthonormalWithAngleTheta) {
   EXPECT_EQ(q.x, 4.0);
   EXPECT_EQ(q.y, 5.0);
   EXPECT_EQ(q.theta, 6.0);
+}
+
+// rotation() remembers the last angles' cos and sin (pose.cpp): whatever the order of the calls
+// (repeats, two angles alternating, +0 and -0, NaN, a fresh thread), the same bits as cos and sin.
+TEST(Pose2, RotationIsExactlyCosAndSinInAnyOrderOfCalls) {
+  auto same_bits = [](double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0 || (std::isnan(a) && std::isnan(b)); };
+  auto check = [&](double theta) {
+    const Eigen::Matrix2d R = Pose2{0.0, 0.0, theta}.rotation();
+    EXPECT_TRUE(same_bits(R(0, 0), std::cos(theta))) << theta;
+    EXPECT_TRUE(same_bits(R(1, 0), std::sin(theta))) << theta;
+    EXPECT_TRUE(same_bits(R(0, 1), -std::sin(theta))) << theta;
+  };
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> a(-10.0, 10.0);
+  std::vector<double> angles{0.0, -0.0, 0.0, -0.0, std::nan(""), 1e-300, -1e-300, 0.0};
+  for (int i = 0; i < 300; ++i) angles.push_back(i % 3 == 0 && !angles.empty() ? angles[angles.size() - 2] : a(rng));
+  for (double theta : angles) check(theta);
+  std::thread other([&] { for (double theta : angles) check(theta); });
+  other.join();
 }
 
 TEST(Pose2, WrapAngleRange) {
