@@ -153,9 +153,9 @@ ChainSolver::Impl::Impl(ceres::Problem& p) : problem(&p) {
   }
   n = offset;
   // Residual blocks, their Jacobian storage, and for every variable block b the blocks a >= b
-  // it shares a residual block with (J^T J's block pattern, below the diagonal; a few per block
-  // in a chain: a linear search, where sorting every pair, setFromTriplets and a binary search
-  // per entry were 40 % of the constructor's time).
+  // it shares a residual block with (J^T J's block pattern below the diagonal: a few per block
+  // in a chain, all of them for a block shared by the trajectory such as c; sorting every pair,
+  // setFromTriplets and a binary search per entry were 40 % of the constructor's time).
   std::vector<std::vector<int>> below(blocks.size());
   for (std::size_t b = 0; b < blocks.size(); ++b) below[b].push_back(static_cast<int>(b));
   int jacobian_size = 0, residual_size = 0;
@@ -187,8 +187,7 @@ ChainSolver::Impl::Impl(ceres::Problem& p) : problem(&p) {
     for (int qa = r.param_begin; qa < r.param_begin + r.num_params; ++qa) {
       for (int qb = r.param_begin; qb < r.param_begin + r.num_params; ++qb) {
         const int a = param_block[qa], b = param_block[qb];
-        if (a < 0 || b < 0 || a < b || std::find(below[b].begin(), below[b].end(), a) != below[b].end()) continue;
-        below[b].push_back(a);
+        if (a > b && b >= 0) below[b].push_back(a);  // duplicates removed below
       }
     }
   }
@@ -205,6 +204,7 @@ ChainSolver::Impl::Impl(ceres::Problem& p) : problem(&p) {
   for (std::size_t b = 0; b < blocks.size(); ++b) {
     std::vector<int>& rows = below[b];
     std::sort(rows.begin() + 1, rows.end());
+    rows.erase(std::unique(rows.begin() + 1, rows.end()), rows.end());
     rows_before[b].assign(rows.size(), 0);
     for (std::size_t i = 2; i < rows.size(); ++i) rows_before[b][i] = rows_before[b][i - 1] + blocks[rows[i - 1]].size;
     const Block& cb = blocks[b];
@@ -236,7 +236,7 @@ ChainSolver::Impl::Impl(ceres::Problem& p) : problem(&p) {
         pair.rows = ra.size;
         pair.cols = cb.size;
         const std::vector<int>& rows = below[col_block];
-        const std::size_t i = static_cast<std::size_t>(std::find(rows.begin(), rows.end(), row_block) - rows.begin());
+        const std::size_t i = row_block == col_block ? 0 : static_cast<std::size_t>(std::lower_bound(rows.begin() + 1, rows.end(), row_block) - rows.begin());
         for (int k = 0; k < cb.size; ++k) {
           column_offsets.push_back(outer[cb.offset + k] + (i == 0 ? 0 : cb.size - k + rows_before[col_block][i]));
         }

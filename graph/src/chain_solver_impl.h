@@ -36,12 +36,12 @@ struct ChainSolver::Impl {
     int pair_begin = 0, pair_end = 0;  // into pairs
     bool constant = false;             // every block held fixed
   };
-  // One block pair (row >= column in the ordering) of a residual block's J^T J contribution:
-  // column c of it starts at values[column_offsets[offsets_begin + c]] (contiguous rows).
   // Adds weight * Ja^T Jb (Ja m x rows, Jb m x cols, row-major) to the stored lower triangle:
   // column c's entries start at h[offsets[c]] (from row c on a diagonal block).
   using PairKernel = void (*)(const double* Ja, const double* Jb, double weight, int m, int rows, int cols,
                               const int* offsets, double* h);
+  // One block pair (row >= column in the ordering) of a residual block's J^T J contribution:
+  // column c of it starts at values[column_offsets[offsets_begin + c]] (contiguous rows).
   struct Pair {
     int row_param = 0, col_param = 0, offsets_begin = 0;
     int rows = 0, cols = 0;       // the two blocks' sizes
