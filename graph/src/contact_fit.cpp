@@ -66,6 +66,15 @@ std::vector<Vec2> OutlineSamples(const Shape& shape) {
   return pts;
 }
 
+double OutlineDisplacement(const Shape& file, const ShapeTransform& t) {
+  double moved = 0.0;
+  for (const Vec2& p : OutlineSamples(file)) {
+    const Vec2 file_point(t.scale * p.x(), (t.mirrored ? -1.0 : 1.0) * t.scale * p.y());
+    moved = std::max(moved, (geometry::Act(t.pose, file_point) - p).norm());
+  }
+  return moved;
+}
+
 // Whether placements a and b of a shape coincide on its outline within tolerance.
 bool SamePlacement(const Shape& outline, const std::vector<Vec2>& samples, const Placement& a, const Placement& b,
                    double tolerance) {

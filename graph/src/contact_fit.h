@@ -36,6 +36,9 @@ std::string UnitPhrase(double scale);
 Shape OutlineOf(const Shape& shape);
 /// Points on the outline: vertices and edge midpoints of the outer rings (at most 400).
 std::vector<Vec2> OutlineSamples(const Shape& shape);
+// How far transform t moves the outline of the shape `file` (the largest move of its outline
+// samples, each scaled and mirrored by t, then placed by t.pose).
+double OutlineDisplacement(const Shape& file, const ShapeTransform& t);
 
 // Contact samples of one or more recordings: the finger's reference point and pose in the
 // object frame, the recording each comes from, and its weight (1 / samples per correlation time).

@@ -1,3 +1,4 @@
+#include "contact_fit.h"
 #include "graph_builder.h"
 
 #include <ceres/normal_prior.h>
@@ -176,9 +177,12 @@ std::string UnitsText(const ShapeTransform& t) {
   return s;
 }
 
+// A transform of units (scale, mirror) only: no turn or shift to save.
+bool UnitsOnly(const ShapeTransform& t) { return t.pose.x == 0.0 && t.pose.y == 0.0 && t.pose.theta == 0.0; }
+
 std::string TransformText(const ShapeTransform& t) {
   const std::string units = UnitsText(t);
-  if (t.pose.x == 0.0 && t.pose.y == 0.0 && t.pose.theta == 0.0 && !units.empty()) return units;
+  if (UnitsOnly(t) && !units.empty()) return units;
   char buf[128];
   std::snprintf(buf, sizeof buf, "--transform %.6g,%.6g,%.6g", t.pose.x, t.pose.y, t.pose.theta);
   return units.empty() ? buf : units + " " + buf;
@@ -212,8 +216,7 @@ std::string AlignedText(const RegistrationResult& registration, const ShapeAlign
   s += " (to save it: pushgraph footprint SHAPE_FILE " + TransformText(t);
   const bool turn_within = !alignment.rotation_observable || std::abs(t.pose.theta) <= 3.0 * sigma.z();
   const bool shift_within = std::abs(t.pose.x) <= 3.0 * sigma.x() && std::abs(t.pose.y) <= 3.0 * sigma.y();
-  const bool units_only = t.pose.x == 0.0 && t.pose.y == 0.0 && t.pose.theta == 0.0;
-  if (!UnitsText(t).empty() && !units_only && ((turn_within && shift_within) || !alignment.ties.empty())) {
+  if (!UnitsText(t).empty() && !UnitsOnly(t) && ((turn_within && shift_within) || !alignment.ties.empty())) {
     s += alignment.ties.empty() ? "; the turn and shift are within three sigmas of none" : "; the turn and shift are unsettled";
     s += ": if the file's frame is otherwise right, pushgraph footprint SHAPE_FILE " + UnitsText(t) + " alone";
   }
@@ -505,9 +508,7 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
   if (frame_check) {
     try {
       frame_cost = framed_cost(ShapeTransform{}, &frame_refined, quick);
-      for (const geometry::Polygon& p : trajectory.object.shape.polygons()) {
-        for (const Vec2& v : p.outer) frame_moved = std::max(frame_moved, (geometry::Act(frame_refined.pose, v) - v).norm());
-      }
+      frame_moved = internal::registration::OutlineDisplacement(trajectory.object.shape, frame_refined);
     } catch (const std::exception& e) {
       // A check, not the estimate: a solve with the frame free that fails leaves the shape as given.
       alignment.notes.push_back(std::string("frame check skipped: ") + e.what());

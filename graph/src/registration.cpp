@@ -445,11 +445,7 @@ RegistrationResult RegisterShape(const std::vector<const push::Trajectory*>& rec
     result.aligned_gap_rms = 1.4826 * Median(gaps);
   }
 
-  // How far the transform moves the outline of the file's shape.
-  for (const Vec2& p : OutlineSamples(file_shape)) {
-    const Vec2 file_point(result.transform.scale * p.x(), (f.mirrored ? -1.0 : 1.0) * result.transform.scale * p.y());
-    result.displacement = std::max(result.displacement, (geometry::Act(result.transform.pose, file_point) - p).norm());
-  }
+  result.displacement = OutlineDisplacement(file_shape, result.transform);
   // The verdict rests on the shape as given alone, not on how much better the best fit is:
   // a better fit can come from samples that were never in contact (a finger sliding past the
   // end of a side makes the side look longer).
