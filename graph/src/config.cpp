@@ -170,6 +170,10 @@ EstimatorConfig ParseEstimatorConfig(const std::string& json_text, const std::st
       if (!it->is_number_integer()) Fail(source, key, "expected an integer");
       cfg.incremental_window_steps = it->get<int>();
       if (cfg.incremental_window_steps < 3) Fail(source, key, "must be >= 3 (the V factors span three steps)");
+    } else if (key == "incremental_window_iterations") {
+      if (!it->is_number_integer()) Fail(source, key, "expected an integer");
+      cfg.incremental_window_iterations = it->get<int>();
+      if (cfg.incremental_window_iterations < 1) Fail(source, key, "must be >= 1");
     } else if (key == "covariance_method") {
       cfg.covariance_method = ParseChoice<EstimatorConfig::CovarianceMethod>(
           *it, source, key, {{"selected_inversion", EstimatorConfig::CovarianceMethod::kSelectedInversion},
@@ -252,6 +256,9 @@ void ValidateConfig(const EstimatorConfig& cfg) {
   }
   if (cfg.incremental_update_every_steps < 0) {
     throw GraphError("config key 'incremental_update_every_steps' must be >= 1 (0: unset)");
+  }
+  if (cfg.incremental_window_iterations < 0) {
+    throw GraphError("config key 'incremental_window_iterations' must be >= 1 (0: unset)");
   }
   if (cfg.incremental_window_steps != 0 && cfg.incremental_window_steps < 3) {
     throw GraphError("config key 'incremental_window_steps' must be >= 3 (0: unset)");

@@ -379,17 +379,52 @@ TEST(ChainSolver, SmoothingPassBringsAShortWindowToTheBatchEstimate) {
   }
 }
 
+// At the sensor rate an update relinearizes its window a bounded number of times (unset
+// incremental_window_iterations: 3, as iSAM2's one step per update bounds an update's time); a
+// step is refined by the ten or more updates it spends in the window, and Finish converges the
+// last window, which no later update refines. The result stays with the uncapped smoother's,
+// the newest steps included.
+TEST(ChainSolver, BoundedWindowSolvesAtTheSensorRateKeepTheResult) {
+  PerStepCase c = MakePerStepCase(0.015, 1.0, 5);
+  EstimatorConfig cfg = c.cfg;
+  ASSERT_EQ(cfg.incremental_window_iterations, 0);  // unset: 3 at the sensor rate
+  const EstimationResult capped = Estimate(c.traj, Model::kQs, Mode::kIncremental, cfg);
+  cfg.incremental_window_iterations = cfg.incremental_max_iterations;
+  const EstimationResult full = Estimate(c.traj, Model::kQs, Mode::kIncremental, cfg);
+  ASSERT_EQ(capped.states.size(), full.states.size());
+  double worst = 0.0, worst_last = 0.0;
+  const std::size_t n = capped.states.size();
+  for (std::size_t k = 0; k < n; ++k) {
+    const double d = (capped.states[k].object_pose.translation() - full.states[k].object_pose.translation()).norm();
+    worst = std::max(worst, d);
+    if (k + 15 >= n) worst_last = std::max(worst_last, d);
+  }
+  const double b = c.batch.metrics.at("object_position_rms"), i = capped.metrics.at("object_position_rms");
+  std::printf("[bounded window solves] %d against %d iterations over %d updates; |capped - uncapped| worst %.4f mm, "
+              "last 15 steps %.4f mm; object RMS %.3f mm (uncapped %.3f, batch %.3f)\n",
+              capped.solver.iterations, full.solver.iterations, capped.solver.updates, 1e3 * worst, 1e3 * worst_last,
+              1e3 * i, 1e3 * full.metrics.at("object_position_rms"), 1e3 * b);
+  // Measured: 2073 against 2612 iterations, worst 0.009 mm, last 15 steps 0.004 mm (0.07 mm when
+  // Finish does not converge the last window).
+  EXPECT_LT(capped.solver.iterations, full.solver.iterations);
+  EXPECT_LT(worst_last, 2e-5);
+  EXPECT_LT(worst, 1e-4);
+  EXPECT_LT(i, 1.05 * b);
+}
+
 TEST(ChainSolver, ConfigSelectsTheSolverAndTheUpdateRate) {
   EXPECT_EQ(ParseEstimatorConfig(R"({"solver": "ceres"})").solver, EstimatorConfig::Solver::kCeres);
   EXPECT_EQ(ParseEstimatorConfig(R"({"solver": "chain"})").solver, EstimatorConfig::Solver::kChain);
   EXPECT_EQ(EstimatorConfig{}.solver, EstimatorConfig::Solver::kChain);
   EXPECT_EQ(ParseEstimatorConfig(R"({"incremental_update_every_steps": 1})").incremental_update_every_steps, 1);
   EXPECT_EQ(ParseEstimatorConfig(R"({"incremental_window_steps": 40})").incremental_window_steps, 40);
+  EXPECT_EQ(ParseEstimatorConfig(R"({"incremental_window_iterations": 5})").incremental_window_iterations, 5);
   EXPECT_TRUE(EstimatorConfig{}.incremental_smoothing);
   EXPECT_FALSE(ParseEstimatorConfig(R"({"incremental_smoothing": false})").incremental_smoothing);
   for (const char* bad : {R"({"solver": "gtsam"})", R"({"incremental_update_every_steps": 0})",
                           R"({"incremental_update_every_steps": 1.5})", R"({"incremental_window_steps": 2})",
-                          R"({"incremental_window_steps": "25"})", R"({"incremental_smoothing": 1})"}) {
+                          R"({"incremental_window_steps": "25"})", R"({"incremental_smoothing": 1})",
+                          R"({"incremental_window_iterations": 0})", R"({"incremental_window_iterations": 2.5})"}) {
     try {
       ParseEstimatorConfig(bad, "cfg.json");
       ADD_FAILURE() << bad;
