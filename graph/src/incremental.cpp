@@ -335,15 +335,16 @@ struct FixedLagSmoother {
   static constexpr int kDefaultWindowStepsAtSensorRate = 15;
 
   // Iterations of an update's window solve after the first (which starts cold and converges).
-  // Unset: 3 at the sensor rate, where a step is refined by every update of its 10 or more in
-  // the window and Finish converges the last window (the result as uncapped on three simulated
-  // pushes, the worst update 2.3-3.0 -> 0.7-1.1 ms); otherwise to convergence: every 5 object
-  // samples a step sees one or two updates, and a leaving step's marginal prior keeps the
-  // linearization point it had (a cap of 3 there: ellip1's QS incremental object RMS 1.25 ->
-  // 1.81 mm on docs/results.md's set).
+  // Unset: 3 where a step spends ten or more updates in the window (the sensor rate with its
+  // default window): each refines it, and Finish re-solves the last window (the result as
+  // uncapped on three simulated pushes, the worst update 2.3-3.0 -> 0.7-1.1 ms). Otherwise to
+  // convergence: every 5 object samples a step sees one or two updates, and a leaving step's
+  // marginal prior keeps the linearization point it had (a cap of 3 there: ellip1's QS
+  // incremental object RMS 1.25 -> 1.81 mm on docs/results.md's set).
   int WindowIterations() const {
     if (cfg.incremental_window_iterations > 0) return cfg.incremental_window_iterations;
-    return cfg.incremental_update_every_steps > 0 ? kDefaultWindowIterationsAtSensorRate : cfg.incremental_max_iterations;
+    const int every = cfg.incremental_update_every_steps;
+    return every > 0 && WindowSteps() >= 10 * every ? kDefaultWindowIterationsAtSensorRate : cfg.incremental_max_iterations;
   }
   static constexpr int kDefaultWindowIterationsAtSensorRate = 3;
 
@@ -419,6 +420,7 @@ struct FixedLagSmoother {
       window_converged = summary.converged;
       chain = std::move(summary.chain);
     }
+    const bool last_window_converged = window_converged;
     Record(rest, chain.get());
     if (cfg.incremental_smoothing) {
       // The window eliminated in time order too, then one backward pass over every conditional.
@@ -440,6 +442,11 @@ struct FixedLagSmoother {
     r.solver.mean_update_time_s = stats.updates > 0 ? update_sum / stats.updates : 0.0;
     builder.DropUnobservableForces(r);
     r.metrics = ComputeMetrics(traj, r.states);
+    if (!last_window_converged) {
+      r.warnings.push_back("incremental: the last window's solve stopped at incremental_max_iterations (" +
+                           std::to_string(cfg.incremental_max_iterations) +
+                           ") without meeting its tolerance; the newest states may not be converged");
+    }
     return r;
   }
 

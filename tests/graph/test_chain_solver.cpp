@@ -381,7 +381,7 @@ TEST(ChainSolver, SmoothingPassBringsAShortWindowToTheBatchEstimate) {
 
 // At the sensor rate an update relinearizes its window a bounded number of times (unset
 // incremental_window_iterations: 3, as iSAM2's one step per update bounds an update's time); a
-// step is refined by the ten or more updates it spends in the window, and Finish converges the
+// step is refined by the ten or more updates it spends in the window, and Finish re-solves the
 // last window, which no later update refines. The result stays with the uncapped smoother's,
 // the newest steps included.
 TEST(ChainSolver, BoundedWindowSolvesAtTheSensorRateKeepTheResult) {
@@ -410,6 +410,35 @@ TEST(ChainSolver, BoundedWindowSolvesAtTheSensorRateKeepTheResult) {
   EXPECT_LT(worst_last, 2e-5);
   EXPECT_LT(worst, 1e-4);
   EXPECT_LT(i, 1.05 * b);
+  // Unset is 3 there: the same bits as 3 set.
+  cfg.incremental_window_iterations = 3;
+  const EstimationResult three = Estimate(c.traj, Model::kQs, Mode::kIncremental, cfg);
+  EXPECT_EQ(three.solver.iterations, capped.solver.iterations);
+  for (std::size_t k = 0; k < n; ++k) ASSERT_EQ(three.states[k].object_pose.vector(), capped.states[k].object_pose.vector()) << k;
+  // Where a step spends fewer than ten updates in the window (every 5 steps, a 15-step window)
+  // unset means uncapped: the same bits as incremental_max_iterations set.
+  cfg.incremental_update_every_steps = 5;
+  cfg.incremental_window_steps = 15;
+  cfg.incremental_window_iterations = 0;
+  const EstimationResult short_unset = Estimate(c.traj, Model::kQs, Mode::kIncremental, cfg);
+  cfg.incremental_window_iterations = cfg.incremental_max_iterations;
+  const EstimationResult short_full = Estimate(c.traj, Model::kQs, Mode::kIncremental, cfg);
+  EXPECT_EQ(short_unset.solver.iterations, short_full.solver.iterations);
+  for (std::size_t k = 0; k < n; ++k) {
+    ASSERT_EQ(short_unset.states[k].object_pose.vector(), short_full.states[k].object_pose.vector()) << k;
+  }
+  // A last window that does not converge within incremental_max_iterations is said so.
+  cfg = c.cfg;
+  cfg.incremental_max_iterations = 1;
+  const EstimationResult starved = Estimate(c.traj, Model::kQs, Mode::kIncremental, cfg);
+  bool warned = false;
+  for (const std::string& w : starved.warnings) {
+    warned = warned || w.find("the last window's solve stopped at incremental_max_iterations (1)") != std::string::npos;
+  }
+  EXPECT_TRUE(warned);
+  bool warned_before = false;
+  for (const std::string& w : capped.warnings) warned_before = warned_before || w.find("the last window's solve") != std::string::npos;
+  EXPECT_FALSE(warned_before);
 }
 
 TEST(ChainSolver, ConfigSelectsTheSolverAndTheUpdateRate) {

@@ -156,14 +156,17 @@ struct EstimatorConfig {
   /// re-solves a short window, and the final smoothing pass (incremental_smoothing) brings the
   /// older states to the batch estimate's accuracy.
   int incremental_window_steps = 0;
-  /// Iteration limit of the new steps' staging, of the first update and of Finish's last window.
+  /// Iteration limit of the new steps' staging and of every window solve (the first update's,
+  /// Finish's re-solve of a last window that stopped at its cap, and every update's unless
+  /// incremental_window_iterations applies).
   int incremental_max_iterations = 50;
-  /// Levenberg-Marquardt iterations of each update's window solve after the first (>= 1): a
-  /// bounded relinearization per update, as iSAM2's, which bounds an update's time; Finish
-  /// converges the last window. 0: unset, which means 3 when incremental_update_every_steps is
-  /// set (a step is refined by the ten or more updates it spends in the window) and
-  /// incremental_max_iterations otherwise (a step spends one or two updates in the window and
-  /// leaves with the linearization point it had: a cap there costs accuracy, docs/estimation.md).
+  /// Levenberg-Marquardt iterations of each update's window solve after the first (>= 1, in
+  /// every mode when set): a bounded relinearization per update, as iSAM2's, which bounds an
+  /// update's time; Finish re-solves the last window when its solve stopped at the cap. 0: unset,
+  /// which means 3 where a step spends ten or more updates in the window (incremental_update_every_steps
+  /// set with the default window) and incremental_max_iterations otherwise (a step that spends
+  /// one or two updates in the window leaves with the linearization point it had: a cap there
+  /// costs accuracy, docs/estimation.md).
   int incremental_window_iterations = 0;
   /// The final result of the incremental mode (Finish()): true (the default) smooths the whole
   /// trajectory backwards through the Gaussian conditionals its steps left when they were
