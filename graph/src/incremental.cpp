@@ -420,7 +420,6 @@ struct FixedLagSmoother {
       window_converged = summary.converged;
       chain = std::move(summary.chain);
     }
-    const bool last_window_converged = window_converged;
     Record(rest, chain.get());
     if (cfg.incremental_smoothing) {
       // The window eliminated in time order too, then one backward pass over every conditional.
@@ -442,7 +441,7 @@ struct FixedLagSmoother {
     r.solver.mean_update_time_s = stats.updates > 0 ? update_sum / stats.updates : 0.0;
     builder.DropUnobservableForces(r);
     r.metrics = ComputeMetrics(traj, r.states);
-    if (!last_window_converged) {
+    if (!window_converged) {
       r.warnings.push_back("incremental: the last window's solve stopped at incremental_max_iterations (" +
                            std::to_string(cfg.incremental_max_iterations) +
                            ") without meeting its tolerance; the newest states may not be converged");
