@@ -7,7 +7,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <utility>
@@ -118,6 +120,18 @@ LossConfig ParseLoss(const Json& j, const std::string& source, const std::string
   return loss;
 }
 
+// nlohmann's get<int>() wraps silently (4294967297 -> 1); an integer key reads through this.
+int GetInt(const Json& j, const std::string& source, const std::string& key) {
+  if (!j.is_number_integer()) Fail(source, key, "expected an integer");
+  const bool fits = j.is_number_unsigned()
+                        ? j.get<std::uint64_t>() <= static_cast<std::uint64_t>(std::numeric_limits<int>::max())
+                        : j.get<std::int64_t>() >= std::numeric_limits<int>::min() &&
+                              j.get<std::int64_t>() <= std::numeric_limits<int>::max();
+  if (!fits) Fail(source, key, "integer " + j.dump() + " out of range (" + std::to_string(std::numeric_limits<int>::min()) +
+                                   " to " + std::to_string(std::numeric_limits<int>::max()) + ")");
+  return static_cast<int>(j.get<std::int64_t>());
+}
+
 void CheckPositive(double v, const std::string& key) {
   if (!(v > 0.0) || !std::isfinite(v)) {
     std::ostringstream text;
@@ -133,7 +147,7 @@ EstimatorConfig ParseEstimatorConfig(const std::string& json_text, const std::st
   Json j;
   try {
     j = Json::parse(json_text);
-  } catch (const Json::parse_error& e) {
+  } catch (const Json::exception& e) {  // syntax errors, and numbers that overflow a double (1e999)
     throw GraphError(source + ": invalid JSON: " + e.what());
   }
   if (const std::string dup = geometry::FindDuplicateJsonKey(json_text); !dup.empty()) throw GraphError(source + ": " + dup);
@@ -148,8 +162,7 @@ EstimatorConfig ParseEstimatorConfig(const std::string& json_text, const std::st
       if (!it->is_number()) Fail(source, key, "expected a number");
       d->second(cfg) = it->get<double>();
     } else if (auto i = ints.find(key); i != ints.end()) {
-      if (!it->is_number_integer()) Fail(source, key, "expected an integer");
-      cfg.*(i->second) = it->get<int>();
+      cfg.*(i->second) = GetInt(*it, source, key);
     } else if (key == "contact_finger") {
       cfg.contact_finger = ParseChoice<EstimatorConfig::ContactFinger>(
           *it, source, key, {{"witness", EstimatorConfig::ContactFinger::kWitness},
@@ -163,16 +176,13 @@ EstimatorConfig ParseEstimatorConfig(const std::string& json_text, const std::st
       cfg.solver = ParseChoice<EstimatorConfig::Solver>(
           *it, source, key, {{"chain", EstimatorConfig::Solver::kChain}, {"ceres", EstimatorConfig::Solver::kCeres}});
     } else if (key == "incremental_update_every_steps") {
-      if (!it->is_number_integer()) Fail(source, key, "expected an integer");
-      cfg.incremental_update_every_steps = it->get<int>();
+      cfg.incremental_update_every_steps = GetInt(*it, source, key);
       if (cfg.incremental_update_every_steps < 1) Fail(source, key, "must be >= 1");
     } else if (key == "incremental_window_steps") {
-      if (!it->is_number_integer()) Fail(source, key, "expected an integer");
-      cfg.incremental_window_steps = it->get<int>();
+      cfg.incremental_window_steps = GetInt(*it, source, key);
       if (cfg.incremental_window_steps < 3) Fail(source, key, "must be >= 3 (the V factors span three steps)");
     } else if (key == "incremental_window_iterations") {
-      if (!it->is_number_integer()) Fail(source, key, "expected an integer");
-      cfg.incremental_window_iterations = it->get<int>();
+      cfg.incremental_window_iterations = GetInt(*it, source, key);
       if (cfg.incremental_window_iterations < 1) Fail(source, key, "must be >= 1");
     } else if (key == "covariance_method") {
       cfg.covariance_method = ParseChoice<EstimatorConfig::CovarianceMethod>(
@@ -238,6 +248,9 @@ EstimatorConfig ApplyMeasurementSigmas(EstimatorConfig cfg, const push::Measurem
   return cfg;
 }
 
+// Noise scales outside these are no measurement (a picometre, a piconewton; 1e12 of either).
+constexpr double kMinNoiseScale = 1e-12, kMaxNoiseScale = 1e12;
+
 void ValidateConfig(const EstimatorConfig& cfg) {
   EstimatorConfig copy = cfg;  // the field accessors take a mutable config
   for (const auto& [key, field] : DoubleFields()) {
@@ -248,6 +261,16 @@ void ValidateConfig(const EstimatorConfig& cfg) {
       }
     } else {
       CheckPositive(v, key);
+    }
+    // A noise scale weighs its factor by 1/sigma^2: 1e-320 passed "> 0" and failed inside the
+    // solver naming a factor, not the key (1/sigma overflows); 1e-300 overflowed the covariances.
+    const bool noise_scale = key.find("sigma") != std::string::npos || key.rfind("accel_", 0) == 0 ||
+                             key.find("random_walk") != std::string::npos;
+    if (noise_scale && !(v >= kMinNoiseScale && v <= kMaxNoiseScale)) {
+      std::ostringstream text;
+      text << v;
+      throw GraphError("config key '" + key + "' is a standard deviation (SI units): must be within [1e-12, 1e12], got " +
+                       text.str());
     }
   }
   for (const auto& [key, member] : LossFields()) CheckPositive((cfg.*member).scale, "losses." + key + ".scale");

@@ -461,8 +461,15 @@ RegistrationResult RegisterShape(const std::vector<const push::Trajectory*>& rec
   // poses to occlusion reached 5 to 6 with the true shape: it is a suspicion, not a verdict.
   result.better_elsewhere = !equivalent && result.identity_cost - result.aligned_cost >= o.misfit_evidence &&
                             result.displacement > o.fit_tolerance;
-  result.fits_as_given = (result.check.fits || equivalent) && result.transform.scale == 1.0 && !f.mirrored;
-  if (result.check.fits && (result.transform.scale != 1.0 || f.mirrored)) {
+  // With estimate_scale the continuous scale of a true shape comes back near, never at, 1 (0.9987
+  // on a simulated push of the notched block): within three sigmas of 1, or moving the outline
+  // by less than the fit tolerance, it is the file's own scale (as align_scale off would judge).
+  const double scale_change = std::abs(result.transform.scale - 1.0);
+  const bool unit_scale = result.transform.scale == 1.0 ||
+                          (f.scale == 1.0 && act.scale &&
+                           (scale_change <= 3.0 * result.scale_sigma || scale_change * file_radius <= o.fit_tolerance));
+  result.fits_as_given = (result.check.fits || equivalent) && unit_scale && !f.mirrored;
+  if (result.check.fits && (!unit_scale || f.mirrored)) {
     result.notes.push_back("the contacts lie on the shape as given, but they fit it better in other units or mirrored");
   }
   // Another explanation of a misfit: the shape as given with the finger larger or smaller (a

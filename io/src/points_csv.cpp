@@ -1,5 +1,6 @@
 // Points CSV files and comma-separated number lists (header points_csv.h).
 #include <pushgraph/io/points_csv.h>
+#include <pushgraph/geometry/types.h>
 
 #include <pushgraph/io/errors.h>
 
@@ -92,6 +93,13 @@ std::vector<geometry::Vec2> ParsePointsCsv(const std::string& text, const std::s
       v = ParseNumberList(item, 2, "point");
     } catch (const IoError& e) {
       throw IoError(where + ": " + e.what());
+    }
+    // The queries' own limit, checked here where the line is known.
+    if (std::abs(v[0]) > geometry::kMaxQueryCoordinate || std::abs(v[1]) > geometry::kMaxQueryCoordinate) {
+      std::ostringstream text;
+      text << where << ": point (" << v[0] << ", " << v[1] << ") is outside the supported range +-"
+           << geometry::kMaxQueryCoordinate << " (docs/geometry.md, Limits)";
+      throw IoError(text.str());
     }
     points.emplace_back(v[0], v[1]);
   }

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <map>
 #include <string>
@@ -211,14 +212,33 @@ SimulationResult Simulate(const PushPlan& plan) {
 
   const double path_length = PathLength(plan.waypoints);
   const double duration = plan.duration > 0.0 ? plan.duration : path_length / plan.speed;
+  // Bounds checked in doubles before any count is cast (a 1e17 m push overflowed the cast and
+  // passed the sample check, then integrated forever). A state costs about 1.5 kB: 1e6 samples of
+  // one stream (66 min at 250 Hz) is 1.5 GB; 1e8 integration steps take minutes.
+  constexpr double kMaxStreamSamples = 1e6, kMaxIntegrationSteps = 1e8;
+  const double step_time = std::min(plan.internal_step, plan.max_step_length / plan.speed);
+  if (!(duration / step_time <= kMaxIntegrationSteps)) {
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "PushPlan: a %.3g s push in steps of %.3g s is more than 1e8 integration steps (shorten the push or "
+                  "enlarge internal_step / max_step_length)",
+                  duration, step_time);
+    throw PushError(text);
+  }
 
   // Sample times of every stream: t_k = k / rate, exact doubles shared by the integrator.
   enum : unsigned { kObject = 1, kFinger = 2, kContact = 4, kForce = 8 };
   std::map<double, unsigned> samples;
   auto add_stream = [&](double rate, unsigned bit) {
     if (rate <= 0.0) return;
-    const long long count = static_cast<long long>(std::floor(duration * rate + 1e-9));
-    if (count > 10000000) throw PushError("PushPlan.rates: more than 1e7 samples in one stream");
+    const double samples_in_stream = std::floor(duration * rate + 1e-9);
+    if (!(samples_in_stream <= kMaxStreamSamples)) {
+      char text[200];
+      std::snprintf(text, sizeof text, "PushPlan.rates: a %.3g s push at %.3g Hz is more than 1e6 samples in one stream",
+                    duration, rate);
+      throw PushError(text);
+    }
+    const long long count = static_cast<long long>(samples_in_stream);
     for (long long k = 0; k <= count; ++k) samples[std::min(duration, static_cast<double>(k) / rate)] |= bit;
   };
   add_stream(plan.rates.object_pose, kObject);
@@ -289,7 +309,6 @@ SimulationResult Simulate(const PushPlan& plan) {
     record(0.0, next_sample->second);
     ++next_sample;
   }
-  const double step_time = std::min(plan.internal_step, plan.max_step_length / plan.speed);
   while (t < duration) {
     double t_next = std::min(t + step_time, duration);
     bool at_sample = false;

@@ -463,5 +463,26 @@ TEST(ChainSolver, ConfigSelectsTheSolverAndTheUpdateRate) {
   }
 }
 
+// An integer key's value outside int's range is an error naming the key, not a silent wrap
+// (4294967297 read as 1 would cap every solve at one iteration).
+TEST(ChainSolver, ConfigIntegersOutOfRangeAreErrors) {
+  EXPECT_EQ(ParseEstimatorConfig(R"({"max_iterations": 2147483647})").max_iterations, 2147483647);
+  for (const std::string key : {"max_iterations", "incremental_window", "incremental_update_every",
+                                "incremental_max_iterations", "incremental_update_every_steps",
+                                "incremental_window_steps", "incremental_window_iterations"}) {
+    for (const std::string value : {"4294967297", "2147483648", "18446744073709551615", "-4294967295"}) {
+      const std::string text = "{\"" + key + "\": " + value + "}";
+      try {
+        ParseEstimatorConfig(text, "cfg.json");
+        ADD_FAILURE() << text;
+      } catch (const GraphError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("cfg.json: config key '" + key + "'"), std::string::npos) << what;
+        EXPECT_NE(what.find("out of range"), std::string::npos) << what;
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace pushgraph::graph

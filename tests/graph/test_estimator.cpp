@@ -58,6 +58,15 @@ TEST(Estimator, ConfigParsingNamesBadKeys) {
   EXPECT_NE(message(R"({"force_sigma": 0.5, "force_sigma": 5})").find("cfg.json: duplicate key \"force_sigma\""),
             std::string::npos);
   EXPECT_NE(message(R"({"force_sigma": -1})").find("force_sigma"), std::string::npos);
+  // Noise scales a factor cannot be weighed by: named here, not as a factor failing in the solver.
+  for (const char* text : {R"({"force_sigma": 1e-320})", R"({"accel_trans": 1e-13})", R"({"random_walk_rot": 1e13})",
+                           R"({"contact_sigma": 1e-300})"}) {
+    const std::string m = message(text);
+    EXPECT_NE(m.find("is a standard deviation"), std::string::npos) << text << ": " << m;
+  }
+  EXPECT_EQ(ParseEstimatorConfig(R"({"force_prior_sigma": 1e6, "accel_trans": 1e-9})").force_prior_sigma, 1e6);
+  // A number a double cannot hold is malformed JSON of this file, not an anonymous library error.
+  EXPECT_NE(message(R"({"force_sigma": 1e999})").find("cfg.json: invalid JSON"), std::string::npos);
   EXPECT_NE(message(R"({"losses": {"force": {"type": "tukey"}}})").find("tukey"), std::string::npos);
   EXPECT_NE(message(R"({"max_iterations": 2.5})").find("max_iterations"), std::string::npos);
   EXPECT_NE(message("{").find("cfg.json"), std::string::npos);
@@ -79,6 +88,23 @@ TEST(Estimator, ConfigParsingNamesBadKeys) {
   const EstimatorConfig over = ParseEstimatorConfig(R"({"force_sigma": 0.5})", "cfg.json", base);
   EXPECT_EQ(over.measurement.force, 0.5);
   EXPECT_EQ(over.measurement.object_trans, 0.007);
+}
+
+// Ground truth on another clock scores nothing, and the estimate says why.
+TEST(Estimator, GroundTruthThatSharesNoTimeIsNamed) {
+  push::Trajectory t = GeneratePush(OffsetPush(3, 0.5));
+  ASSERT_TRUE(t.ground_truth.has_value());
+  EXPECT_FALSE(Estimate(t, Model::kCp, Mode::kBatch).metrics.empty());
+  for (auto* stream : {&t.ground_truth->object_pose, &t.ground_truth->finger_pose}) {
+    for (auto& sample : *stream) sample.t += 100.0;
+  }
+  for (auto& sample : t.ground_truth->contact_point) sample.t += 100.0;
+  for (auto& sample : t.ground_truth->force) sample.t += 100.0;
+  const EstimationResult r = Estimate(t, Model::kCp, Mode::kBatch);
+  EXPECT_TRUE(r.metrics.empty());
+  bool named = false;
+  for (const std::string& w : r.warnings) named = named || w.find("shares no time with the estimate") != std::string::npos;
+  EXPECT_TRUE(named) << (r.warnings.empty() ? "no warning" : r.warnings[0]);
 }
 
 // Joint estimation of c: started 40% too high, the estimate moves towards the value of the

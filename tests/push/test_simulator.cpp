@@ -285,6 +285,29 @@ TEST(Simulator, BadPlansNameTheField) {
   EXPECT_THROW(StraightPushPath(plan, 0.0, 0.2, 0.005, 0.01), PushError);  // line misses
   plan.waypoints = {Vec2(0.0, 0.0), Vec2(0.01, 0.0)};  // starts inside the object
   EXPECT_THROW(Simulate(plan), PushError);
+  // Pushes too long to hold or to integrate are refused up front, not run out of memory or
+  // forever (1e20 s once overflowed the sample count's cast and passed its check).
+  auto expect_refused = [](const PushPlan& p, const std::string& text) {
+    try {
+      Simulate(p);
+      ADD_FAILURE() << "no exception, expected " << text;
+    } catch (const PushError& e) {
+      EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
+    }
+  };
+  for (double duration : {1e20, 1e9}) {
+    plan = SquarePlan(0.3, 0.0);
+    plan.duration = duration;
+    expect_refused(plan, "more than 1e8 integration steps");
+  }
+  plan = SquarePlan(0.3, 0.0);
+  plan.duration = 20000.0;  // 5e6 samples at 250 Hz
+  plan.internal_step = 1.0;
+  plan.max_step_length = 1e3;
+  expect_refused(plan, "more than 1e6 samples in one stream");
+  plan = SquarePlan(0.3, 0.0);
+  plan.internal_step = 1e-12;
+  expect_refused(plan, "more than 1e8 integration steps");
 }
 
 // ---- noise models ----------------------------------------------------------------------------

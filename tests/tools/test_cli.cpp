@@ -72,6 +72,11 @@ TEST_F(CliTest, DistanceBadInputNamesFileAndLine) {
   EXPECT_NE(r.err.find("bad.csv:3"), std::string::npos) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "one line on stderr: " << r.err;
 
+  r = Exec("distance " + shape + " " + Write("far.csv", "x,y\n1,2\n\n1e300,0\n"));  // beyond the queries' range
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("far.csv:4"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("outside the supported range"), std::string::npos) << r.err;
+
   r = Exec("distance " + shape + " " + Write("nohdr.csv", "1,2\n"));
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find("nohdr.csv:1"), std::string::npos) << r.err;
