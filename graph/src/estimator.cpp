@@ -219,6 +219,18 @@ std::string AlignedText(const RegistrationResult& registration, const ShapeAlign
     // for the true shape. Estimates stay close to the data either way; the frame is what is open.
     s += "; ambiguous: " + registration.ambiguity + ": this recording does not settle the placement, check the shape file's frame";
   }
+  // Contacts along one side fix the placement across it only: rect1's mesh at twice its size, or
+  // rect3's, was "aligned" on a rect1 recording with contact gaps of 0.14 mm, as the true mesh.
+  if (!registration.weak_directions.empty()) {
+    s += "; the contacts do not fix its position along";
+    for (std::size_t k = 0; k < registration.weak_directions.size(); ++k) {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "%s (%.2f, %.2f)", k == 0 ? "" : " or", registration.weak_directions[k].x(),
+                    registration.weak_directions[k].y());
+      s += buf;
+    }
+    s += " (a prior on the centroid does), and a shape of another size or object would fit them as well";
+  }
   s += " (to save it: pushgraph footprint SHAPE_FILE " + TransformText(t);
   const bool turn_within = !alignment.rotation_observable || std::abs(t.pose.theta) <= 3.0 * sigma.z();
   const bool shift_within = std::abs(t.pose.x) <= 3.0 * sigma.x() && std::abs(t.pose.y) <= 3.0 * sigma.y();

@@ -8,8 +8,11 @@
 #include <pushgraph/io/footprint.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <string>
+#include <utility>
 
 namespace pushgraph::cli {
 
@@ -71,8 +74,22 @@ void RegisterFootprint(CLI::App& app) {
     const geometry::Box2 box = shape.bounds();
     const double across = std::max(box.max.x() - box.min.x(), box.max.y() - box.min.y());
     if (across > 2.0 || across < 1e-3) {
+      // The units that would make it 1 cm to 1 m across (a centimetre mesh was told "millimetres").
+      std::string units;
+      if (across > 2.0) {
+        for (const auto& [name, scale] : {std::pair<const char*, double>{"millimetres", 1e-3}, {"centimetres", 1e-2},
+                                          {"inches", 0.0254}}) {
+          if (across * scale < 0.01 || across * scale > 1.0) continue;
+          char text[120];
+          std::snprintf(text, sizeof text, "%s%s (--scale %g: %.3g m across)", units.empty() ? "" : " or ", name, scale,
+                        across * scale);
+          units += text;
+        }
+      }
       std::cerr << "footprint: warning: the shape is " << FormatDouble(across) << " m across: shapes are in metres ("
-                << (across > 2.0 ? "is the file in millimetres? --scale 0.001" : "was it scaled twice, or is it in other units?")
+                << (across > 2.0 ? (units.empty() ? std::string("is it in other units? --scale converts")
+                                                   : "is the file in " + units + "?")
+                                 : std::string("was it scaled twice, or is it in other units?"))
                 << ")\n";
     }
     if (!args->quiet && !json) {
