@@ -231,10 +231,18 @@ EstimatorConfig LoadEstimatorConfig(const std::string& path, const EstimatorConf
   return ParseEstimatorConfig(ss.str(), path, base);
 }
 
+// Noise scales outside these are no measurement (a picometre, a piconewton; 1e12 of either).
+constexpr double kMinNoiseScale = 1e-12, kMaxNoiseScale = 1e12;
+
 EstimatorConfig ApplyMeasurementSigmas(EstimatorConfig cfg, const push::MeasurementSigmas& s) {
   auto floor_at = [](double sigma, double least, const char* what) {
     if (!std::isfinite(sigma) || sigma < 0.0) {
       throw GraphError(std::string("measurement_sigmas.") + what + " must be finite and >= 0");
+    }
+    if (sigma > kMaxNoiseScale) {  // named here, not as a config key in ValidateConfig
+      std::ostringstream text;
+      text << sigma;
+      throw GraphError(std::string("measurement_sigmas.") + what + " must be at most 1e12, got " + text.str());
     }
     return std::max(sigma, least);
   };
@@ -247,9 +255,6 @@ EstimatorConfig ApplyMeasurementSigmas(EstimatorConfig cfg, const push::Measurem
   m.force = floor_at(s.force, 1e-3, "force");
   return cfg;
 }
-
-// Noise scales outside these are no measurement (a picometre, a piconewton; 1e12 of either).
-constexpr double kMinNoiseScale = 1e-12, kMaxNoiseScale = 1e12;
 
 void ValidateConfig(const EstimatorConfig& cfg) {
   EstimatorConfig copy = cfg;  // the field accessors take a mutable config
@@ -269,7 +274,7 @@ void ValidateConfig(const EstimatorConfig& cfg) {
     if (noise_scale && !(v >= kMinNoiseScale && v <= kMaxNoiseScale)) {
       std::ostringstream text;
       text << v;
-      throw GraphError("config key '" + key + "' is a standard deviation (SI units): must be within [1e-12, 1e12], got " +
+      throw GraphError("config key '" + key + "' is a noise scale (in its own units): must be within [1e-12, 1e12], got " +
                        text.str());
     }
   }

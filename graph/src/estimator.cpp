@@ -222,7 +222,7 @@ std::string AlignedText(const RegistrationResult& registration, const ShapeAlign
   // Contacts along one side fix the placement across it only: rect1's mesh at twice its size, or
   // rect3's, was "aligned" on a rect1 recording with contact gaps of 0.14 mm, as the true mesh.
   if (!registration.weak_directions.empty()) {
-    s += "; the contacts do not fix its position along";
+    s += "; the contacts do not fix its position along (object frame)";
     for (std::size_t k = 0; k < registration.weak_directions.size(); ++k) {
       char buf[64];
       std::snprintf(buf, sizeof buf, "%s (%.2f, %.2f)", k == 0 ? "" : " or", registration.weak_directions[k].x(),
@@ -698,18 +698,35 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
         internal::Diagnose(*working, model, config, result, frame_state ? &*frame_state : nullptr, querier);
     for (const std::string& cause : result.diagnostics->causes) warnings.push_back("diagnostics: " + cause);
   }
-  // Ground truth that shares no time with the estimate scores nothing: said, not left as a
-  // missing "metrics" (a file whose truth was shifted by 100 s, or streams in another clock).
+  // Ground truth that scores nothing is said, not left as a missing "metrics": a file whose truth
+  // was shifted by 100 s (no shared time), or truth too sparse or off the estimate's clock to be
+  // read at its times (scoring.h: a sample within 1e-9 s, or two within 0.1 s to interpolate).
   if (trajectory.ground_truth && result.metrics.empty() && !result.states.empty()) {
     const push::Streams& gt = *trajectory.ground_truth;
-    if (!gt.object_pose.empty() || !gt.finger_pose.empty()) {
-      const auto& poses = gt.object_pose.empty() ? gt.finger_pose : gt.object_pose;
+    double first = INFINITY, last = -INFINITY;
+    auto span = [&](const auto& stream) {
+      if (stream.empty()) return;
+      first = std::min(first, stream.front().t);
+      last = std::max(last, stream.back().t);
+    };
+    span(gt.object_pose);
+    span(gt.finger_pose);
+    span(gt.contact_point);
+    span(gt.force);
+    if (first <= last) {
+      const double t0 = result.states.front().t, t1 = result.states.back().t;
       char text[400];
-      std::snprintf(text, sizeof text,
-                    "the trajectory's ground truth (%s poses at t = %.9g to %.9g s) shares no time with the estimate "
-                    "(t = %.9g to %.9g s): no metrics (are they on one clock?)",
-                    gt.object_pose.empty() ? "finger" : "object", poses.front().t, poses.back().t,
-                    result.states.front().t, result.states.back().t);
+      if (last < t0 || first > t1) {
+        std::snprintf(text, sizeof text,
+                      "the trajectory's ground truth (t = %.9g to %.9g s) shares no time with the estimate (t = %.9g to "
+                      "%.9g s): no metrics (are they on one clock?)",
+                      first, last, t0, t1);
+      } else {
+        std::snprintf(text, sizeof text,
+                      "the trajectory's ground truth (t = %.9g to %.9g s) could not be read at any of the estimate's "
+                      "times (a sample within 1e-9 s, or two at most 0.1 s apart around it): no metrics",
+                      first, last);
+      }
       warnings.push_back(text);
     }
   }

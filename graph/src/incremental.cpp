@@ -2,7 +2,7 @@
 
 #include <pushgraph/graph/incremental.h>
 
-#include <Eigen/Eigenvalues>
+#include <Eigen/QR>
 
 #include <algorithm>
 #include <deque>
@@ -99,27 +99,9 @@ struct StepConditional {
   std::vector<int> removed_sizes, separator_sizes;
   Eigen::VectorXd removed_lin, separator_lin;
   Eigen::MatrixXd G;       // removed_dim x separator_dim
-  // The conditional's square-root information: rows sqrt(lambda_i) u_i^T of H_rr's eigenpairs
-  // (only when covariances are wanted; rank-revealing like the marginal prior).
+  // The conditional's square-root information, S^T S = H_rr (only when covariances are wanted;
+  // rank-revealing like the marginal prior).
   Eigen::MatrixXd S;
-};
-
-// The eigen-decomposition of D^-1 H D^-1, D = sqrt(diag H) (zero diagonal entries scaled by 1):
-// eigenvalues relative to each unknown's own scale, so rank decisions do not depend on units.
-struct JacobiScaled {
-  Eigen::VectorXd d, d_inv, eigenvalues;
-  Eigen::MatrixXd eigenvectors;
-  double max_eigenvalue = 0.0;
-  explicit JacobiScaled(const Eigen::MatrixXd& H) {
-    d = H.diagonal().cwiseMax(0.0).cwiseSqrt();
-    for (Eigen::Index i = 0; i < d.size(); ++i)
-      if (!(d[i] > 0.0)) d[i] = 1.0;
-    d_inv = d.cwiseInverse();
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(d_inv.asDiagonal() * H * d_inv.asDiagonal());
-    eigenvalues = solver.eigenvalues();
-    eigenvectors = solver.eigenvectors();
-    max_eigenvalue = eigenvalues.size() > 0 ? std::max(eigenvalues.maxCoeff(), 1e-300) : 1e-300;
-  }
 };
 
 // The fixed-lag smoother both front ends drive: steps join at updates, the window is re-solved,
@@ -230,8 +212,10 @@ struct FixedLagSmoother {
       }
       rb_params.push_back(ps);
     }
-    Eigen::MatrixXd H = Eigen::MatrixXd::Zero(dim, dim);
-    Eigen::VectorXd b = Eigen::VectorXd::Zero(dim);
+    // The factors' whitened Jacobians stacked, [A | r] (rows of every factor; the robust loss as
+    // the solver weighs it, sqrt(rho')), the removed step's columns first.
+    std::vector<Eigen::MatrixXd> stacked;
+    int rows = 0;
     std::size_t k = 0;
     for (ceres::ResidualBlockId id : rbs) {
       const std::vector<double*>& ps = rb_params[k++];
@@ -252,10 +236,11 @@ struct FixedLagSmoother {
         loss->Evaluate(r.squaredNorm(), rho);
         scale = std::sqrt(std::max(rho[1], 0.0));
       }
-      Eigen::MatrixXd Jf = Eigen::MatrixXd::Zero(m, dim);
-      for (std::size_t q = 0; q < ps.size(); ++q) Jf.middleCols(offset[ps[q]], J[q].cols()) += scale * J[q];
-      H.noalias() += Jf.transpose() * Jf;
-      b.noalias() += Jf.transpose() * (scale * r);
+      Eigen::MatrixXd block = Eigen::MatrixXd::Zero(m, dim + 1);
+      for (std::size_t q = 0; q < ps.size(); ++q) block.middleCols(offset[ps[q]], J[q].cols()) += scale * J[q];
+      block.col(dim) = scale * r;
+      rows += m;
+      stacked.push_back(std::move(block));
     }
     // Remove the step: its residual blocks in the order above first (RemoveParameterBlock would
     // remove them in hash-set order, and fast removal moves the problem's last block into each
@@ -266,18 +251,36 @@ struct FixedLagSmoother {
     }
     for (double* p : removed) problem->RemoveParameterBlock(p);
     const int sep_dim = dim - removed_dim;
-    // Rank decisions on the Jacobi-scaled matrix D^-1 H D^-1 (D = sqrt(diag H)): relative to the
-    // largest eigenvalue of H itself they depended on the units, and a direction held only by a
-    // weak prior (a force at its 100 N prior, 1e-4 against 4e6 for a contact point at 0.5 mm)
-    // fell below the cutoff and was dropped: the smoothed covariances of a flat pusher's line
-    // contact then failed as rank deficient.
-    const JacobiScaled er(H.topLeftCorner(removed_dim, removed_dim));
-    Eigen::VectorXd inv = er.eigenvalues;
-    for (int i = 0; i < inv.size(); ++i) inv[i] = inv[i] > 1e-12 * er.max_eigenvalue ? 1.0 / inv[i] : 0.0;
-    // H_rr^+ = D^-1 U diag(inv) U^T D^-1.
-    const Eigen::MatrixXd U_rr = er.d_inv.asDiagonal() * er.eigenvectors;
-    const Eigen::MatrixXd Hrr_inv = U_rr * inv.asDiagonal() * U_rr.transpose();
-    const Eigen::MatrixXd Hsr = H.bottomLeftCorner(sep_dim, removed_dim);
+    Eigen::MatrixXd A(rows, dim + 1);
+    rows = 0;
+    for (const Eigen::MatrixXd& block : stacked) {
+      A.middleRows(rows, block.rows()) = block;
+      rows += static_cast<int>(block.rows());
+    }
+    // Elimination in square-root form (the Jacobian's QR, as GTSAM eliminates Jacobian factors;
+    // M. Kaess et al., "iSAM: Incremental Smoothing and Mapping", T-RO 2008): the marginal prior's
+    // information T2^T T2 is positive semidefinite by construction. The Schur complement of
+    // J^T J it replaces (H_ss - H_sr H_rr^+ H_rs) squared the removed block's condition number:
+    // on docs/results.md's recordings 20 of 25000 priors came out indefinite beyond 1e-6 of their
+    // largest eigenvalue, the worst -0.75 against 12.7 (the negative part dropped, the rest
+    // rounding). Columns scaled to unit norm (D = the column norms, sqrt(diag J^T J)) so that the
+    // rank decisions do not depend on units: relative to the largest entry of the unscaled
+    // factor, a direction held only by a weak prior (a force at its 100 N prior against a contact
+    // point at 0.5 mm) fell below the cutoff and a flat pusher's smoothed covariances failed.
+    Eigen::VectorXd d(dim);
+    for (int j = 0; j < dim; ++j) {
+      d[j] = A.col(j).norm();
+      if (!(d[j] > 0.0)) d[j] = 1.0;
+      A.col(j) /= d[j];
+    }
+    // The removed step's columns: Q^T A_r P = [R11 R12; 0 0], rank k where |R_ii| falls below
+    // 1e-6 of the largest (the square root of the eigenvalue cutoff 1e-12 used before).
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> removed_qr(A.leftCols(removed_dim));
+    removed_qr.setThreshold(kRemovedRankCutoff);
+    const int rank = static_cast<int>(removed_qr.rank());
+    Eigen::MatrixXd rest = A.rightCols(sep_dim + 1);  // [A_s | r], rotated by Q^T below
+    rest.applyOnTheLeft(removed_qr.householderQ().transpose());
+    const Eigen::MatrixXd R = removed_qr.matrixR().topRows(rank).triangularView<Eigen::Upper>();  // rank x removed_dim
     const std::vector<double*> sep(order.begin() + removed.size(), order.end());
     const std::vector<int> sep_sizes(order_sizes.begin() + removed.size(), order_sizes.end());
     const Eigen::VectorXd x_bar = Values(sep, sep_sizes);  // the separator's linearization point
@@ -290,38 +293,34 @@ struct FixedLagSmoother {
       c.separator_sizes = sep_sizes;
       c.removed_lin = Values(c.removed, c.removed_sizes);
       c.separator_lin = x_bar;
-      c.G = -Hrr_inv * Hsr.transpose();
-      if (cfg.covariance) {
-        std::vector<int> informative;
-        for (int i = 0; i < removed_dim; ++i) if (inv[i] > 0.0) informative.push_back(i);
-        c.S.resize(static_cast<Eigen::Index>(informative.size()), removed_dim);
-        // H_rr = (D U) diag(lambda) (D U)^T: rows sqrt(lambda_i) (D u_i)^T.
-        for (std::size_t i = 0; i < informative.size(); ++i) {
-          c.S.row(static_cast<Eigen::Index>(i)) = std::sqrt(er.eigenvalues[informative[i]]) *
-                                                   (er.d.asDiagonal() * er.eigenvectors.col(informative[i])).transpose();
-        }
+      // R11 (P^T D_r dx_r)_1 + T1 D_s dx_s = 0 on the first `rank` rows; the directions beyond
+      // the rank (no factor holds them) do not move: G = -D_r^-1 P [R11^-1 T1; 0] D_s.
+      Eigen::MatrixXd G_scaled = Eigen::MatrixXd::Zero(removed_dim, sep_dim);
+      if (rank > 0 && sep_dim > 0) {
+        G_scaled.topRows(rank) =
+            -R.leftCols(rank).triangularView<Eigen::Upper>().solve(rest.topLeftCorner(rank, sep_dim));
       }
+      c.G = d.head(removed_dim).cwiseInverse().asDiagonal() * (removed_qr.colsPermutation() * G_scaled) *
+            d.segment(removed_dim, sep_dim).asDiagonal();
+      // S^T S = H_rr: S = [R11 R12] P^T D_r.
+      if (cfg.covariance) c.S = (R * removed_qr.colsPermutation().transpose()) * d.head(removed_dim).asDiagonal();
       conditionals.push_back(std::move(c));
     }
-    if (sep_dim == 0) return nullptr;
-    const Eigen::MatrixXd Hm = H.bottomRightCorner(sep_dim, sep_dim) - Hsr * Hrr_inv * Hsr.transpose();
-    const Eigen::VectorXd bm = b.tail(sep_dim) - Hsr * Hrr_inv * b.head(removed_dim);
-    const JacobiScaled es(0.5 * (Hm + Hm.transpose()));
-    std::vector<int> keep;
-    for (int i = 0; i < sep_dim; ++i)
-      if (es.eigenvalues[i] > 1e-10 * es.max_eigenvalue && es.eigenvalues[i] > 0) keep.push_back(i);
-    if (keep.empty()) return nullptr;
-    // Hm = (D U) diag(lambda) (D U)^T: S rows sqrt(lambda) (D u)^T, and S^T r0 = bm on them.
-    Eigen::MatrixXd S(keep.size(), sep_dim);
-    Eigen::VectorXd r0(keep.size());
-    for (std::size_t i = 0; i < keep.size(); ++i) {
-      const double lambda = es.eigenvalues[keep[i]];
-      const Eigen::VectorXd u = es.eigenvectors.col(keep[i]);
-      S.row(i) = std::sqrt(lambda) * (es.d.asDiagonal() * u).transpose();
-      r0[i] = u.dot(es.d_inv.asDiagonal() * bm) / std::sqrt(lambda);
-    }
-    return problem->AddResidualBlock(new MarginalPriorFactor(sep_sizes, x_bar, S, r0), nullptr, sep);
+    if (sep_dim == 0 || rows <= rank) return nullptr;
+    // The rows below the rank hold the separator alone: T2 dx_s + c2. Compressed to at most
+    // sep_dim rows by a second QR, rank-revealing at 1e-5 (the eigenvalue cutoff 1e-10 before).
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> separator_qr(rest.bottomLeftCorner(rows - rank, sep_dim));
+    separator_qr.setThreshold(kSeparatorRankCutoff);
+    const int kept = static_cast<int>(separator_qr.rank());
+    if (kept == 0) return nullptr;
+    const Eigen::VectorXd c2 = separator_qr.householderQ().transpose() * rest.bottomRightCorner(rows - rank, 1);
+    // The prior 1/2 |S (x - x_bar) + r0|^2: S = R2 P2^T D_s, r0 = (Q2^T c2) on the kept rows.
+    const Eigen::MatrixXd R2 = separator_qr.matrixR().topRows(kept).triangularView<Eigen::Upper>();
+    Eigen::MatrixXd S = (R2 * separator_qr.colsPermutation().transpose()) * d.segment(removed_dim, sep_dim).asDiagonal();
+    Eigen::VectorXd r0 = c2.head(kept);
+    return problem->AddResidualBlock(new MarginalPriorFactor(sep_sizes, x_bar, std::move(S), std::move(r0)), nullptr, sep);
   }
+  static constexpr double kRemovedRankCutoff = 1e-6, kSeparatorRankCutoff = 1e-5;
 
   // The window's length in steps (0: in time, window_duration).
   int WindowSteps() const {

@@ -469,6 +469,14 @@ RegistrationResult RegisterShape(const std::vector<const push::Trajectory*>& rec
                           (f.scale == 1.0 && act.scale &&
                            (scale_change <= 3.0 * result.scale_sigma || scale_change * file_radius <= o.fit_tolerance));
   result.fits_as_given = (result.check.fits || equivalent) && unit_scale && !f.mirrored;
+  if (unit_scale && result.transform.scale != 1.0) {
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "a scale of %.5g (sigma %.2g) fits the contacts slightly better; it moves the outline by less than the "
+                  "fit tolerance or lies within three sigmas of 1, and is not applied",
+                  result.transform.scale, result.scale_sigma);
+    result.notes.push_back(text);
+  }
   if (result.check.fits && (!unit_scale || f.mirrored)) {
     result.notes.push_back("the contacts lie on the shape as given, but they fit it better in other units or mirrored");
   }

@@ -158,6 +158,7 @@ TEST(Alignment, MisframedShapesAreAlignedAndEstimatedAsWellAsTheTrueOne) {
   std::printf("[alignment] %d aligned as ambiguous, %d with a direction the contacts do not fix\n", ambiguous_count,
               weak_count);
   EXPECT_GT(ambiguous_count, 0);  // the checks above ran
+  EXPECT_GT(weak_count, 0);
   std::printf("[alignment] %d cases: %d flagged with alignment off, %d aligned; median outline error %.2f mm, median object "
               "RMS / true-shape RMS %.3f (alignment off: %.2f), worst ratio %.3f\n",
               cases, flagged, aligned_count, Median(outlines) * 1e3, Median(ratios), Median(off_ratios),

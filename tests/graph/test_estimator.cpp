@@ -62,7 +62,7 @@ TEST(Estimator, ConfigParsingNamesBadKeys) {
   for (const char* text : {R"({"force_sigma": 1e-320})", R"({"accel_trans": 1e-13})", R"({"random_walk_rot": 1e13})",
                            R"({"contact_sigma": 1e-300})"}) {
     const std::string m = message(text);
-    EXPECT_NE(m.find("is a standard deviation"), std::string::npos) << text << ": " << m;
+    EXPECT_NE(m.find("is a noise scale"), std::string::npos) << text << ": " << m;
   }
   EXPECT_EQ(ParseEstimatorConfig(R"({"force_prior_sigma": 1e6, "accel_trans": 1e-9})").force_prior_sigma, 1e6);
   // A number a double cannot hold is malformed JSON of this file, not an anonymous library error.
@@ -105,6 +105,25 @@ TEST(Estimator, GroundTruthThatSharesNoTimeIsNamed) {
   bool named = false;
   for (const std::string& w : r.warnings) named = named || w.find("shares no time with the estimate") != std::string::npos;
   EXPECT_TRUE(named) << (r.warnings.empty() ? "no warning" : r.warnings[0]);
+  // Truth over the same time but too sparse, off the estimate's clock, to be read at its times.
+  push::Trajectory sparse = GeneratePush(OffsetPush(3, 0.5));
+  auto thin = [](auto* stream) {
+    std::remove_reference_t<decltype(*stream)> kept;
+    for (std::size_t i = 0; i < stream->size(); i += 50) {
+      kept.push_back((*stream)[i]);
+      kept.back().t += 0.002;
+    }
+    *stream = kept;
+  };
+  thin(&sparse.ground_truth->object_pose);
+  thin(&sparse.ground_truth->finger_pose);
+  thin(&sparse.ground_truth->contact_point);
+  thin(&sparse.ground_truth->force);
+  const EstimationResult s = Estimate(sparse, Model::kCp, Mode::kBatch);
+  ASSERT_TRUE(s.metrics.empty()) << s.metrics.size() << " metrics";
+  named = false;
+  for (const std::string& w : s.warnings) named = named || w.find("could not be read at any of the estimate's times") != std::string::npos;
+  EXPECT_TRUE(named) << (s.warnings.empty() ? "no warning" : s.warnings[0]);
 }
 
 // Joint estimation of c: started 40% too high, the estimate moves towards the value of the

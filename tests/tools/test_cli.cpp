@@ -274,10 +274,12 @@ TEST_F(CliTest, OutputsThatAreInputsAreRefusedAndInputsKept) {
   const ToolRun millimetres = Exec("footprint " + shape + " --transform 20,0,0 -o " + (dir_ / "t4.json").string() + " -q");
   EXPECT_NE(millimetres.err.find("taken as metres"), std::string::npos) << millimetres.err;
   const ToolRun huge = Exec("footprint " + shape + " --scale 1000 -o " + (dir_ / "t5.json").string() + " -q");
-  EXPECT_NE(huge.err.find("is the file in millimetres (--scale 0.001"), std::string::npos) << huge.err;
+  // The suggestion is relative to the file: here the --scale given was the error.
+  EXPECT_NE(huge.err.find("is the file in millimetres (--scale 1 in place of the --scale given"), std::string::npos)
+      << huge.err;
   // A shape 100 times too large: the units that make it 1 cm to 1 m across, centimetres among them.
   const ToolRun centimetres = Exec("footprint " + shape + " --scale 100 -o " + (dir_ / "t6.json").string() + " -q");
-  EXPECT_NE(centimetres.err.find("centimetres (--scale 0.01"), std::string::npos) << centimetres.err;
+  EXPECT_NE(centimetres.err.find("centimetres (--scale 1 in place"), std::string::npos) << centimetres.err;
 }
 
 TEST_F(CliTest, UnknownSubcommandsSeedsAndIgnoredSigmasAreNamed) {

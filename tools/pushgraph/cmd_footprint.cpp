@@ -81,8 +81,9 @@ void RegisterFootprint(CLI::App& app) {
                                           {"inches", 0.0254}}) {
           if (across * scale < 0.01 || across * scale > 1.0) continue;
           char text[120];
-          std::snprintf(text, sizeof text, "%s%s (--scale %g: %.3g m across)", units.empty() ? "" : " or ", name, scale,
-                        across * scale);
+          // Relative to the file: a --scale given already is part of `across`.
+          std::snprintf(text, sizeof text, "%s%s (--scale %g%s: %.3g m across)", units.empty() ? "" : " or ", name,
+                        scale * args->scale, args->scale != 1.0 ? " in place of the --scale given" : "", across * scale);
           units += text;
         }
       }
