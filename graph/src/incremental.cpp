@@ -300,10 +300,22 @@ struct FixedLagSmoother {
         G_scaled.topRows(rank) =
             -R.leftCols(rank).triangularView<Eigen::Upper>().solve(rest.topLeftCorner(rank, sep_dim));
       }
-      c.G = d.head(removed_dim).cwiseInverse().asDiagonal() * (removed_qr.colsPermutation() * G_scaled) *
-            d.segment(removed_dim, sep_dim).asDiagonal();
+      // The permutation applied by indices: Eigen's permutation products read through a null
+      // pointer on an empty operand (UBSan; a step with no separator, or of rank 0).
+      const Eigen::VectorXi& perm = removed_qr.colsPermutation().indices();
+      c.G = Eigen::MatrixXd::Zero(removed_dim, sep_dim);
+      for (int i = 0; i < removed_dim; ++i) {
+        for (int j = 0; j < sep_dim; ++j) {
+          c.G(perm[i], j) = (1.0 / d[perm[i]]) * G_scaled(i, j) * d[removed_dim + j];  // D_r^-1 P G_scaled D_s
+        }
+      }
       // S^T S = H_rr: S = [R11 R12] P^T D_r.
-      if (cfg.covariance) c.S = (R * removed_qr.colsPermutation().transpose()) * d.head(removed_dim).asDiagonal();
+      if (cfg.covariance) {
+        c.S = Eigen::MatrixXd::Zero(rank, removed_dim);
+        for (int i = 0; i < rank; ++i) {
+          for (int j = 0; j < removed_dim; ++j) c.S(i, perm[j]) = R(i, j) * d[perm[j]];
+        }
+      }
       conditionals.push_back(std::move(c));
     }
     if (sep_dim == 0 || rows <= rank) return nullptr;
@@ -316,7 +328,11 @@ struct FixedLagSmoother {
     const Eigen::VectorXd c2 = separator_qr.householderQ().transpose() * rest.bottomRightCorner(rows - rank, 1);
     // The prior 1/2 |S (x - x_bar) + r0|^2: S = R2 P2^T D_s, r0 = (Q2^T c2) on the kept rows.
     const Eigen::MatrixXd R2 = separator_qr.matrixR().topRows(kept).triangularView<Eigen::Upper>();
-    Eigen::MatrixXd S = (R2 * separator_qr.colsPermutation().transpose()) * d.segment(removed_dim, sep_dim).asDiagonal();
+    const Eigen::VectorXi& perm2 = separator_qr.colsPermutation().indices();
+    Eigen::MatrixXd S = Eigen::MatrixXd::Zero(kept, sep_dim);
+    for (int i = 0; i < kept; ++i) {
+      for (int j = 0; j < sep_dim; ++j) S(i, perm2[j]) = R2(i, j) * d[removed_dim + perm2[j]];
+    }
     Eigen::VectorXd r0 = c2.head(kept);
     return problem->AddResidualBlock(new MarginalPriorFactor(sep_sizes, x_bar, std::move(S), std::move(r0)), nullptr, sep);
   }
