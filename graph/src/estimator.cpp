@@ -314,6 +314,7 @@ EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode 
   EstimationResult r = EstimateValidated(repaired ? *repaired : trajectory, model, mode, config);
   if (repaired) r.warnings.insert(r.warnings.begin(), note);
   if (auto unobserved = UnobservedObjectNote(trajectory, model)) r.warnings.push_back(*unobserved);
+  if (auto clock = internal::TimeUnitNote(trajectory)) r.warnings.insert(r.warnings.begin(), *clock);
   return r;
 }
 

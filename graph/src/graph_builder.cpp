@@ -1,4 +1,5 @@
 #include "graph_builder.h"
+#include "text.h"
 
 #include <ceres/normal_prior.h>
 
@@ -225,6 +226,20 @@ void GraphBuilder::SetUpShapes(std::shared_ptr<const geometry::ShapePairQuerier>
     normal_load_ = traj_.object.mass * limit_surface::kStandardGravity;
     f_max_ = mu_surface_ * normal_load_;
   }
+  // The force model's fixed scales (eps_force's cap aside, force_random_walk in N/sqrt(s), the
+  // solver's tolerances) assume loads of a millinewton or more: below that the estimate was broken
+  // (a 1e-5 kg object without a force stream: forces stuck near 0.1 N, object RMS 1.6 mm against
+  // 0.6 with its true 0.5 kg) while the exit status said nothing.
+  constexpr double kMinFrictionLoad = 1e-3;  // N
+  if (ModelHasForce(model_) && f_max_ > 0.0 && f_max_ < kMinFrictionLoad) {
+    throw GraphError(Format("object: its friction load mu_surface m g = %.3g N (mu_surface %.3g, mass %.3g kg) is below "
+                            "the %.0e N the force model supports: is the mass in kg?",
+                            f_max_, mu_surface_, traj_.object.mass, kMinFrictionLoad));
+  }
+  // eps_force regularizes |g'| (N) in D and the load; against a light object's f_max a fixed 0.05 N
+  // would dominate the wrench (a 10 g block: f_max 0.03 N, so |g'|_eps / f_max >= 1.7 and the load
+  // factor could never hold). Capped at f_max / 20, it stays a small fraction of any load.
+  eps_force_ = f_max_ > 0.0 ? std::min(cfg_.eps_force, f_max_ / 20.0) : cfg_.eps_force;
   using Load = EstimatorConfig::LimitSurfaceLoad;
   use_load_factor_ = f_max_ > 0.0 && (cfg_.limit_surface_load == Load::kOn ||
                                       (cfg_.limit_surface_load == Load::kAuto && !streams_.force));
@@ -1151,11 +1166,11 @@ void GraphBuilder::AddDynamicFactors(ceres::Problem& problem, int i) {
   }
   if (contacts.size() == 2) {
     Add(problem, FactorType::kQuasiStatic,
-        new QuasiStaticTwoContactFactor(g, cfg_.eps_velocity, cfg_.eps_force, cfg_.quasi_static_sigma * rate_scale),
+        new QuasiStaticTwoContactFactor(g, cfg_.eps_velocity, eps_force_, cfg_.quasi_static_sigma * rate_scale),
         nullptr, blocks, {0, 1});
     if (use_load_factor_) {
       Add(problem, FactorType::kLimitSurfaceLoad,
-          new LimitSurfaceLoadTwoContactFactor(g, f_max_, cfg_.eps_velocity, cfg_.eps_force,
+          new LimitSurfaceLoadTwoContactFactor(g, f_max_, cfg_.eps_velocity, eps_force_,
                                                cfg_.limit_surface_sigma * rate_scale),
           nullptr, blocks, {0, 1});
     }
@@ -1163,11 +1178,11 @@ void GraphBuilder::AddDynamicFactors(ceres::Problem& problem, int i) {
   }
   const int n = static_cast<int>(contacts.size());
   Add(problem, FactorType::kQuasiStatic,
-      new QuasiStaticMultiContactFactor(g, n, cfg_.eps_velocity, cfg_.eps_force, cfg_.quasi_static_sigma * rate_scale),
+      new QuasiStaticMultiContactFactor(g, n, cfg_.eps_velocity, eps_force_, cfg_.quasi_static_sigma * rate_scale),
       nullptr, blocks, {0, 1});
   if (use_load_factor_) {
     Add(problem, FactorType::kLimitSurfaceLoad,
-        new LimitSurfaceLoadMultiContactFactor(g, n, f_max_, cfg_.eps_velocity, cfg_.eps_force,
+        new LimitSurfaceLoadMultiContactFactor(g, n, f_max_, cfg_.eps_velocity, eps_force_,
                                                cfg_.limit_surface_sigma * rate_scale),
         nullptr, blocks, {0, 1});
   }
@@ -1185,14 +1200,14 @@ void GraphBuilder::AddOneContactQuasiStatic(ceres::Problem& problem, int i, doub
   }
   if (estimate_c_) {
     Add(problem, FactorType::kQuasiStatic,
-        new QuasiStaticFactorWithC(g, cfg_.eps_velocity, cfg_.eps_force, cfg_.quasi_static_sigma * rate_scale), nullptr,
+        new QuasiStaticFactorWithC(g, cfg_.eps_velocity, eps_force_, cfg_.quasi_static_sigma * rate_scale), nullptr,
         {vars_[i - 1].x, v.x, p, f, c_var_}, {0, 1});
     // Prior around the geometric value; bounds keep c physical (tau / c in D).
     if (!c_in_problem_) AddSharedParameterPrior(*this, problem, c_var_, qs_.c, cfg_.c_prior_sigma);
     c_in_problem_ = true;
   } else {
     Add(problem, FactorType::kQuasiStatic,
-        new QuasiStaticFactor(g, cfg_.eps_velocity, cfg_.eps_force, cfg_.quasi_static_sigma * rate_scale), nullptr,
+        new QuasiStaticFactor(g, cfg_.eps_velocity, eps_force_, cfg_.quasi_static_sigma * rate_scale), nullptr,
         {vars_[i - 1].x, v.x, p, f}, {0, 1});
   }
   if (use_load_factor_ && (estimate_c_ || estimate_mu_)) {
@@ -1202,14 +1217,14 @@ void GraphBuilder::AddOneContactQuasiStatic(ceres::Problem& problem, int i, doub
     if (estimate_mu_) blocks.push_back(mu_var_);
     Add(problem, FactorType::kLimitSurfaceLoad,
         new LimitSurfaceLoadFactorWithParameters(g, normal_load_, mu_surface_, {estimate_c_, estimate_mu_},
-                                                 cfg_.eps_velocity, cfg_.eps_force, cfg_.limit_surface_sigma * rate_scale),
+                                                 cfg_.eps_velocity, eps_force_, cfg_.limit_surface_sigma * rate_scale),
         nullptr, blocks, {0, 1});
     // Prior around the trajectory's mu; bounds keep f_max physical.
     if (estimate_mu_ && !mu_in_problem_) AddSharedParameterPrior(*this, problem, mu_var_, mu_surface_, cfg_.mu_prior_sigma);
     mu_in_problem_ = mu_in_problem_ || estimate_mu_;
   } else if (use_load_factor_) {
     Add(problem, FactorType::kLimitSurfaceLoad,
-        new LimitSurfaceLoadFactor(g, f_max_, cfg_.eps_velocity, cfg_.eps_force, cfg_.limit_surface_sigma * rate_scale),
+        new LimitSurfaceLoadFactor(g, f_max_, cfg_.eps_velocity, eps_force_, cfg_.limit_surface_sigma * rate_scale),
         nullptr, {vars_[i - 1].x, v.x, p, f}, {0, 1});
   }
 }

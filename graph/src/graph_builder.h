@@ -404,6 +404,7 @@ class GraphBuilder {
   double c_var_[1] = {0.0};
   double f_max_ = 0.0;  ///< mu m g; 0 when the trajectory lacks mass or friction
   double mu_surface_ = 0.0, normal_load_ = 0.0;  ///< the trajectory's mu and m g
+  double eps_force_ = 0.0;  ///< cfg.eps_force, capped at f_max / 20 (a light object)
   bool estimate_mu_ = false;
   bool mu_in_problem_ = false;
   double mu_var_[1] = {0.0};
@@ -449,6 +450,10 @@ Diagnostics Diagnose(const push::Trajectory& trajectory, Model model, const Esti
 /// stream, sample and value): missing shapes or streams, NaN, unsupported magnitudes, unsorted
 /// samples, clock jumps within or between streams.
 void ValidateTrajectory(const push::Trajectory& trajectory);
+/// A warning when every stream is sampled at 0.2 s or slower (5 Hz): the time stamps are likely in
+/// milliseconds or microseconds (times are seconds; a 250 Hz sensor in milliseconds reads 4 s
+/// apart and the noise model's per-second scales then no longer fit the data). Empty otherwise.
+std::optional<std::string> TimeUnitNote(const push::Trajectory& trajectory);
 /// A gap in the object pose stream that counts as the object unobserved (an occluded camera):
 /// longer than max(3 median object periods, 0.1 s); INFINITY with fewer than two poses.
 double LongObjectGap(const push::Trajectory& trajectory);

@@ -213,34 +213,51 @@ struct FixedLagSmoother {
       rb_params.push_back(ps);
     }
     // The factors' whitened Jacobians stacked, [A | r] (rows of every factor; the robust loss as
-    // the solver weighs it, sqrt(rho')), the removed step's columns first.
-    std::vector<Eigen::MatrixXd> stacked;
+    // the solver weighs it, sqrt(rho')), the removed step's columns first; filled in place.
     int rows = 0;
-    std::size_t k = 0;
-    for (ceres::ResidualBlockId id : rbs) {
-      const std::vector<double*>& ps = rb_params[k++];
-      const ceres::CostFunction* cost = problem->GetCostFunctionForResidualBlock(id);
-      const ceres::LossFunction* loss = problem->GetLossFunctionForResidualBlock(id);
-      const int m = cost->num_residuals();
-      Eigen::VectorXd r(m);
-      std::vector<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> J(ps.size());
-      std::vector<double*> jp(ps.size());
-      for (std::size_t q = 0; q < ps.size(); ++q) {
-        J[q].resize(m, problem->ParameterBlockSize(ps[q]));
-        jp[q] = J[q].data();
+    for (ceres::ResidualBlockId id : rbs) rows += problem->GetCostFunctionForResidualBlock(id)->num_residuals();
+    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(rows, dim + 1);
+    {
+      int row = 0;
+      std::size_t k = 0;
+      Eigen::VectorXd r;
+      std::vector<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> J;
+      std::vector<double*> jp;
+      for (ceres::ResidualBlockId id : rbs) {
+        const std::vector<double*>& ps = rb_params[k++];
+        const ceres::CostFunction* cost = problem->GetCostFunctionForResidualBlock(id);
+        const ceres::LossFunction* loss = problem->GetLossFunctionForResidualBlock(id);
+        const int m = cost->num_residuals();
+        r.resize(m);
+        J.resize(ps.size());
+        jp.resize(ps.size());
+        for (std::size_t q = 0; q < ps.size(); ++q) {
+          J[q].resize(m, problem->ParameterBlockSize(ps[q]));
+          jp[q] = J[q].data();
+        }
+        // The window solve has just evaluated every factor at this point, so a failure here is a
+        // fault (a factor whose Evaluate is not a function of its inputs), named rather than skipped.
+        if (!cost->Evaluate(ps.data(), r.data(), jp.data()) || !r.allFinite()) {
+          throw GraphError("incremental: marginalizing step " + std::to_string(s) + ": the " + builder.Describe(id) +
+                           " could not be evaluated (a non-finite residual or Jacobian) at the estimate it was "
+                           "solved to");
+        }
+        double scale = 1.0;
+        if (loss != nullptr) {
+          double rho[3];
+          loss->Evaluate(r.squaredNorm(), rho);
+          scale = std::sqrt(std::max(rho[1], 0.0));
+        }
+        for (std::size_t q = 0; q < ps.size(); ++q) {
+          if (!J[q].allFinite()) {
+            throw GraphError("incremental: marginalizing step " + std::to_string(s) + ": the " + builder.Describe(id) +
+                             " has a non-finite Jacobian at the estimate it was solved to");
+          }
+          A.block(row, offset[ps[q]], m, J[q].cols()) += scale * J[q];
+        }
+        A.col(dim).segment(row, m) = scale * r;
+        row += m;
       }
-      if (!cost->Evaluate(ps.data(), r.data(), jp.data())) continue;
-      double scale = 1.0;
-      if (loss != nullptr) {
-        double rho[3];
-        loss->Evaluate(r.squaredNorm(), rho);
-        scale = std::sqrt(std::max(rho[1], 0.0));
-      }
-      Eigen::MatrixXd block = Eigen::MatrixXd::Zero(m, dim + 1);
-      for (std::size_t q = 0; q < ps.size(); ++q) block.middleCols(offset[ps[q]], J[q].cols()) += scale * J[q];
-      block.col(dim) = scale * r;
-      rows += m;
-      stacked.push_back(std::move(block));
     }
     // Remove the step: its residual blocks in the order above first (RemoveParameterBlock would
     // remove them in hash-set order, and fast removal moves the problem's last block into each
@@ -251,12 +268,6 @@ struct FixedLagSmoother {
     }
     for (double* p : removed) problem->RemoveParameterBlock(p);
     const int sep_dim = dim - removed_dim;
-    Eigen::MatrixXd A(rows, dim + 1);
-    rows = 0;
-    for (const Eigen::MatrixXd& block : stacked) {
-      A.middleRows(rows, block.rows()) = block;
-      rows += static_cast<int>(block.rows());
-    }
     // Elimination in square-root form (the Jacobian's QR, as GTSAM eliminates Jacobian factors;
     // M. Kaess et al., "iSAM: Incremental Smoothing and Mapping", T-RO 2008): the marginal prior's
     // information T2^T T2 is positive semidefinite by construction. The Schur complement of

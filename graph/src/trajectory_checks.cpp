@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <sstream>
 #include <string>
 
@@ -262,6 +263,31 @@ void ValidateTrajectory(const push::Trajectory& traj) {
     CheckFingerSize(traj.extra_fingers[k].finger.shape, traj.extra_fingers[k].measured.finger_pose, m.object_pose,
                     traj.object.shape, "fingers[" + std::to_string(k + 1) + "]: ");
   }
+}
+
+std::optional<std::string> TimeUnitNote(const push::Trajectory& traj) {
+  const auto& m = traj.measured;
+  double finest = INFINITY;
+  for (double p : {MedianPeriod(m.object_pose), MedianPeriod(m.finger_pose), MedianPeriod(m.contact_point), MedianPeriod(m.force)})
+    if (p > 0.0) finest = std::min(finest, p);
+  // Pushing recordings sample their fastest sensor at 10 Hz or more (MIT's: 250 Hz and 100-250 Hz
+  // for the tracker); 5 Hz is already an outlier, 0.25 Hz is a millisecond clock.
+  constexpr double kSlowestPeriod = 0.2;  // s
+  if (!(finest >= kSlowestPeriod) || !std::isfinite(finest)) return std::nullopt;
+  // The finger's net travel over the recording (a path summed sample by sample would add up noise).
+  const double duration = m.finger_pose.size() > 1 ? m.finger_pose.back().t - m.finger_pose.front().t : 0.0;
+  const double speed =
+      duration > 0.0 ? (m.finger_pose.back().pose.translation() - m.finger_pose.front().pose.translation()).norm() / duration
+                     : 0.0;
+  const bool micro = finest >= 1e3 * kSlowestPeriod;
+  const double factor = micro ? 1e6 : 1e3;
+  return Format("time stamps: the fastest stream is sampled every %.4g s (%.3g Hz) and the finger travels at %.3g mm/s: "
+                "are the times in %s? Trajectory times are in seconds; read as %s the streams would run at %.4g Hz and "
+                "the finger at %.3g mm/s. The noise model's per-second scales (accelerations, force random walk, D's "
+                "per-10-ms sigma) do not fit a clock this slow, and the estimate may be worse than the measurements: "
+                "divide the times by %g",
+                finest, 1.0 / finest, 1e3 * speed, micro ? "microseconds" : "milliseconds",
+                micro ? "microseconds" : "milliseconds", factor / finest, 1e3 * speed * factor, factor);
 }
 
 double LongObjectGap(const push::Trajectory& trajectory) {

@@ -126,6 +126,56 @@ TEST(Estimator, GroundTruthThatSharesNoTimeIsNamed) {
   EXPECT_TRUE(named) << (s.warnings.empty() ? "no warning" : s.warnings[0]);
 }
 
+// Time stamps in milliseconds (a 250 Hz push read as 0.25 Hz) are named at the top of the
+// warnings, with the rate and speed they would mean; seconds give no such warning.
+TEST(Estimator, TimeStampsInMillisecondsAreNamed) {
+  const push::Trajectory seconds = GeneratePush(OffsetPush(3, 0.5));
+  auto has_clock_warning = [](const EstimationResult& r, const std::string& unit) {
+    for (const std::string& w : r.warnings)
+      if (w.rfind("time stamps:", 0) == 0 && w.find("are the times in " + unit) != std::string::npos) return true;
+    return false;
+  };
+  const EstimationResult plain = Estimate(seconds, Model::kCp, Mode::kBatch);
+  for (const std::string& w : plain.warnings) EXPECT_EQ(w.find("time stamps:"), std::string::npos) << w;
+  for (double factor : {1e3, 1e6}) {
+    push::Trajectory scaled = seconds;
+    auto scale = [factor](push::Streams* s) {
+      for (auto& x : s->object_pose) x.t *= factor;
+      for (auto& x : s->finger_pose) x.t *= factor;
+      for (auto& x : s->contact_point) x.t *= factor;
+      for (auto& x : s->force) x.t *= factor;
+    };
+    scale(&scaled.measured);
+    scaled.ground_truth.reset();
+    const EstimationResult r = Estimate(scaled, Model::kCp, Mode::kBatch);
+    const std::string unit = factor == 1e3 ? "milliseconds" : "microseconds";
+    EXPECT_TRUE(has_clock_warning(r, unit)) << unit << ": " << (r.warnings.empty() ? "no warning" : r.warnings[0]);
+    ASSERT_FALSE(r.warnings.empty());
+    EXPECT_EQ(r.warnings[0].rfind("time stamps:", 0), 0u) << r.warnings[0];
+  }
+}
+
+// A friction load below a millinewton (a mass given in tonnes, or 1e-30 kg) is refused by the
+// models with forces, naming the load, mass and mu; the contact-point model has no force and runs.
+TEST(Estimator, AFrictionLoadBelowAMillinewtonIsRefused) {
+  push::Trajectory t = GeneratePush(OffsetPush(3, 0.5));
+  t.measured.force.clear();
+  for (double mass : {1e-30, 1e-5}) {
+    t.object.mass = mass;
+    for (Model model : {Model::kQs, Model::kYu}) {
+      try {
+        Estimate(t, model, Mode::kBatch);
+        ADD_FAILURE() << "mass " << mass << " was accepted";
+      } catch (const GraphError& e) {
+        EXPECT_NE(std::string(e.what()).find("is the mass in kg"), std::string::npos) << e.what();
+      }
+    }
+    EXPECT_NO_THROW(Estimate(t, Model::kCp, Mode::kBatch));
+  }
+  t.object.mass = 2e-3;  // 2 g: 6 mN, supported
+  EXPECT_NO_THROW(Estimate(t, Model::kQs, Mode::kBatch));
+}
+
 // Joint estimation of c: started 40% too high, the estimate moves towards the value of the
 // simulated object and reports a sigma.
 TEST(Estimator, JointEstimationOfCMovesTowardsTheTruth) {

@@ -56,7 +56,7 @@ struct EstimatorConfig {
   // covariances overconfident (object-pose NEES 9-27 for dimension 3 on simulated pushes).
   double quasi_static_sigma = 0.3;
   double eps_velocity = 1e-3;  ///< m/s, regularizes |V'| in D
-  double eps_force = 0.05;     ///< N, regularizes |g'| in D
+  double eps_force = 0.05;     ///< N, regularizes |g'| in D; at most f_max / 20 when m and mu are known
   double c = 0.0;              ///< m; 0: from the object's limit surface (uniform pressure)
   double c_scale = 1.0;        ///< multiplies c (published fits are about 1.11 on real data)
   /// Estimate c jointly with the trajectory (QS, batch): one shared variable, started at the
