@@ -283,11 +283,18 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
     std::vector<int> prism_axes;
     for (int a = 0; a < 3; ++a) {
       bool on_ends = hi[a] > lo[a];
+      int at_lo = 0, at_hi = 0;  // an end face needs three vertices (a lone triangle is no prism)
       for (int v = 0; v < nv && on_ends; ++v) {
+        if (!used[v]) continue;
         const double c = coordinates[3 * v + a];
-        on_ends = !used[v] || std::abs(c - lo[a]) <= tolerance || std::abs(c - hi[a]) <= tolerance;
+        at_lo += std::abs(c - lo[a]) <= tolerance;
+        at_hi += std::abs(c - hi[a]) <= tolerance;
+        on_ends = std::abs(c - lo[a]) <= tolerance || std::abs(c - hi[a]) <= tolerance;
       }
-      if (on_ends) prism_axes.push_back(a);
+      if (on_ends && at_lo >= 3 && at_hi >= 3) {
+        prism_axes.push_back(a);
+        rep.prism_axes.push_back(a == 0 ? UpAxis::kX : a == 1 ? UpAxis::kY : UpAxis::kZ);
+      }
     }
     if (!prism_axes.empty() && std::find(prism_axes.begin(), prism_axes.end(), up) == prism_axes.end()) {
       const char* axis = axis_names[prism_axes.front()];

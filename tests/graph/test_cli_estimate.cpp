@@ -288,6 +288,48 @@ TEST_F(EstimateCli, AMeshTurnedBy37DegreesIsAligned) {
 // degrees, shifted by (-5.0, -5.6) mm, sigmas 8.1 degrees, 4.8 and 2.4 mm) is within three sigmas
 // of none, and saving it would bake the turn into the file (later recordings then accepted it:
 // 1.69 against 1.23 mm), so the units alone are offered too.
+// The dataset's meshes given directly (--object rect1.obj --finger tip.obj) are read as
+// `pushgraph footprint` reads them, the probe's cylinder (a prism along y) by its cross-section,
+// and say so; the estimate is the one from the converted files. A mesh in another format is
+// told which files are read (it was "malformed JSON" alone).
+TEST_F(EstimateCli, MeshFilesAreReadDirectly) {
+  if (Mit().empty()) GTEST_SKIP() << "no MIT data";
+  const std::string h5 = Mit() + "abs/rect1/motion_surface=abs_shape=rect1_a=0_v=75_i=2.000_s=0.800_t=0.000.h5";
+  const std::string mass = " --mass 0.8374 --mu 0.35 ";
+  const pushgraph::testing::ToolRun direct = Tool("estimate '" + h5 + "' --object " + Mit() + "obj/rect1.obj --finger " +
+                                                  Mit() + "obj/tip.obj" + mass + "-o " + dir() + "/direct.json");
+  ASSERT_EQ(direct.status, 0) << direct.err;
+  EXPECT_NE(direct.err.find("tip.obj: the mesh's footprint along y (a prism along it: its cross-section)"), std::string::npos)
+      << direct.err;
+  EXPECT_NE(direct.err.find("rect1.obj: the mesh's footprint along z, in its own frame and units"), std::string::npos)
+      << direct.err;
+  EXPECT_EQ(direct.err.find("side view"), std::string::npos) << direct.err;
+  // Its 32-gon is the 4.7 mm disk it tessellates (a polygonal finger solves ~15x slower).
+  EXPECT_NE(direct.err.find("regular 32-gon, a tessellated cylinder: used as the disk of radius 4.7 mm at (0.000, 0.000)"),
+            std::string::npos)
+      << direct.err;
+  ASSERT_EQ(Tool("footprint " + Mit() + "obj/rect1.obj -q -o " + dir() + "/rect1.json").status, 0);
+  std::ofstream(dir() + "/tip.json") << R"({"polygons": [{"outer": [[0, 0]]}], "radius": 0.0047})";
+  const pushgraph::testing::ToolRun converted = Tool("estimate '" + h5 + "' --object " + dir() + "/rect1.json --finger " +
+                                                     dir() + "/tip.json" + mass + "-o " + dir() + "/converted.json");
+  ASSERT_EQ(converted.status, 0) << converted.err;
+  const nlohmann::json a = Load(dir() + "/direct.json"), b = Load(dir() + "/converted.json");
+  // The same estimate up to the disk's radius from the mesh's rounded vertices (4.7 mm +- 1 um).
+  int compared = 0;
+  for (const char* key : {"object_position_rms", "finger_position_rms", "contact_rms"}) {
+    if (!b["metrics"].contains(key)) continue;
+    ++compared;
+    EXPECT_NEAR(a["metrics"][key].get<double>(), b["metrics"][key].get<double>(), 1e-3 * b["metrics"][key].get<double>()) << key;
+  }
+  EXPECT_GE(compared, 2) << b["metrics"].dump();
+  EXPECT_EQ(a["states"].size(), b["states"].size());
+  std::ofstream(dir() + "/probe.stl") << "solid probe\nendsolid probe\n";
+  const pushgraph::testing::ToolRun stl =
+      Tool("estimate '" + h5 + "' --object " + dir() + "/probe.stl --finger " + dir() + "/tip.json" + mass + "-o " + dir() + "/x.json");
+  EXPECT_EQ(stl.status, 1);
+  EXPECT_NE(stl.err.find("OBJ meshes, named .obj, are read directly"), std::string::npos) << stl.err;
+}
+
 TEST_F(EstimateCli, AMeshInMillimetresIsOfferedItsUnitsAlone) {
   if (Mit().empty()) GTEST_SKIP() << "no MIT data";
   const std::string h5 = Mit() + "abs/rect1/motion_surface=abs_shape=rect1_a=0_v=75_i=2.000_s=0.800_t=0.000.h5";

@@ -117,6 +117,22 @@ TEST_F(Footprint, SideViewsAndSeveralObjectsAreWarned) {
   io::FootprintReport report;
   io::MeshFootprint(tetra, {}, &report);
   EXPECT_TRUE(report.warnings.empty());
+  EXPECT_TRUE(report.prism_axes.empty());
+  // A lone flat triangle: its three vertices lie on two planes across x, but no end face has
+  // three of them, so it is no prism (it was told "a prism along x").
+  const std::string flat = Write("flat.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  io::FootprintReport flat_report;
+  io::MeshFootprint(flat, {}, &flat_report);
+  EXPECT_TRUE(flat_report.warnings.empty()) << flat_report.warnings[0];
+  EXPECT_TRUE(flat_report.prism_axes.empty());
+  // The axes a prism is extruded along, which LoadShapeArgument uses to read a probe's mesh.
+  io::FootprintReport tip;
+  io::MeshFootprint(kObj + "tip.obj", {}, &tip);
+  ASSERT_EQ(tip.prism_axes.size(), 1u);
+  EXPECT_EQ(tip.prism_axes[0], io::UpAxis::kY);
+  io::FootprintReport rect;
+  io::MeshFootprint(kObj + "rect1.obj", {}, &rect);
+  EXPECT_EQ(rect.prism_axes, std::vector<io::UpAxis>{io::UpAxis::kZ});
 }
 
 TEST_F(Footprint, UnionOfOverlappingAndOpenNonManifoldMeshes) {

@@ -36,6 +36,9 @@ struct FootprintReport {
   /// blocks), or a prism along another axis than `up` (its side view, e.g. tip.obj without
   /// --up y: every vertex on the two end planes of another axis).
   std::vector<std::string> warnings;
+  /// The axes along which the mesh is a prism (every vertex on two end planes, at least three on
+  /// each): an extruded outline, whose cross-section is its footprint along that axis.
+  std::vector<UpAxis> prism_axes;
 };
 
 /// Throws IoError naming the file for unreadable, empty or broken meshes, an unknown object name,
