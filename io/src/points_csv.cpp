@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string_view>
 
 namespace pushgraph::io {
 namespace {
@@ -43,7 +44,8 @@ std::vector<double> ParseNumberList(const std::string& text, std::size_t count, 
   // Split on commas as std::getline would (no item after a trailing comma; none for "").
   for (std::size_t start = 0; start < text.size();) {
     const std::size_t comma = std::min(text.find(',', start), text.size());
-    const std::string item = text.substr(start, comma - start);
+    // Spaces around an item are the writer's layout ("0.01 , 0.02"), not part of the number.
+    const std::string item = Trim(text.substr(start, comma - start));
     start = comma + 1;
     std::size_t used = item.size();
     double value = 0.0;
@@ -69,7 +71,9 @@ std::vector<double> ParseNumberList(const std::string& text, std::size_t count, 
 }
 
 std::vector<geometry::Vec2> ParsePointsCsv(const std::string& text, const std::string& source_name) {
-  std::istringstream in(text);
+  // A UTF-8 byte order mark (spreadsheet exports write one) is not part of the header.
+  constexpr std::string_view kBom = "\xEF\xBB\xBF";
+  std::istringstream in(text.compare(0, kBom.size(), kBom) == 0 ? text.substr(kBom.size()) : text);
   std::string line;
   int line_number = 0;
   std::vector<geometry::Vec2> points;

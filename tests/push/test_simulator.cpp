@@ -510,8 +510,13 @@ TEST_F(SimulateCli, BadInputIsOneLineError) {
   for (const std::string& args : {std::string("-o " + out + " --mass -1"), std::string("-o " + out + " --noise pink"),
                                   std::string("-o " + out + " --occlusion 2,1"),
                                   std::string("-o " + out + " --object /nonexistent/shape.json"),
-                                  std::string("-o " + out + " --outliers 2")}) {
+                                  std::string("-o " + out + " --outliers 2"),
+                                  // A file estimate could not read: noise beyond its range, or no object pose at all.
+                                  std::string("-o " + out + " --sigma-object 1e300,1e300"),
+                                  std::string("-o " + out + " --sigma-force 2e6"),
+                                  std::string("-o " + out + " --occlusion -1,100")}) {
     const pushgraph::testing::ToolRun r = RunTool(args);
+    EXPECT_FALSE(std::ifstream(out).good()) << args << ": a file was written";
     EXPECT_NE(r.status, 0) << args;
     EXPECT_FALSE(r.err.empty()) << args;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << ": " << r.err;

@@ -77,6 +77,21 @@ TEST_F(CliTest, DistanceBadInputNamesFileAndLine) {
   EXPECT_NE(r.err.find("far.csv:4"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("outside the supported range"), std::string::npos) << r.err;
 
+  // Spaces around a number and a spreadsheet's UTF-8 byte order mark are layout: the same rows
+  // as a plain file ("0.01 ,0.02" was refused while " 0.01,0.02" was read; a BOM failed the
+  // header with an invisible difference).
+  const ToolRun plain = Exec("distance " + shape + " " + Write("plain.csv", "x,y\n0.01,0.02\n0.3,-0.1\n"));
+  ASSERT_EQ(plain.status, 0) << plain.err;
+  const ToolRun spaced = Exec("distance " + shape + " " + Write("spaced.csv", "x, y\n0.01 ,0.02\n 0.3 , -0.1 \n"));
+  EXPECT_EQ(spaced.status, 0) << spaced.err;
+  EXPECT_EQ(spaced.out, plain.out);
+  const ToolRun bom = Exec("distance " + shape + " " + Write("bom.csv", "\xEF\xBB\xBFx,y\n0.01,0.02\n0.3,-0.1\n"));
+  EXPECT_EQ(bom.status, 0) << bom.err;
+  EXPECT_EQ(bom.out, plain.out);
+  r = Exec("distance " + shape + " " + Write("inner.csv", "x,y\n0.0 1,0.02\n"));  // a space inside a number
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("inner.csv:2"), std::string::npos) << r.err;
+
   r = Exec("distance " + shape + " " + Write("nohdr.csv", "1,2\n"));
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find("nohdr.csv:1"), std::string::npos) << r.err;

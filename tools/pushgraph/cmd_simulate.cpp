@@ -127,17 +127,26 @@ void Run(const SimulateOptions& o) {
         throw CliError(std::string(flag) + " " + *value + " is given with --noise none, which adds no noise: drop it or "
                        "choose --noise gaussian or bimodal");
   }
-  auto set_sigma = [&](const std::string& text, push::StreamNoise& stream, bool with_angle, const std::string& what) {
+  // Noise up to 1 m, 10 rad, 1e6 N: beyond, the samples leave the range that estimate reads
+  // (positions within 1e6 m), so the file written could not be used (1e300 was written).
+  auto set_sigma = [&](const std::string& text, push::StreamNoise& stream, bool with_angle, double max_value,
+                       const std::string& what) {
     if (text.empty()) return;
     const std::vector<double> v = ParseNumbers(text, with_angle ? 2 : 1, what);
-    for (double x : v) NonNegative(x, what);
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      NonNegative(v[k], what);
+      const double bound = k == 0 ? max_value : 10.0;
+      if (v[k] > bound)
+        throw CliError(what + ": " + FormatDouble(v[k]) + " is beyond the supported " + FormatDouble(bound) +
+                       (k == 0 ? (max_value == 1.0 ? " m" : " N") : " rad"));
+    }
     stream.position.sigma = v[0];
     if (with_angle) stream.angle.sigma = v[1];
   };
-  set_sigma(o.sigma_object, plan.noise.object_pose, true, "--sigma-object (M,RAD)");
-  set_sigma(o.sigma_finger, plan.noise.finger_pose, false, "--sigma-finger (M)");
-  set_sigma(o.sigma_contact, plan.noise.contact_point, false, "--sigma-contact (M)");
-  set_sigma(o.sigma_force, plan.noise.force, false, "--sigma-force (N)");
+  set_sigma(o.sigma_object, plan.noise.object_pose, true, 1.0, "--sigma-object (M,RAD)");
+  set_sigma(o.sigma_finger, plan.noise.finger_pose, false, 1.0, "--sigma-finger (M)");
+  set_sigma(o.sigma_contact, plan.noise.contact_point, false, 1.0, "--sigma-contact (M)");
+  set_sigma(o.sigma_force, plan.noise.force, false, 1e6, "--sigma-force (N)");
   for (const std::string& text : o.occlusions) {
     const auto [t0, t1] = ParseWindow(text, "--occlusion");
     plan.noise.occlusions.push_back({t0, t1, o.occlusion_mode == "degrade" ? push::OcclusionMode::kDegrade
@@ -166,6 +175,12 @@ void Run(const SimulateOptions& o) {
   const push::SimulationResult result = push::Simulate(plan);
   push::Trajectory trajectory = result.trajectory;
   if (o.no_ground_truth) trajectory.ground_truth.reset();
+  // --occlusion windows (stop mode) over the whole push leave nothing that anchors the object,
+  // which estimate refuses: said here, before a file that cannot be estimated is written.
+  if (trajectory.measured.object_pose.empty()) {
+    throw CliError("every object pose sample falls inside an --occlusion window (stop mode): the file would have no "
+                   "object poses, which estimate needs; shorten the windows or use --occlusion-mode degrade");
+  }
   io::SaveTrajectoryJson(trajectory, o.output);
   if (!o.svg.empty()) {
     evaluation::PushPlotOptions picture;
