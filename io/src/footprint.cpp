@@ -116,7 +116,10 @@ std::vector<geometry::Polygon> AssemblePolygons(const std::vector<geometry::Ring
 
 // tinyobjloader's number parser is not correctly rounded (it can be 1 ulp off); re-read the
 // vertex lines with strtod, which is. Returns empty if the file's vertex count differs.
-std::vector<double> ReadVertexCoordinates(const std::string& path, std::size_t expected) {
+// Lines of a kind the OBJ format does not define are counted in *unknown (the first one named in
+// *first_unknown): the parser skips them, which a corrupted or mislabelled file should not pass.
+std::vector<double> ReadVertexCoordinates(const std::string& path, std::size_t expected, int* unknown,
+                                          std::string* first_unknown) {
   std::ifstream in(path);
   std::vector<double> out;
   std::string line;
@@ -154,7 +157,21 @@ std::vector<double> ReadVertexCoordinates(const std::string& path, std::size_t e
       }
       continue;
     }
-    if (c[0] != 'v' || (c[1] != ' ' && c[1] != '\t')) continue;
+    if (c[0] != 'v' || (c[1] != ' ' && c[1] != '\t')) {
+      std::string keyword;
+      for (const char* k = c; *k != '\0' && *k != ' ' && *k != '\t' && *k != '\r'; ++k) keyword += *k;
+      // OBJ's statements (vertex data, elements, grouping, display; free-form geometry's too).
+      static const char* const kKnown[] = {"vt", "vn", "vp", "v", "l", "p", "o", "g", "s", "mg", "usemtl", "mtllib",
+                                           "cstype", "deg", "bmat", "step", "curv", "curv2", "surf", "parm", "trim",
+                                           "hole", "scrv", "sp", "end", "con", "bevel", "c_interp", "d_interp",
+                                           "lod", "shadow_obj", "trace_obj", "ctech", "stech", "maplib", "usemap"};
+      const bool known = keyword.empty() || keyword[0] == '#' ||
+                         std::any_of(std::begin(kKnown), std::end(kKnown), [&](const char* k) { return keyword == k; });
+      if (!known && ++*unknown == 1) {
+        *first_unknown = std::to_string(line_number) + ": '" + line.substr(0, 60) + (line.size() > 60 ? "...'" : "'");
+      }
+      continue;
+    }
     c += 2;
     for (int k = 0; k < 3; ++k) {
       char* end = nullptr;
@@ -216,7 +233,13 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
     throw IoError(path + ": no object named '" + options.object + "' (the file has: " + names + ")");
   }
   const int nv = static_cast<int>(attrib.vertices.size() / 3);
-  std::vector<double> coordinates = ReadVertexCoordinates(path, attrib.vertices.size());
+  int unknown_lines = 0;
+  std::string first_unknown;
+  std::vector<double> coordinates = ReadVertexCoordinates(path, attrib.vertices.size(), &unknown_lines, &first_unknown);
+  if (unknown_lines > 0) {
+    rep.warnings.push_back(std::to_string(unknown_lines) + " line(s) that are no OBJ statement were skipped (the first at line " +
+                           first_unknown + "): is it an OBJ file, and complete?");
+  }
   if (coordinates.empty()) coordinates.assign(attrib.vertices.begin(), attrib.vertices.end());
   auto project = [&](int index) -> Point {
     const double x = coordinates[3 * index] * options.scale, y = coordinates[3 * index + 1] * options.scale,

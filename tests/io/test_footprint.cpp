@@ -125,6 +125,20 @@ TEST_F(Footprint, SideViewsAndSeveralObjectsAreWarned) {
   io::MeshFootprint(flat, {}, &flat_report);
   EXPECT_TRUE(flat_report.warnings.empty()) << flat_report.warnings[0];
   EXPECT_TRUE(flat_report.prism_axes.empty());
+  // OBJ statements the footprint does not use pass; a line of no OBJ kind is counted and named.
+  const std::string decorated = Write("d.obj",
+                                      "# c\nmtllib a.mtl\no t\ng t\nusemtl m\ns off\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"
+                                      "vt 0 0\nvn 0 0 1\nf 1/1/1 2/1/1 3/1/1\nl 1 2\n");
+  io::FootprintReport decorated_report;
+  io::MeshFootprint(decorated, {}, &decorated_report);
+  EXPECT_TRUE(decorated_report.warnings.empty()) << decorated_report.warnings[0];
+  const std::string garbled = Write("g.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nhello world\n<html>\n");
+  io::FootprintReport garbled_report;
+  io::MeshFootprint(garbled, {}, &garbled_report);
+  ASSERT_EQ(garbled_report.warnings.size(), 1u);
+  EXPECT_NE(garbled_report.warnings[0].find("2 line(s) that are no OBJ statement were skipped (the first at line 5: 'hello world')"),
+            std::string::npos)
+      << garbled_report.warnings[0];
   // The axes a prism is extruded along, which LoadShapeArgument uses to read a probe's mesh.
   io::FootprintReport tip;
   io::MeshFootprint(kObj + "tip.obj", {}, &tip);
