@@ -150,8 +150,10 @@ EstimationResult EstimateBatch(const push::Trajectory& traj, Model model, const 
   if (!summary.converged) {
     // Ceres and the chain solver both say "iteration limit" in their own words: said once.
     const bool at_limit = summary.termination.find("iteration") != std::string::npos;
-    r.warnings.push_back("the batch solve stopped at its iteration limit (" + std::to_string(cfg.max_iterations) +
-                         ") before converging" + (at_limit ? std::string(" (max_iterations in the config raises it)")
+    // max_iterations bounds each stage (motion only, contacts, the full model); the result's
+    // iterations are their sum.
+    r.warnings.push_back("the batch solve's last stage stopped at its iteration limit (" + std::to_string(cfg.max_iterations) +
+                         " per stage) before converging" + (at_limit ? std::string(" (max_iterations in the config raises it)")
                                                            : ": " + summary.termination));
   }
   r.solver.updates = 1;
