@@ -311,12 +311,24 @@ EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode 
                           const EstimatorConfig& config) {
   ValidateConfig(config);
   internal::ValidateTrajectory(trajectory);
-  std::string note;
-  const std::optional<push::Trajectory> repaired = DropForceSpikes(trajectory, &note);
-  EstimationResult r = EstimateValidated(repaired ? *repaired : trajectory, model, mode, config);
-  if (repaired) r.warnings.insert(r.warnings.begin(), note);
+  std::string note, glitch_note;
+  std::optional<push::Trajectory> repaired = DropForceSpikes(trajectory, &note);
+  const push::Trajectory* before_glitches = repaired ? &*repaired : &trajectory;
+  std::optional<push::Trajectory> cleaned = internal::DropObjectPoseGlitches(*before_glitches, &glitch_note);
+  const push::Trajectory& input = cleaned ? *cleaned : *before_glitches;
+  EstimationResult r = EstimateValidated(input, model, mode, config);
+  if (cleaned && !r.metrics.empty()) {
+    // The raw tracker's errors are the stream as recorded, glitches included.
+    for (const auto& [key, value] : ComputeMetrics(*before_glitches, r.states))
+      if (key.rfind("measured_object", 0) == 0) r.metrics[key] = value;
+  }
+  if (!note.empty()) r.warnings.insert(r.warnings.begin(), note);
+  if (!glitch_note.empty()) r.warnings.insert(r.warnings.begin(), glitch_note);
+  if (auto yaw = internal::YawUnitNote(trajectory)) r.warnings.insert(r.warnings.begin(), *yaw);
   if (auto unobserved = UnobservedObjectNote(trajectory, model)) r.warnings.push_back(*unobserved);
   if (auto clock = internal::TimeUnitNote(trajectory)) r.warnings.insert(r.warnings.begin(), *clock);
+  if (auto direction = internal::ForceDirectionNote(input)) r.warnings.insert(r.warnings.begin(), *direction);
+  if (auto scale = internal::ForceScaleNote(input)) r.warnings.insert(r.warnings.begin(), *scale);
   return r;
 }
 

@@ -454,6 +454,23 @@ void ValidateTrajectory(const push::Trajectory& trajectory);
 /// milliseconds or microseconds (times are seconds; a 250 Hz sensor in milliseconds reads 4 s
 /// apart and the noise model's per-second scales then no longer fit the data). Empty otherwise.
 std::optional<std::string> TimeUnitNote(const push::Trajectory& trajectory);
+/// A warning when the measured force does negative work on the object over the samples where it
+/// is above a quarter of its 95th percentile (f . v summed, v the finger's velocity over +-0.1 s):
+/// a quasi-static push takes positive work from the finger, so such a stream has its sign flipped
+/// (the force on the sensor), its axes swapped, or another frame.
+std::optional<std::string> ForceDirectionNote(const push::Trajectory& trajectory);
+/// A warning when the measured forces' 95th percentile is over 20 times the object's friction load
+/// mu m g, or under 1/20 of it while the object moves over 1 cm (a quasi-static push needs about
+/// that load): another force unit, or a wrong mass or mu_surface.
+std::optional<std::string> ForceScaleNote(const push::Trajectory& trajectory);
+/// The object pose stream without its tracker glitches: samples more than max(1 cm, 10 scatters)
+/// or max(0.3 rad, 10 scatters) from the median of their neighbours within +-max(0.1 s, 3
+/// periods), when they are at most a tenth of the stream (more is the stream itself, left to the
+/// other checks); nullopt when there is none; `note` says how many, the first and the bounds.
+std::optional<push::Trajectory> DropObjectPoseGlitches(const push::Trajectory& trajectory, std::string* note);
+/// A warning when the object's yaw scatters by more than 0.2 rad about its running median: a yaw
+/// in degrees.
+std::optional<std::string> YawUnitNote(const push::Trajectory& trajectory);
 /// A gap in the object pose stream that counts as the object unobserved (an occluded camera):
 /// longer than max(3 median object periods, 0.1 s); INFINITY with fewer than two poses.
 double LongObjectGap(const push::Trajectory& trajectory);

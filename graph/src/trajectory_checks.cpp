@@ -6,10 +6,12 @@
 
 #include <pushgraph/geometry/shape.h>
 #include <pushgraph/geometry/shape_pair.h>
+#include <pushgraph/limit_surface/support.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -263,6 +265,166 @@ void ValidateTrajectory(const push::Trajectory& traj) {
     CheckFingerSize(traj.extra_fingers[k].finger.shape, traj.extra_fingers[k].measured.finger_pose, m.object_pose,
                     traj.object.shape, "fingers[" + std::to_string(k + 1) + "]: ");
   }
+}
+
+namespace {
+
+// The finger's position at t, linearly interpolated (nullopt outside the stream).
+std::optional<geometry::Vec2> FingerPositionAt(const std::vector<push::PoseSample>& s, double t) {
+  if (s.empty() || t < s.front().t || t > s.back().t) return std::nullopt;
+  const auto it = std::lower_bound(s.begin(), s.end(), t, [](const push::PoseSample& a, double x) { return a.t < x; });
+  if (it == s.begin()) return it->pose.translation();
+  const auto prev = it - 1;
+  const double w = (t - prev->t) / (it->t - prev->t);
+  return (1.0 - w) * prev->pose.translation() + w * it->pose.translation();
+}
+
+}  // namespace
+
+std::optional<std::string> ForceDirectionNote(const push::Trajectory& traj) {
+  const auto& forces = traj.measured.force;
+  const auto& finger = traj.measured.finger_pose;
+  if (forces.size() < 20 || finger.size() < 5 || !traj.extra_fingers.empty()) return std::nullopt;
+  std::vector<double> magnitude;
+  for (const auto& f : forces) magnitude.push_back(f.force.norm());
+  const double strong = 0.25 * Percentile95(magnitude);
+  // The finger's velocity by a central difference over +-h. Summed over the samples, its noise
+  // (a 5 mm tracker at 250 Hz is noisier than a 50 mm/s push sample by sample) averages out of
+  // the work sum f . v while |f| |v| keeps it: the ratio is a lower bound of the mean cosine.
+  const double h = std::max(0.1, 2.0 * MedianPeriod(finger));
+  double work = 0.0, scale = 0.0;
+  std::size_t used = 0, against = 0;
+  for (const auto& f : forces) {
+    if (!(f.force.norm() >= strong) || !(f.force.norm() > 0.0)) continue;
+    const auto a = FingerPositionAt(finger, f.t - h), b = FingerPositionAt(finger, f.t + h);
+    if (!a || !b) continue;
+    const geometry::Vec2 v = (*b - *a) / (2.0 * h);
+    work += f.force.dot(v);
+    scale += f.force.norm() * v.norm();
+    against += f.force.dot(v) < 0.0;
+    ++used;
+  }
+  if (used < 20 || !(scale > 0.0)) return std::nullopt;
+  // Quasi-static pushing dissipates what the finger puts in: the force on the object has a
+  // positive component along the contact point's velocity, which is the finger's.
+  const double mean_cosine = work / scale;
+  if (mean_cosine >= 0.0) return std::nullopt;
+  return Format("force: the measured force does negative work on the object (the force and the finger's motion are at a "
+                "mean cosine of %.2f over the %zu samples where it pushes, %.0f%% of them pointing against the motion), "
+                "but a pushing finger does positive work: is the stream the force on the sensor (the reaction: negate "
+                "it), are its x and y swapped, or is it in another frame than the poses'?",
+                mean_cosine, used, 100.0 * static_cast<double>(against) / static_cast<double>(used));
+}
+
+std::optional<std::string> ForceScaleNote(const push::Trajectory& traj) {
+  const auto& forces = traj.measured.force;
+  const auto& object = traj.measured.object_pose;
+  if (forces.size() < 20 || object.size() < 2 || !(traj.object.mass > 0.0) || !(traj.object.mu_surface > 0.0) ||
+      !traj.extra_fingers.empty())
+    return std::nullopt;
+  std::vector<double> magnitude;
+  for (const auto& f : forces) magnitude.push_back(f.force.norm());
+  const double p95 = Percentile95(magnitude);
+  const double load = traj.object.mu_surface * traj.object.mass * limit_surface::kStandardGravity;
+  // A quasi-static push needs about the friction load mu m g to slide the object (from about a
+  // third of it, turning about a far point, to the whole of it in translation); impacts and
+  // miscalibration aside, 20 times more or less is another unit or a wrong mass or mu.
+  constexpr double kFactor = 20.0;
+  double travel = 0.0;
+  for (const auto& o : object) travel = std::max(travel, (o.pose.translation() - object.front().pose.translation()).norm());
+  if (p95 > kFactor * load) {
+    return Format("force: the measured forces (95th percentile %.3g N) are %.0f times the object's friction load mu_surface "
+                  "m g = %.3g N, about what a quasi-static push needs: is the force in millinewtons (or the mass or "
+                  "mu_surface too small)?",
+                  p95, p95 / load, load);
+  }
+  if (travel > 0.01 && p95 < load / kFactor) {
+    return Format("force: the object moves %.0f mm but the measured forces (95th percentile %.3g N) are 1/%.0f of its "
+                  "friction load mu_surface m g = %.3g N, about what a quasi-static push needs: is the force in kilonewtons, "
+                  "or the mass or mu_surface too large?",
+                  1e3 * travel, p95, load / p95, load);
+  }
+  return std::nullopt;
+}
+
+std::optional<push::Trajectory> DropObjectPoseGlitches(const push::Trajectory& traj, std::string* note) {
+  const auto& s = traj.measured.object_pose;
+  const std::size_t n = s.size();
+  if (n < 7) return std::nullopt;
+  // Each sample against the component-wise median of its neighbours within +-max(0.1 s, 3
+  // periods): a glitch of up to ~40 % of that window (a 40 ms jump of a 250 Hz tracker) leaves the
+  // median on the true path, and a steady motion moves it by nothing in the middle of the window.
+  const double half = std::max(0.1, 3.0 * MedianPeriod(s));
+  std::vector<double> position_gap(n), angle_gap(n), xs, ys, as;
+  for (std::size_t i = 0, lo = 0, hi = 0; i < n; ++i) {
+    while (s[i].t - s[lo].t > half) ++lo;
+    while (hi + 1 < n && s[hi + 1].t - s[i].t <= half) ++hi;
+    xs.clear(), ys.clear(), as.clear();
+    for (std::size_t j = lo; j <= hi; ++j) {
+      if (j == i) continue;
+      xs.push_back(s[j].pose.x), ys.push_back(s[j].pose.y);
+      as.push_back(std::remainder(s[j].pose.theta - s[i].pose.theta, 2.0 * M_PI));
+    }
+    if (xs.size() < 4) { position_gap[i] = angle_gap[i] = 0.0; continue; }
+    position_gap[i] = std::hypot(s[i].pose.x - Median(xs), s[i].pose.y - Median(ys));
+    angle_gap[i] = std::abs(Median(as));
+  }
+  // The stream's own scatter about its running median (1.4826 MAD: a Gaussian's sigma).
+  const double sigma_p = 1.4826 * Median(position_gap), sigma_a = 1.4826 * Median(angle_gap);
+  const double bound_p = std::max(0.01, 10.0 * sigma_p), bound_a = std::max(0.3, 10.0 * sigma_a);
+  std::vector<bool> glitch(n);
+  std::size_t count = 0, first = n;
+  for (std::size_t i = 0; i < n; ++i) {
+    glitch[i] = position_gap[i] > bound_p || angle_gap[i] > bound_a;
+    if (glitch[i] && count++ == 0) first = i;
+  }
+  // More than a tenth is no glitch but the stream itself (a yaw in degrees, another unit): left
+  // to the other checks and the diagnostics.
+  if (count == 0 || 10 * count > n) return std::nullopt;
+  push::Trajectory out = traj;
+  out.measured.object_pose.clear();
+  for (std::size_t i = 0; i < n; ++i)
+    if (!glitch[i]) out.measured.object_pose.push_back(s[i]);
+  *note = Format("%zu object pose sample%s left out as tracker glitches (more than %.3g mm or %.3g deg from the median of "
+                 "their neighbours within +-%.3g s); the first: object_pose[%zu] at t = %.9g s, %.3g mm and %.3g deg off",
+                 count, count == 1 ? "" : "s", 1e3 * bound_p, bound_a * 180.0 / M_PI, half, first, s[first].t,
+                 1e3 * position_gap[first], angle_gap[first] * 180.0 / M_PI);
+  return out;
+}
+
+std::optional<std::string> YawUnitNote(const push::Trajectory& traj) {
+  const auto& s = traj.measured.object_pose;
+  if (s.size() < 7) return std::nullopt;
+  // The yaw's scatter about the median of its neighbours within +-0.1 s: a tracker's is below a
+  // few degrees; a yaw in degrees read as radians scatters by tens of "radians".
+  std::vector<double> gaps, as;
+  const double half = std::max(0.1, 3.0 * MedianPeriod(s));
+  for (std::size_t i = 0, lo = 0, hi = 0; i < s.size(); ++i) {
+    while (s[i].t - s[lo].t > half) ++lo;
+    while (hi + 1 < s.size() && s[hi + 1].t - s[i].t <= half) ++hi;
+    as.clear();
+    for (std::size_t j = lo; j <= hi; ++j)
+      if (j != i) as.push_back(std::remainder(s[j].pose.theta - s[i].pose.theta, 2.0 * M_PI));
+    if (as.size() >= 4) gaps.push_back(std::abs(Median(as)));
+  }
+  if (gaps.size() < 5) return std::nullopt;
+  const double scatter = 1.4826 * Median(gaps);
+  // The turning rate over the same windows: a pushed object turns at a few rad/s at most (a
+  // 10 cm object pushed at 0.2 m/s at its edge: 4 rad/s); in degrees a slow turn reads 57 times faster.
+  std::vector<double> rates;
+  for (std::size_t i = 0, j = 0; i < s.size(); ++i) {
+    while (j + 1 < s.size() && s[j].t - s[i].t < half) ++j;
+    if (s[j].t - s[i].t >= half) rates.push_back(std::abs(std::remainder(s[j].pose.theta - s[i].pose.theta, 2.0 * M_PI)) / (s[j].t - s[i].t));
+  }
+  const double rate = rates.size() >= 5 ? Median(rates) : 0.0;
+  double lo_t = INFINITY, hi_t = -INFINITY;
+  for (const auto& p : s) lo_t = std::min(lo_t, p.pose.theta), hi_t = std::max(hi_t, p.pose.theta);
+  constexpr double kMaxScatter = 0.2, kMaxRate = 8.0;  // rad (11 degrees), rad/s (1.3 turns a second)
+  if (scatter < kMaxScatter && rate < kMaxRate) return std::nullopt;
+  return Format("object_pose: the yaw scatters by %.3g rad (%.0f deg) about the median of its neighbours within +-%.3g s, "
+                "turns at a median %.3g rad/s, and spans %.3g to %.3g: is it in degrees? Trajectory angles are in radians "
+                "(a tracker's yaw noise is a few degrees at most, and a pushed object turns at a few rad/s)",
+                scatter, scatter * 180.0 / M_PI, half, rate, lo_t, hi_t);
 }
 
 std::optional<std::string> TimeUnitNote(const push::Trajectory& traj) {
