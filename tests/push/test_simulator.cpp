@@ -514,7 +514,10 @@ TEST_F(SimulateCli, BadInputIsOneLineError) {
                                   // A file estimate could not read: noise beyond its range, or no object pose at all.
                                   std::string("-o " + out + " --sigma-object 1e300,1e300"),
                                   std::string("-o " + out + " --sigma-force 2e6"),
-                                  std::string("-o " + out + " --occlusion -1,100")}) {
+                                  std::string("-o " + out + " --occlusion -1,100"),
+                                  // 50 m/s (mm/s meant): the push ends before a second sample.
+                                  std::string("-o " + out + " --speed 50"),
+                                  std::string("-o " + out + " --rate-object 0 --rate-finger 0 --rate-contact 0 --rate-force 0")}) {
     const pushgraph::testing::ToolRun r = RunTool(args);
     EXPECT_FALSE(std::ifstream(out).good()) << args << ": a file was written";
     EXPECT_NE(r.status, 0) << args;

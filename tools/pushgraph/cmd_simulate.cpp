@@ -177,7 +177,16 @@ void Run(const SimulateOptions& o) {
   if (o.no_ground_truth) trajectory.ground_truth.reset();
   // --occlusion windows (stop mode) over the whole push leave nothing that anchors the object,
   // which estimate refuses: said here, before a file that cannot be estimated is written.
-  if (trajectory.measured.object_pose.empty()) {
+  // A push shorter than two sample periods of every stream (--speed 50 typed for mm/s: 5 cm in
+  // 1 ms) writes one sample per stream, which no estimate can use.
+  const std::size_t most = std::max({trajectory.measured.object_pose.size(), trajectory.measured.finger_pose.size(),
+                                     trajectory.measured.contact_point.size(), trajectory.measured.force.size()});
+  if (most < 3) {
+    throw CliError("the push is sampled at most " + std::to_string(most) + " time(s) per stream: it ends within two "
+                   "sample periods of every stream (--speed " + FormatDouble(o.speed) +
+                   " m/s; is it in m/s?), or every stream is disabled (--rate-* 0)");
+  }
+  if (trajectory.measured.object_pose.empty() && !o.occlusions.empty() && o.rate_object > 0.0) {
     throw CliError("every object pose sample falls inside an --occlusion window (stop mode): the file would have no "
                    "object poses, which estimate needs; shorten the windows or use --occlusion-mode degrade");
   }
