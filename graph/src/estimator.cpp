@@ -329,6 +329,13 @@ EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode 
   if (auto clock = internal::TimeUnitNote(trajectory)) r.warnings.insert(r.warnings.begin(), *clock);
   if (auto direction = internal::ForceDirectionNote(input)) r.warnings.insert(r.warnings.begin(), *direction);
   if (auto scale = internal::ForceScaleNote(input)) r.warnings.insert(r.warnings.begin(), *scale);
+  if (auto sigmas = internal::MeasurementSigmaNote(input, config.measurement)) r.warnings.insert(r.warnings.begin(), *sigmas);
+  if (const std::size_t n = trajectory.measured.object_pose.size(); n < 3) {
+    r.warnings.push_back("object_pose: only " + std::to_string(n) + " sample" + (n == 1 ? "" : "s") +
+                         ": the object's path between them rests on the contacts" +
+                         (model == Model::kQs || model == Model::kYu ? " and the pushing model" : "") +
+                         ", and a wrong shape frame or friction cannot be told from the data");
+  }
   return r;
 }
 

@@ -471,6 +471,9 @@ std::optional<push::Trajectory> DropObjectPoseGlitches(const push::Trajectory& t
 /// A warning when the object's yaw scatters by more than 0.2 rad about its running median: a yaw
 /// in degrees.
 std::optional<std::string> YawUnitNote(const push::Trajectory& trajectory);
+/// A warning naming every measurement sigma above ten times the range of its stream's values
+/// (and above 1 cm, 1 N; rotation above 10 rad): such a stream carries no weight.
+std::optional<std::string> MeasurementSigmaNote(const push::Trajectory& trajectory, const push::MeasurementSigmas& sigmas);
 /// A gap in the object pose stream that counts as the object unobserved (an occluded camera):
 /// longer than max(3 median object periods, 0.1 s); INFINITY with fewer than two poses.
 double LongObjectGap(const push::Trajectory& trajectory);

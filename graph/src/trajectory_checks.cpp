@@ -427,6 +427,39 @@ std::optional<std::string> YawUnitNote(const push::Trajectory& traj) {
                 scatter, scatter * 180.0 / M_PI, half, rate, lo_t, hi_t);
 }
 
+std::optional<std::string> MeasurementSigmaNote(const push::Trajectory& traj, const push::MeasurementSigmas& sigma) {
+  const auto& m = traj.measured;
+  // How far a stream's values range: a sigma ten times beyond it (and beyond 1 cm, 1 N) leaves its
+  // samples no weight at all, which no sensor's noise model means (1000 m typed for 1000 um?).
+  auto span = [](const auto& samples, auto value) {
+    if (samples.empty()) return 0.0;
+    Eigen::Vector2d lo = value(samples.front()), hi = lo;
+    for (const auto& x : samples) lo = lo.cwiseMin(value(x)), hi = hi.cwiseMax(value(x));
+    return (hi - lo).norm();
+  };
+  const auto pose = [](const push::PoseSample& x) -> Eigen::Vector2d { return x.pose.translation(); };
+  std::string found;
+  auto check = [&](double value, double range, double floor, const char* name, const char* unit) {
+    const double bound = 10.0 * std::max(range, floor);
+    if (value > bound) {
+      found += Format("%s%s %.3g %s (the stream ranges over %.3g %s)", found.empty() ? "" : ", ", name, value, unit, range, unit);
+    }
+  };
+  if (!m.object_pose.empty()) check(sigma.object_trans, span(m.object_pose, pose), 0.01, "object_pose", "m");
+  if (!m.finger_pose.empty()) check(sigma.finger_trans, span(m.finger_pose, pose), 0.01, "finger_pose", "m");
+  if (!m.contact_point.empty())
+    check(sigma.contact, span(m.contact_point, [](const push::PointSample& x) -> Eigen::Vector2d { return x.point; }), 0.01,
+          "contact_point", "m");
+  if (!m.force.empty())
+    check(sigma.force, span(m.force, [](const push::ForceSample& x) -> Eigen::Vector2d { return x.force; }), 1.0, "force", "N");
+  if (!m.object_pose.empty() && sigma.object_rot > 10.0)
+    found += Format("%sobject_pose rotation %.3g rad", found.empty() ? "" : ", ", sigma.object_rot);
+  if (found.empty()) return std::nullopt;
+  return "measurement sigmas: " + found +
+         ": ten times beyond the values the stream takes, its samples carry no weight in the estimate; are the sigmas "
+         "in other units (metres, radians, newtons)?";
+}
+
 std::optional<std::string> TimeUnitNote(const push::Trajectory& traj) {
   const auto& m = traj.measured;
   double finest = INFINITY;

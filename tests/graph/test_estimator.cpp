@@ -240,6 +240,22 @@ TEST(Estimator, AYawInDegreesIsNamed) {
   EXPECT_TRUE(HasWarning(Estimate(degrees, Model::kCp, Mode::kBatch), "object_pose: the yaw scatters by"));
 }
 
+// Measurement sigmas far beyond the values their stream takes (1000 m for a 5 cm push) leave
+// its samples no weight and are named; so is an object seen once.
+TEST(Estimator, SigmasBeyondTheDataAndASingleObjectSampleAreNamed) {
+  const push::Trajectory good = GeneratePush(OffsetPush(3, 0.5));
+  EXPECT_FALSE(HasWarning(Estimate(good, Model::kCp, Mode::kBatch), "measurement sigmas:"));
+  EstimatorConfig cfg;
+  cfg.measurement.object_trans = 1000.0;
+  const EstimationResult r = Estimate(good, Model::kCp, Mode::kBatch, cfg);
+  EXPECT_TRUE(HasWarning(r, "measurement sigmas: object_pose 1e+03 m")) << (r.warnings.empty() ? "" : r.warnings[0]);
+  EXPECT_FALSE(HasWarning(r, "finger_pose 1e+03"));
+  push::Trajectory once = good;
+  once.measured.object_pose.resize(1);
+  EXPECT_TRUE(HasWarning(Estimate(once, Model::kQs, Mode::kBatch), "object_pose: only 1 sample: "));
+  EXPECT_FALSE(HasWarning(Estimate(good, Model::kQs, Mode::kBatch), "object_pose: only"));
+}
+
 // Joint estimation of c: started 40% too high, the estimate moves towards the value of the
 // simulated object and reports a sigma.
 TEST(Estimator, JointEstimationOfCMovesTowardsTheTruth) {

@@ -12,10 +12,12 @@
 int main(int argc, char** argv) {
   using namespace pushgraph::cli;
 #ifdef PUSHGRAPH_WITH_GRAPH
-  // Ceres logs through glog: warnings to stderr, no log files, and no "Logging before
+  // Ceres logs through glog: to stderr, no log files, and no "Logging before
   // InitGoogleLogging()" line ahead of the first one.
   FLAGS_logtostderr = true;
-  FLAGS_minloglevel = google::GLOG_WARNING;
+  // Errors only: a warning of Ceres (a rank-deficient covariance) is already in the result's
+  // covariance status, and a raw log line on stderr read as a crash to a user.
+  FLAGS_minloglevel = google::GLOG_ERROR;
   google::InitGoogleLogging(argv[0]);
 #endif
   CLI::App app{"pushgraph: geometry-exact planar contact, limit surfaces and pushing estimation"};
