@@ -116,10 +116,51 @@ std::vector<geometry::Polygon> AssemblePolygons(const std::vector<geometry::Ring
 
 // tinyobjloader's number parser is not correctly rounded (it can be 1 ulp off); re-read the
 // vertex lines with strtod, which is. Returns empty if the file's vertex count differs.
+// A polygon face (4+ vertices) whose outline crosses itself in its own plane (a bow-tie quad):
+// the parser's fan triangulation then covers neither what the outline encloses nor its hull.
+// The plane's normal by Newell's method; the outline projected along its largest component and
+// every pair of non-adjacent edges tested for a proper crossing (orientation signs).
+bool FaceCrossesItself(const std::vector<double>& xyz, const std::vector<long>& face) {
+  const std::size_t n = face.size();
+  double normal[3] = {0.0, 0.0, 0.0};
+  for (std::size_t i = 0; i < n; ++i) {
+    const double* a = &xyz[3 * face[i]];
+    const double* b = &xyz[3 * face[(i + 1) % n]];
+    normal[0] += (a[1] - b[1]) * (a[2] + b[2]);
+    normal[1] += (a[2] - b[2]) * (a[0] + b[0]);
+    normal[2] += (a[0] - b[0]) * (a[1] + b[1]);
+  }
+  // A bow-tie's two lobes cancel in Newell's sum: with no normal left, the plane is the one across
+  // the axis of least extent.
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (long k : face)
+    for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], xyz[3 * k + a]), hi[a] = std::max(hi[a], xyz[3 * k + a]);
+  const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+  double weight[3];
+  const bool flat = std::abs(normal[0]) + std::abs(normal[1]) + std::abs(normal[2]) <= 1e-9 * extent * extent;
+  for (int a = 0; a < 3; ++a) weight[a] = flat ? -(hi[a] - lo[a]) : std::abs(normal[a]);
+  const int drop = weight[0] >= weight[1] && weight[0] >= weight[2] ? 0 : weight[1] >= weight[2] ? 1 : 2;
+  const int u = (drop + 1) % 3, v = (drop + 2) % 3;
+  auto point = [&](std::size_t i) { return std::pair<double, double>{xyz[3 * face[i % n] + u], xyz[3 * face[i % n] + v]}; };
+  auto orient = [](std::pair<double, double> a, std::pair<double, double> b, std::pair<double, double> c) {
+    const double d = (b.first - a.first) * (c.second - a.second) - (b.second - a.second) * (c.first - a.first);
+    return (d > 0.0) - (d < 0.0);
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = i + 2; j < n; ++j) {
+      if (i == 0 && j == n - 1) continue;  // adjacent through the closing edge
+      const auto a = point(i), b = point(i + 1), c = point(j), d = point(j + 1);
+      if (orient(a, b, c) * orient(a, b, d) < 0 && orient(c, d, a) * orient(c, d, b) < 0) return true;
+    }
+  }
+  return false;
+}
+
 // Lines of a kind the OBJ format does not define are counted in *unknown (the first one named in
 // *first_unknown): the parser skips them, which a corrupted or mislabelled file should not pass.
 std::vector<double> ReadVertexCoordinates(const std::string& path, std::size_t expected, int* unknown,
-                                          std::string* first_unknown) {
+                                          std::string* first_unknown, int* crossing, std::string* first_crossing) {
+  std::vector<long> face;
   std::ifstream in(path);
   std::vector<double> out;
   std::string line;
@@ -150,11 +191,14 @@ std::vector<double> ReadVertexCoordinates(const std::string& path, std::size_t e
                         std::to_string(vertices) + " vertices defined before it: '" + line + "'");
         }
         ++count;
+        face.push_back(index > 0 ? index - 1 : vertices + index);
       }
       if (count < 3) {
         throw IoError(path + ":" + std::to_string(line_number) + ": a face needs at least 3 vertices, this one has " +
                       std::to_string(count) + " (a truncated file?): '" + line + "'");
       }
+      if (count >= 4 && FaceCrossesItself(out, face) && ++*crossing == 1) *first_crossing = std::to_string(line_number);
+      face.clear();
       continue;
     }
     if (c[0] != 'v' || (c[1] != ' ' && c[1] != '\t')) {
@@ -233,9 +277,15 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
     throw IoError(path + ": no object named '" + options.object + "' (the file has: " + names + ")");
   }
   const int nv = static_cast<int>(attrib.vertices.size() / 3);
-  int unknown_lines = 0;
-  std::string first_unknown;
-  std::vector<double> coordinates = ReadVertexCoordinates(path, attrib.vertices.size(), &unknown_lines, &first_unknown);
+  int unknown_lines = 0, crossing_faces = 0;
+  std::string first_unknown, first_crossing;
+  std::vector<double> coordinates = ReadVertexCoordinates(path, attrib.vertices.size(), &unknown_lines, &first_unknown,
+                                                          &crossing_faces, &first_crossing);
+  if (crossing_faces > 0) {
+    rep.warnings.push_back(std::to_string(crossing_faces) + " face(s) cross themselves (the first at line " + first_crossing +
+                           "): such a face is triangulated as a fan, which covers neither its outline's inside nor its "
+                           "hull; split it into simple faces");
+  }
   if (unknown_lines > 0) {
     rep.warnings.push_back(std::to_string(unknown_lines) + " line(s) that are no OBJ statement were skipped (the first at line " +
                            first_unknown + "): is it an OBJ file, and complete?");

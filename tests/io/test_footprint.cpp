@@ -139,6 +139,19 @@ TEST_F(Footprint, SideViewsAndSeveralObjectsAreWarned) {
   EXPECT_NE(garbled_report.warnings[0].find("2 line(s) that are no OBJ statement were skipped (the first at line 5: 'hello world')"),
             std::string::npos)
       << garbled_report.warnings[0];
+  // A bow-tie quad is named (its fan triangulation is neither the bow-tie nor the square); a
+  // convex and a non-convex (L-shaped) simple face pass.
+  const std::string bowtie = Write("b.obj", "v 0 0 0\nv 0.05 0.05 0\nv 0.05 0 0\nv 0 0.05 0\nf 1 2 3 4\n");
+  io::FootprintReport bowtie_report;
+  io::MeshFootprint(bowtie, {}, &bowtie_report);
+  ASSERT_EQ(bowtie_report.warnings.size(), 1u);
+  EXPECT_NE(bowtie_report.warnings[0].find("1 face(s) cross themselves (the first at line 5)"), std::string::npos)
+      << bowtie_report.warnings[0];
+  const std::string ell = Write("l.obj", "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\nf 1 2 3 4 5 6\n"
+                                         "v 0 0 1\nv 0 1 1\nv 1 1 1\nv 1 0 1\nf 7 8 9 10\n");
+  io::FootprintReport ell_report;
+  io::MeshFootprint(ell, {}, &ell_report);
+  EXPECT_TRUE(ell_report.warnings.empty()) << ell_report.warnings[0];
   // The axes a prism is extruded along, which LoadShapeArgument uses to read a probe's mesh.
   io::FootprintReport tip;
   io::MeshFootprint(kObj + "tip.obj", {}, &tip);
