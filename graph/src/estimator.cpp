@@ -322,14 +322,19 @@ EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode 
     for (const auto& [key, value] : ComputeMetrics(*before_glitches, r.states))
       if (key.rfind("measured_object", 0) == 0) r.metrics[key] = value;
   }
-  if (!note.empty()) r.warnings.insert(r.warnings.begin(), note);
-  if (!glitch_note.empty()) r.warnings.insert(r.warnings.begin(), glitch_note);
-  if (auto yaw = internal::YawUnitNote(trajectory)) r.warnings.insert(r.warnings.begin(), *yaw);
+  // The input's own warnings first, in this order: the clock and units, then what was left out,
+  // then what the streams say against the physics of a push.
+  std::vector<std::string> front;
+  auto add = [&front](const std::optional<std::string>& w) { if (w) front.push_back(*w); };
+  add(internal::TimeUnitNote(trajectory));
+  add(internal::YawUnitNote(trajectory));
+  if (!note.empty()) front.push_back(note);
+  if (!glitch_note.empty()) front.push_back(glitch_note);
+  add(internal::ForceDirectionNote(input));
+  add(internal::ForceScaleNote(input, config.measurement.force));
+  add(internal::MeasurementSigmaNote(input, config.measurement));
+  r.warnings.insert(r.warnings.begin(), front.begin(), front.end());
   if (auto unobserved = UnobservedObjectNote(trajectory, model)) r.warnings.push_back(*unobserved);
-  if (auto clock = internal::TimeUnitNote(trajectory)) r.warnings.insert(r.warnings.begin(), *clock);
-  if (auto direction = internal::ForceDirectionNote(input)) r.warnings.insert(r.warnings.begin(), *direction);
-  if (auto scale = internal::ForceScaleNote(input)) r.warnings.insert(r.warnings.begin(), *scale);
-  if (auto sigmas = internal::MeasurementSigmaNote(input, config.measurement)) r.warnings.insert(r.warnings.begin(), *sigmas);
   if (const std::size_t n = trajectory.measured.object_pose.size(); n < 3) {
     r.warnings.push_back("object_pose: only " + std::to_string(n) + " sample" + (n == 1 ? "" : "s") +
                          ": the object's path between them rests on the contacts" +

@@ -460,9 +460,9 @@ std::optional<std::string> TimeUnitNote(const push::Trajectory& trajectory);
 /// (the force on the sensor), its axes swapped, or another frame.
 std::optional<std::string> ForceDirectionNote(const push::Trajectory& trajectory);
 /// A warning when the measured forces' 95th percentile is over 20 times the object's friction load
-/// mu m g, or under 1/20 of it while the object moves over 1 cm (a quasi-static push needs about
+/// mu m g (and 5 force sigmas), or their fifth largest under 1/20 of it while the object moves over 1 cm (a quasi-static push needs about
 /// that load): another force unit, or a wrong mass or mu_surface.
-std::optional<std::string> ForceScaleNote(const push::Trajectory& trajectory);
+std::optional<std::string> ForceScaleNote(const push::Trajectory& trajectory, double force_sigma);
 /// The object pose stream without its tracker glitches: samples more than max(1 cm, 10 scatters)
 /// or max(0.3 rad, 10 scatters) from the median of their neighbours within +-max(0.1 s, 3
 /// periods), when they are at most a tenth of the stream (more is the stream itself, left to the

@@ -235,12 +235,19 @@ struct FixedLagSmoother {
           J[q].resize(m, problem->ParameterBlockSize(ps[q]));
           jp[q] = J[q].data();
         }
-        // The window solve has just evaluated every factor at this point, so a failure here is a
-        // fault (a factor whose Evaluate is not a function of its inputs), named rather than skipped.
+        // A factor that does not evaluate here (its own domain: a contact "not facing", c or f_max
+        // out of range) or evaluates to non-finite values keeps zero rows: it adds no information
+        // to the marginal prior, the documented fallback (docs/estimation.md), rather than ending
+        // the run or putting NaN into the prior.
         if (!cost->Evaluate(ps.data(), r.data(), jp.data()) || !r.allFinite()) {
-          throw GraphError("incremental: marginalizing step " + std::to_string(s) + ": the " + builder.Describe(id) +
-                           " could not be evaluated (a non-finite residual or Jacobian) at the estimate it was "
-                           "solved to");
+          row += m;
+          continue;
+        }
+        bool finite = true;
+        for (std::size_t q = 0; q < ps.size(); ++q) finite = finite && J[q].allFinite();
+        if (!finite) {
+          row += m;
+          continue;
         }
         double scale = 1.0;
         if (loss != nullptr) {
@@ -248,13 +255,7 @@ struct FixedLagSmoother {
           loss->Evaluate(r.squaredNorm(), rho);
           scale = std::sqrt(std::max(rho[1], 0.0));
         }
-        for (std::size_t q = 0; q < ps.size(); ++q) {
-          if (!J[q].allFinite()) {
-            throw GraphError("incremental: marginalizing step " + std::to_string(s) + ": the " + builder.Describe(id) +
-                             " has a non-finite Jacobian at the estimate it was solved to");
-          }
-          A.block(row, offset[ps[q]], m, J[q].cols()) += scale * J[q];
-        }
+        for (std::size_t q = 0; q < ps.size(); ++q) A.block(row, offset[ps[q]], m, J[q].cols()) += scale * J[q];
         A.col(dim).segment(row, m) = scale * r;
         row += m;
       }

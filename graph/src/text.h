@@ -7,12 +7,15 @@
 
 namespace pushgraph::graph::internal {
 
-/// printf-style formatting into a string (messages of at most 320 characters).
+/// printf-style formatting into a string of any length (measured first).
 template <class... Args>
 std::string Format(const char* fmt, Args... args) {
-  char buf[320];
-  std::snprintf(buf, sizeof buf, fmt, args...);
-  return buf;
+  const int size = std::snprintf(nullptr, 0, fmt, args...);
+  if (size <= 0) return {};
+  std::string out(static_cast<std::size_t>(size) + 1, '\0');
+  std::snprintf(out.data(), out.size(), fmt, args...);
+  out.resize(static_cast<std::size_t>(size));
+  return out;
 }
 
 /// The median (upper middle for an even count); 0 for an empty vector.

@@ -284,13 +284,10 @@ TEST_F(EstimateCli, AMeshTurnedBy37DegreesIsAligned) {
   }
 }
 
-// The mesh in millimetres and nothing else: the placement found with the units (turned by 12.1
-// degrees, shifted by (-5.0, -5.6) mm, sigmas 8.1 degrees, 4.8 and 2.4 mm) is within three sigmas
-// of none, and saving it would bake the turn into the file (later recordings then accepted it:
-// 1.69 against 1.23 mm), so the units alone are offered too.
 // The dataset's meshes given directly (--object rect1.obj --finger tip.obj) are read as
-// `pushgraph footprint` reads them, the probe's cylinder (a prism along y) by its cross-section,
-// and say so; the estimate is the one from the converted files. A mesh in another format is
+// `pushgraph footprint` reads them, the probe's cylinder (a prism along y) by its cross-section
+// and then as the 4.7 mm disk it tessellates, and say so; the estimate is the one from the
+// converted object file and a 4.7 mm disk probe. A mesh in another format is
 // told which files are read (it was "malformed JSON" alone).
 TEST_F(EstimateCli, MeshFilesAreReadDirectly) {
   if (Mit().empty()) GTEST_SKIP() << "no MIT data";
@@ -330,6 +327,10 @@ TEST_F(EstimateCli, MeshFilesAreReadDirectly) {
   EXPECT_NE(stl.err.find("OBJ meshes, named .obj, are read directly"), std::string::npos) << stl.err;
 }
 
+// The mesh in millimetres and nothing else: the placement found with the units (turned by 12.1
+// degrees, shifted by (-5.0, -5.6) mm, sigmas 8.1 degrees, 4.8 and 2.4 mm) is within three sigmas
+// of none, and saving it would bake the turn into the file (later recordings then accepted it:
+// 1.69 against 1.23 mm), so the units alone are offered too.
 TEST_F(EstimateCli, AMeshInMillimetresIsOfferedItsUnitsAlone) {
   if (Mit().empty()) GTEST_SKIP() << "no MIT data";
   const std::string h5 = Mit() + "abs/rect1/motion_surface=abs_shape=rect1_a=0_v=75_i=2.000_s=0.800_t=0.000.h5";

@@ -152,10 +152,13 @@ TEST(Estimator, TimeStampsInMillisecondsAreNamed) {
     EXPECT_TRUE(has_clock_warning(r, unit)) << unit << ": " << (r.warnings.empty() ? "no warning" : r.warnings[0]);
     ASSERT_FALSE(r.warnings.empty());
     EXPECT_EQ(r.warnings[0].rfind("time stamps:", 0), 0u) << r.warnings[0];
+    // The whole message, to its advice (messages were cut at 319 characters).
+    const std::string advice = factor == 1e3 ? "divide the times by 1000" : "divide the times by 1e+06";
+    EXPECT_NE(r.warnings[0].find(advice), std::string::npos) << r.warnings[0];
   }
 }
 
-// A friction load below a millinewton (a mass given in tonnes, or 1e-30 kg) is refused by the
+// A friction load below a millinewton (1e-30 kg, or 1e-5 kg: a mass in the wrong unit) is refused by the
 // models with forces, naming the load, mass and mu; the contact-point model has no force and runs.
 TEST(Estimator, AFrictionLoadBelowAMillinewtonIsRefused) {
   push::Trajectory t = GeneratePush(OffsetPush(3, 0.5));
@@ -172,7 +175,7 @@ TEST(Estimator, AFrictionLoadBelowAMillinewtonIsRefused) {
     }
     EXPECT_NO_THROW(Estimate(t, Model::kCp, Mode::kBatch));
   }
-  t.object.mass = 2e-3;  // 2 g: 6 mN, supported
+  t.object.mass = 2e-3;  // 2 g at mu 0.25: 4.9 mN, supported
   EXPECT_NO_THROW(Estimate(t, Model::kQs, Mode::kBatch));
 }
 
@@ -193,6 +196,15 @@ TEST(Estimator, AForceThatDoesNegativeWorkIsNamed) {
   const EstimationResult r = Estimate(flipped, Model::kCp, Mode::kBatch);
   EXPECT_TRUE(HasWarning(r, "force: the measured force does negative work on the object")) << r.warnings.size();
   EXPECT_TRUE(HasWarning(r, "negate it"));
+  EXPECT_TRUE(HasWarning(r, "in another frame than the poses'?"));  // the whole message
+  // Axes swapped on a push along a diagonal: the force then points against the motion too.
+  PushSpec diagonal = OffsetPush(3, 0.5);
+  diagonal.push_velocity = {0.04, -0.03};
+  const push::Trajectory pushed = GeneratePush(diagonal);
+  EXPECT_FALSE(HasWarning(Estimate(pushed, Model::kCp, Mode::kBatch), "does negative work"));
+  push::Trajectory swapped = pushed;
+  for (auto& f : swapped.measured.force) f.force = geometry::Vec2(f.force.y(), f.force.x());
+  EXPECT_TRUE(HasWarning(Estimate(swapped, Model::kCp, Mode::kBatch), "does negative work"));
 }
 
 // Forces 1000 times the object's friction load (millinewtons), or a mass 1000 times too large
@@ -229,6 +241,18 @@ TEST(Estimator, ObjectTrackerGlitchesAreLeftOut) {
   EXPECT_NEAR(r.metrics.at("object_position_rms"), base.metrics.at("object_position_rms"),
               0.05 * base.metrics.at("object_position_rms"));
   EXPECT_GT(r.metrics.at("measured_object_position_rms"), 2.0 * base.metrics.at("measured_object_position_rms"));
+  // A 10 Hz tracker on a fast push that turns the object: every sample is the object's own (a
+  // window that left the sample out was a period ahead of it and dropped true poses), and its
+  // turning is no yaw in degrees.
+  PushSpec fast = OffsetPush(4, 0.8);
+  fast.object_rate = 10.0;
+  fast.push_velocity = {0.15, 0.0};
+  fast.contact_offset = 0.03;
+  fast.sigma_object_trans = 0.0005;
+  fast.sigma_object_rot = 0.005;
+  const EstimationResult quick = Estimate(GeneratePush(fast), Model::kCp, Mode::kBatch);
+  EXPECT_FALSE(HasWarning(quick, "tracker glitches")) << quick.warnings[0];
+  EXPECT_FALSE(HasWarning(quick, "is it in degrees"));
 }
 
 // A yaw in degrees (read as radians it turns 57 times faster and scatters 57 times more) is named.

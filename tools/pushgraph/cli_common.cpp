@@ -176,7 +176,7 @@ CLI::Validator FrictionValue(bool zero_allowed) {
 
 namespace {
 
-// A finger mesh whose footprint is a regular polygon of 12 or more vertices (a tessellated
+// A finger mesh whose footprint is a regular polygon of 20 or more vertices (a tessellated
 // cylinder: the MIT tip.obj is a 32-gon of radius 4.7 mm) is the disk it approximates: its
 // vertices lie on the cylinder within 0.5 %, and a polygonal finger needs an exact Minkowski-sum
 // obstacle per relative angle (a rect1 recording: 6.4 s against 0.4 s as a disk). Centre and
@@ -185,7 +185,7 @@ std::optional<geometry::Shape> TessellatedDisk(const geometry::Shape& shape) {
   if (shape.polygons().size() != 1 || !shape.polygons()[0].holes.empty() || shape.radius() != 0.0) return std::nullopt;
   const geometry::Ring& ring = shape.polygons()[0].outer;
   const std::size_t n = ring.size();
-  if (n < 12) return std::nullopt;
+  if (n < 20) return std::nullopt;  // a 12-gon's inscribed circle is 3.4 % smaller than its circumcircle
   geometry::Vec2 centre = geometry::Vec2::Zero();
   for (const geometry::Vec2& v : ring) centre += v;
   centre /= static_cast<double>(n);
@@ -217,8 +217,10 @@ geometry::Shape LoadShapeArgument(const std::string& path, const std::string& wh
       io::FootprintOptions options;
       io::FootprintReport report;
       geometry::Shape shape = io::MeshFootprint(path, options, &report);
+      // Objects keep z: a can lying along x is pushed by its 100 x 60 mm side, not its round end.
+      const bool finger = what.find("finger") != std::string::npos;
       const auto& prisms = report.prism_axes;
-      if (prisms.size() == 1 && prisms[0] != io::UpAxis::kZ) {
+      if (finger && prisms.size() == 1 && prisms[0] != io::UpAxis::kZ) {
         options.up = prisms[0];
         report = {};
         shape = io::MeshFootprint(path, options, &report);
@@ -234,9 +236,14 @@ geometry::Shape LoadShapeArgument(const std::string& path, const std::string& wh
                    what.c_str(), path.c_str(), up, options.up == io::UpAxis::kZ ? "" : " (a prism along it: its cross-section)",
                    shape.polygons().size(), holes, box.max.x() - box.min.x(),
                    box.max.y() - box.min.y(), path.c_str());
-      for (const std::string& w : report.warnings)
+      for (std::string w : report.warnings) {
+        // footprint's own flag is named --object; here that names the shape file.
+        const std::string flag = "--object NAME takes one";
+        if (const std::size_t at = w.find(flag); at != std::string::npos)
+          w.replace(at, flag.size(), "pushgraph footprint " + path + " --object NAME -o SHAPE.json takes one");
         std::fprintf(stderr, "pushgraph: warning: %s %s: %s\n", what.c_str(), path.c_str(), w.c_str());
-      if (what.find("finger") != std::string::npos) {
+      }
+      if (finger) {
         if (const std::optional<geometry::Shape> disk = TessellatedDisk(shape)) {
           const geometry::Vec2 centre = disk->polygons()[0].outer[0];
           std::fprintf(stderr,

@@ -148,8 +148,8 @@ void RegisterEstimate(CLI::App& app) {
                   "chain (the default: banded Levenberg-Marquardt, chain_solver.h) or ceres (the reference); overrides the config's")
       ->check(CLI::IsMember({"chain", "ceres"}));
   sub->add_option("--config", opts->config, "Estimator configuration JSON (sigmas, losses, window; docs/estimation.md)");
-  sub->add_option("--object", opts->object, "Object shape JSON (required for MIT recordings; overrides a trajectory's)");
-  sub->add_option("--finger", opts->finger, "Finger (probe) shape JSON (required for MIT recordings)");
+  sub->add_option("--object", opts->object, "Object shape JSON or OBJ mesh (required for MIT recordings; overrides a trajectory's)");
+  sub->add_option("--finger", opts->finger, "Finger (probe) shape JSON or OBJ mesh (required for MIT recordings)");
   sub->add_option("--mass", opts->mass, "Object mass in kg (required for MIT recordings)")->check(MassValue());
   sub->add_option("--mu", opts->mu, "Object-table friction coefficient (required for MIT recordings)")
       ->check(FrictionValue(true));

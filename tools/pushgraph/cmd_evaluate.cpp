@@ -206,8 +206,8 @@ void RegisterEvaluate(CLI::App& app) {
   cmd->add_option("--plots", o->plots,
                   "Pictures of the first N pushes of every object in OUT/plots (Fig. 3, 5, 6 style SVG; 0: none)")
       ->capture_default_str();
-  cmd->add_option("--object", o->object, "Object shape JSON for every MIT recording (with --finger --mass --mu)");
-  cmd->add_option("--finger", o->finger, "Probe shape JSON for every MIT recording");
+  cmd->add_option("--object", o->object, "Object shape JSON or OBJ mesh for every MIT recording (with --finger --mass --mu)");
+  cmd->add_option("--finger", o->finger, "Probe shape JSON or OBJ mesh for every MIT recording");
   cmd->add_option("--mass", o->mass, "Object mass (kg) for every MIT recording")->check(MassValue());
   cmd->add_option("--mu", o->mu, "Object-table friction for every MIT recording")->check(FrictionValue(false));
   cmd->add_option("--mesh-dir", o->mesh_dir,

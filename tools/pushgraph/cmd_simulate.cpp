@@ -6,6 +6,7 @@
 
 #include <pushgraph/evaluation/plots.h>
 #include <pushgraph/io/trajectory_json.h>
+#include <pushgraph/limit_surface/support.h>
 #include <pushgraph/push/simulator.h>
 
 #include <algorithm>
@@ -85,6 +86,12 @@ void Run(const SimulateOptions& o) {
   push::PushPlan plan;
   Positive(o.mass, "--mass");
   Positive(o.mu_surface, "--mu-surface");
+  // estimate's force models (qs, yu) refuse a friction load below 1 mN (graph_builder.cpp): said
+  // here, where the file is made (cp can still estimate it).
+  if (const double load = o.mu_surface * o.mass * limit_surface::kStandardGravity; load < 1e-3) {
+    std::cerr << "simulate: warning: the friction load mu_surface m g = " << FormatDouble(load)
+              << " N is below the 1 mN that estimate's force models (qs, yu) support: is --mass in kg?\n";
+  }
   NonNegative(o.mu_contact, "--mu-contact");
   Positive(o.speed, "--speed");
   NonNegative(o.duration, "--duration");
@@ -241,9 +248,9 @@ void RegisterSimulate(CLI::App& app) {
   auto o = std::make_shared<SimulateOptions>();
   auto* cmd = app.add_subcommand("simulate", "Simulate a quasi-static push and write a trajectory file");
   cmd->add_option("-o,--output", o->output, "Trajectory JSON file to write (pushgraph-trajectory-1)")->required();
-  cmd->add_option("--object", o->object_path, "Object shape JSON (also the support region; uniform pressure)")
+  cmd->add_option("--object", o->object_path, "Object shape JSON or OBJ mesh (also the support region; uniform pressure)")
       ->capture_default_str();
-  auto* finger = cmd->add_option("--finger", o->finger_path, "Finger shape JSON (any shape)")->capture_default_str();
+  auto* finger = cmd->add_option("--finger", o->finger_path, "Finger shape JSON or OBJ mesh (any shape)")->capture_default_str();
   cmd->add_option("--fingers", o->finger_paths,
                   "Two or more finger shape JSON files moving together (instead of --finger): every finger has the "
                   "pusher's pose, placed by its own shape coordinates; all contacts of all fingers are modelled")
