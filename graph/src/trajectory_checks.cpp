@@ -34,6 +34,9 @@ void CheckRange(double t, double value, double bound, const std::string& stream,
     std::ostringstream text;
     text << "trajectory: streams." << stream << "[" << i << "] is out of the supported range (t = " << t << " s, "
          << what << " " << value << "; |t| <= 1e11 s, positions within 1e6 m, forces within 1e9 N)";
+    // Unix time in milliseconds or microseconds (1.7e12, 1.7e15) is the usual way past 1e11 s.
+    if (std::abs(t) > kMaxTime && std::abs(t) < 1e17)
+      text << ": are the time stamps in milliseconds or microseconds? Trajectory times are in seconds";
     throw GraphError(text.str());
   }
 }

@@ -509,6 +509,13 @@ TEST(Estimator, BadTrajectoriesGetClearErrors) {
   for (auto& x : epoch.measured.force) x.t += 1.7e9;
   EXPECT_EQ(message(epoch), "no error");
   EXPECT_EQ(message(t), "no error");
+  auto epoch_ms = epoch;  // unix time in milliseconds: refused, and the unit suggested
+  for (auto* s : {&epoch_ms.measured.object_pose, &epoch_ms.measured.finger_pose}) for (auto& x : *s) x.t *= 1e3;
+  for (auto& x : epoch_ms.measured.contact_point) x.t *= 1e3;
+  for (auto& x : epoch_ms.measured.force) x.t *= 1e3;
+  EXPECT_NE(message(epoch_ms).find("are the time stamps in milliseconds or microseconds?"), std::string::npos)
+      << message(epoch_ms);
+  EXPECT_EQ(message(far).find("milliseconds"), std::string::npos) << message(far);  // a position: no such hint
 }
 
 TEST(Estimator, StepsFollowTheInputClocks) {
