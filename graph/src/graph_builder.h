@@ -450,9 +450,10 @@ Diagnostics Diagnose(const push::Trajectory& trajectory, Model model, const Esti
 /// stream, sample and value): missing shapes or streams, NaN, unsupported magnitudes, unsorted
 /// samples, clock jumps within or between streams.
 void ValidateTrajectory(const push::Trajectory& trajectory);
-/// A warning when every stream is sampled at 0.2 s or slower (5 Hz): the time stamps are likely in
-/// milliseconds or microseconds (times are seconds; a 250 Hz sensor in milliseconds reads 4 s
-/// apart and the noise model's per-second scales then no longer fit the data). Empty otherwise.
+/// A warning when every stream is sampled at 0.2 s or slower (5 Hz) and the streams read in
+/// milliseconds or microseconds are a push (at most 20 kHz, a finger at most 2 m/s): a 250 Hz
+/// sensor in milliseconds reads 4 s apart, and the noise model's per-second scales then no longer
+/// fit the data. Empty otherwise.
 std::optional<std::string> TimeUnitNote(const push::Trajectory& trajectory);
 /// A warning when the measured force does negative work on the object over the samples where it
 /// is above a quarter of its 95th percentile (f . v summed, v the finger's velocity over +-0.1 s):
@@ -460,16 +461,16 @@ std::optional<std::string> TimeUnitNote(const push::Trajectory& trajectory);
 /// (the force on the sensor), its axes swapped, or another frame.
 std::optional<std::string> ForceDirectionNote(const push::Trajectory& trajectory);
 /// A warning when the measured forces' 95th percentile is over 20 times the object's friction load
-/// mu m g (and 5 force sigmas), or their fifth largest under 1/20 of it while the object moves over 1 cm (a quasi-static push needs about
-/// that load): another force unit, or a wrong mass or mu_surface.
+/// mu m g (and 5 force sigmas), or their fifth largest under 1/20 of it while the object moves over
+/// 1 cm (a quasi-static push needs about that load): another force unit, or a wrong mass or mu.
 std::optional<std::string> ForceScaleNote(const push::Trajectory& trajectory, double force_sigma);
 /// The object pose stream without its tracker glitches: samples more than max(1 cm, 10 scatters)
-/// or max(0.3 rad, 10 scatters) from the median of their neighbours within +-max(0.1 s, 3
-/// periods), when they are at most a tenth of the stream (more is the stream itself, left to the
+/// or max(0.3 rad, 10 scatters) from the median of a window centred on them (+-max(0.1 s, 3
+/// periods)), when they are at most a tenth of the stream (more is the stream itself, left to the
 /// other checks); nullopt when there is none; `note` says how many, the first and the bounds.
 std::optional<push::Trajectory> DropObjectPoseGlitches(const push::Trajectory& trajectory, std::string* note);
-/// A warning when the object's yaw scatters by more than 0.2 rad about its running median: a yaw
-/// in degrees.
+/// A warning when the object's yaw scatters by more than 0.2 rad about its centred running median
+/// or turns at a median 8 rad/s or more: a yaw in degrees.
 std::optional<std::string> YawUnitNote(const push::Trajectory& trajectory);
 /// A warning naming every measurement sigma above ten times the range of its stream's values
 /// (and above 1 cm, 1 N; rotation above 10 rad): such a stream carries no weight.

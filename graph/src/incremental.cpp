@@ -239,13 +239,9 @@ struct FixedLagSmoother {
         // out of range) or evaluates to non-finite values keeps zero rows: it adds no information
         // to the marginal prior, the documented fallback (docs/estimation.md), rather than ending
         // the run or putting NaN into the prior.
-        if (!cost->Evaluate(ps.data(), r.data(), jp.data()) || !r.allFinite()) {
-          row += m;
-          continue;
-        }
-        bool finite = true;
-        for (std::size_t q = 0; q < ps.size(); ++q) finite = finite && J[q].allFinite();
-        if (!finite) {
+        const bool usable = cost->Evaluate(ps.data(), r.data(), jp.data()) && r.allFinite() &&
+                            std::all_of(J.begin(), J.end(), [](const auto& Jq) { return Jq.allFinite(); });
+        if (!usable) {
           row += m;
           continue;
         }

@@ -12,7 +12,6 @@
 #include <cmath>
 #include <functional>
 #include <cstdio>
-#include <cstdlib>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -276,11 +275,50 @@ namespace {
 // The finger's position at t, linearly interpolated (nullopt outside the stream).
 std::optional<geometry::Vec2> FingerPositionAt(const std::vector<push::PoseSample>& s, double t) {
   if (s.empty() || t < s.front().t || t > s.back().t) return std::nullopt;
-  const auto it = std::lower_bound(s.begin(), s.end(), t, [](const push::PoseSample& a, double x) { return a.t < x; });
-  if (it == s.begin()) return it->pose.translation();
-  const auto prev = it - 1;
-  const double w = (t - prev->t) / (it->t - prev->t);
-  return (1.0 - w) * prev->pose.translation() + w * it->pose.translation();
+  return push::StreamValueClamped(s, t, [](const push::PoseSample& p) -> geometry::Vec2 { return p.pose.translation(); });
+}
+
+// Each object pose against the component-wise median of a window centred on it (it included, an
+// odd count: on a steady motion the median is the sample itself), +-max(0.1 s, 3 periods) wide
+// with two neighbours or more on each side. A glitch of up to ~40 % of the window (a 40 ms jump of
+// a 250 Hz tracker) leaves the median on the true path; one-sided windows at the stream's ends
+// and beside gaps are biased by the motion and are not judged.
+struct CentredGaps {
+  double half = 0.0;                    ///< the window's half-width, s
+  std::vector<bool> judged;
+  std::vector<double> position, angle;  ///< m, rad; 0 where not judged
+  /// 1.4826 MAD of the judged gaps (a Gaussian's sigma); 0 with none judged.
+  double Scatter(const std::vector<double>& gaps) const {
+    std::vector<double> kept;
+    for (std::size_t i = 0; i < gaps.size(); ++i)
+      if (judged[i]) kept.push_back(gaps[i]);
+    return 1.4826 * Median(kept);
+  }
+};
+
+CentredGaps CentredMedianGaps(const std::vector<push::PoseSample>& s) {
+  const std::size_t n = s.size();
+  CentredGaps g;
+  g.half = std::max(0.1, 3.0 * MedianPeriod(s));
+  g.judged.assign(n, false);
+  g.position.assign(n, 0.0);
+  g.angle.assign(n, 0.0);
+  std::vector<double> xs, ys, as;
+  for (std::size_t i = 0, lo = 0, hi = 0; i < n; ++i) {
+    while (s[i].t - s[lo].t > g.half) ++lo;
+    while (hi + 1 < n && s[hi + 1].t - s[i].t <= g.half) ++hi;
+    const std::size_t side = std::min(i - lo, hi - i);
+    if (side < 2) continue;
+    xs.clear(), ys.clear(), as.clear();
+    for (std::size_t j = i - side; j <= i + side; ++j) {
+      xs.push_back(s[j].pose.x), ys.push_back(s[j].pose.y);
+      as.push_back(std::remainder(s[j].pose.theta - s[i].pose.theta, 2.0 * M_PI));
+    }
+    g.judged[i] = true;
+    g.position[i] = std::hypot(s[i].pose.x - Median(xs), s[i].pose.y - Median(ys));
+    g.angle[i] = std::abs(Median(as));
+  }
+  return g;
 }
 
 }  // namespace
@@ -363,31 +401,12 @@ std::optional<push::Trajectory> DropObjectPoseGlitches(const push::Trajectory& t
   const auto& s = traj.measured.object_pose;
   const std::size_t n = s.size();
   if (n < 7) return std::nullopt;
-  // Each sample against the component-wise median of its neighbours within +-max(0.1 s, 3
-  // periods): a glitch of up to ~40 % of that window (a 40 ms jump of a 250 Hz tracker) leaves the
-  // median on the true path, and a steady motion moves it by nothing in the middle of the window.
-  const double half = std::max(0.1, 3.0 * MedianPeriod(s));
-  std::vector<double> position_gap(n), angle_gap(n), xs, ys, as;
-  for (std::size_t i = 0, lo = 0, hi = 0; i < n; ++i) {
-    while (s[i].t - s[lo].t > half) ++lo;
-    while (hi + 1 < n && s[hi + 1].t - s[i].t <= half) ++hi;
-    // A window centred on the sample (it included, an odd count: on a steady motion the median is
-    // the sample itself) with two neighbours or more on each side; one-sided windows at the
-    // stream's ends and beside gaps are biased by the motion and are not judged.
-    const std::size_t side = std::min(i - lo, hi - i);
-    position_gap[i] = angle_gap[i] = 0.0;
-    if (side < 2) continue;
-    xs.clear(), ys.clear(), as.clear();
-    for (std::size_t j = i - side; j <= i + side; ++j) {
-      xs.push_back(s[j].pose.x), ys.push_back(s[j].pose.y);
-      as.push_back(std::remainder(s[j].pose.theta - s[i].pose.theta, 2.0 * M_PI));
-    }
-    position_gap[i] = std::hypot(s[i].pose.x - Median(xs), s[i].pose.y - Median(ys));
-    angle_gap[i] = std::abs(Median(as));
-  }
-  // The stream's own scatter about its running median (1.4826 MAD: a Gaussian's sigma).
-  const double sigma_p = 1.4826 * Median(position_gap), sigma_a = 1.4826 * Median(angle_gap);
-  const double bound_p = std::max(0.01, 10.0 * sigma_p), bound_a = std::max(0.3, 10.0 * sigma_a);
+  const CentredGaps gaps = CentredMedianGaps(s);
+  const std::vector<double>& position_gap = gaps.position;
+  const std::vector<double>& angle_gap = gaps.angle;
+  const double half = gaps.half;
+  const double bound_p = std::max(0.01, 10.0 * gaps.Scatter(position_gap));
+  const double bound_a = std::max(0.3, 10.0 * gaps.Scatter(angle_gap));
   std::vector<bool> glitch(n);
   std::size_t count = 0, first = n;
   for (std::size_t i = 0; i < n; ++i) {
@@ -411,22 +430,12 @@ std::optional<push::Trajectory> DropObjectPoseGlitches(const push::Trajectory& t
 std::optional<std::string> YawUnitNote(const push::Trajectory& traj) {
   const auto& s = traj.measured.object_pose;
   if (s.size() < 7) return std::nullopt;
-  // The yaw's scatter about the median of its neighbours within +-0.1 s: a tracker's is below a
-  // few degrees; a yaw in degrees read as radians scatters by tens of "radians".
-  std::vector<double> gaps, as;
-  const double half = std::max(0.1, 3.0 * MedianPeriod(s));
-  for (std::size_t i = 0, lo = 0, hi = 0; i < s.size(); ++i) {
-    while (s[i].t - s[lo].t > half) ++lo;
-    while (hi + 1 < s.size() && s[hi + 1].t - s[i].t <= half) ++hi;
-    const std::size_t side = std::min(i - lo, hi - i);  // centred, as DropObjectPoseGlitches
-    if (side < 2) continue;
-    as.clear();
-    for (std::size_t j = i - side; j <= i + side; ++j)
-      as.push_back(std::remainder(s[j].pose.theta - s[i].pose.theta, 2.0 * M_PI));
-    gaps.push_back(std::abs(Median(as)));
-  }
-  if (gaps.size() < 5) return std::nullopt;
-  const double scatter = 1.4826 * Median(gaps);
+  // The yaw's scatter about its centred running median: a tracker's is below a few degrees; a yaw
+  // in degrees read as radians scatters by tens of "radians".
+  const CentredGaps gaps = CentredMedianGaps(s);
+  if (std::count(gaps.judged.begin(), gaps.judged.end(), true) < 5) return std::nullopt;
+  const double scatter = gaps.Scatter(gaps.angle);
+  const double half = gaps.half;
   // The turning rate over the same windows: a pushed object turns at a few rad/s at most (a
   // 10 cm object pushed at 0.2 m/s at its edge: 4 rad/s); in degrees a slow turn reads 57 times faster.
   std::vector<double> rates;

@@ -156,10 +156,15 @@ bool FaceCrossesItself(const std::vector<double>& xyz, const std::vector<long>& 
   return false;
 }
 
-// Lines of a kind the OBJ format does not define are counted in *unknown (the first one named in
-// *first_unknown): the parser skips them, which a corrupted or mislabelled file should not pass.
-std::vector<double> ReadVertexCoordinates(const std::string& path, std::size_t expected, int* unknown,
-                                          std::string* first_unknown, int* crossing, std::string* first_crossing) {
+// What ReadVertexCoordinates finds that the parser passes over: lines of a kind the OBJ format
+// does not define (a corrupted or mislabelled file) and faces that cross themselves; the first
+// of each named by its line.
+struct ObjLineFindings {
+  int unknown = 0, crossing = 0;
+  std::string first_unknown, first_crossing;
+};
+
+std::vector<double> ReadVertexCoordinates(const std::string& path, std::size_t expected, ObjLineFindings* found) {
   std::vector<long> face;
   std::ifstream in(path);
   std::vector<double> out;
@@ -197,7 +202,8 @@ std::vector<double> ReadVertexCoordinates(const std::string& path, std::size_t e
         throw IoError(path + ":" + std::to_string(line_number) + ": a face needs at least 3 vertices, this one has " +
                       std::to_string(count) + " (a truncated file?): '" + line + "'");
       }
-      if (count >= 4 && FaceCrossesItself(out, face) && ++*crossing == 1) *first_crossing = std::to_string(line_number);
+      if (count >= 4 && FaceCrossesItself(out, face) && ++found->crossing == 1)
+        found->first_crossing = std::to_string(line_number);
       face.clear();
       continue;
     }
@@ -211,8 +217,8 @@ std::vector<double> ReadVertexCoordinates(const std::string& path, std::size_t e
                                            "lod", "shadow_obj", "trace_obj", "ctech", "stech", "maplib", "usemap"};
       const bool known = keyword.empty() || keyword[0] == '#' ||
                          std::any_of(std::begin(kKnown), std::end(kKnown), [&](const char* k) { return keyword == k; });
-      if (!known && ++*unknown == 1) {
-        *first_unknown = std::to_string(line_number) + ": '" + line.substr(0, 60) + (line.size() > 60 ? "...'" : "'");
+      if (!known && ++found->unknown == 1) {
+        found->first_unknown = std::to_string(line_number) + ": '" + line.substr(0, 60) + (line.size() > 60 ? "...'" : "'");
       }
       continue;
     }
@@ -277,18 +283,16 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
     throw IoError(path + ": no object named '" + options.object + "' (the file has: " + names + ")");
   }
   const int nv = static_cast<int>(attrib.vertices.size() / 3);
-  int unknown_lines = 0, crossing_faces = 0;
-  std::string first_unknown, first_crossing;
-  std::vector<double> coordinates = ReadVertexCoordinates(path, attrib.vertices.size(), &unknown_lines, &first_unknown,
-                                                          &crossing_faces, &first_crossing);
-  if (crossing_faces > 0) {
-    rep.warnings.push_back(std::to_string(crossing_faces) + " face(s) cross themselves (the first at line " + first_crossing +
+  ObjLineFindings found;
+  std::vector<double> coordinates = ReadVertexCoordinates(path, attrib.vertices.size(), &found);
+  if (found.crossing > 0) {
+    rep.warnings.push_back(std::to_string(found.crossing) + " face(s) cross themselves (the first at line " + found.first_crossing +
                            "): such a face is triangulated as a fan, which covers neither its outline's inside nor its "
                            "hull; split it into simple faces");
   }
-  if (unknown_lines > 0) {
-    rep.warnings.push_back(std::to_string(unknown_lines) + " line(s) that are no OBJ statement were skipped (the first at line " +
-                           first_unknown + "): is it an OBJ file, and complete?");
+  if (found.unknown > 0) {
+    rep.warnings.push_back(std::to_string(found.unknown) + " line(s) that are no OBJ statement were skipped (the first at line " +
+                           found.first_unknown + "): is it an OBJ file, and complete?");
   }
   if (coordinates.empty()) coordinates.assign(attrib.vertices.begin(), attrib.vertices.end());
   auto project = [&](int index) -> Point {
@@ -353,7 +357,6 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
       }
     }
     const double tolerance = 1e-9 * std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 0.0});
-    std::vector<int> prism_axes;
     for (int a = 0; a < 3; ++a) {
       bool on_ends = hi[a] > lo[a];
       int at_lo = 0, at_hi = 0;  // an end face needs three vertices (a lone triangle is no prism)
@@ -365,12 +368,12 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
         on_ends = std::abs(c - lo[a]) <= tolerance || std::abs(c - hi[a]) <= tolerance;
       }
       if (on_ends && at_lo >= 3 && at_hi >= 3) {
-        prism_axes.push_back(a);
         rep.prism_axes.push_back(a == 0 ? UpAxis::kX : a == 1 ? UpAxis::kY : UpAxis::kZ);
       }
     }
-    if (!prism_axes.empty() && std::find(prism_axes.begin(), prism_axes.end(), up) == prism_axes.end()) {
-      const char* axis = axis_names[prism_axes.front()];
+    const auto& prisms = rep.prism_axes;
+    if (!prisms.empty() && std::find(prisms.begin(), prisms.end(), options.up) == prisms.end()) {
+      const char* axis = axis_names[static_cast<int>(prisms.front())];
       rep.warnings.push_back(std::string("every vertex lies on one of two planes across ") + axis + ": the mesh is a prism along " +
                              axis + ", and seen along " + axis_names[up] + " its footprint is its side view; --up " + axis +
                              " gives its cross-section");

@@ -203,60 +203,63 @@ std::optional<geometry::Shape> TessellatedDisk(const geometry::Shape& shape) {
   return geometry::Shape::Disk(mean, centre);
 }
 
+// A mesh read as `pushgraph footprint MESH` would (up z, metres, the file's own frame), said on
+// stderr, since another axis or scale needs that command. A finger mesh that is a prism along x
+// or y only (a probe's cylinder lying along y, as the MIT tip.obj) is meant by its cross-section:
+// seen along z it would be its side view (footprint reports the prism axes after its union, so
+// such a file is read twice).
+geometry::Shape LoadMeshArgument(const std::string& path, const std::string& what) {
+  io::FootprintOptions options;
+  io::FootprintReport report;
+  geometry::Shape shape = io::MeshFootprint(path, options, &report);
+  // Objects keep z: a can lying along x is pushed by its 100 x 60 mm side, not its round end.
+  const bool finger = what.find("finger") != std::string::npos;
+  const auto& prisms = report.prism_axes;
+  if (finger && prisms.size() == 1 && prisms[0] != io::UpAxis::kZ) {
+    options.up = prisms[0];
+    report = {};
+    shape = io::MeshFootprint(path, options, &report);
+  }
+  const char* up = options.up == io::UpAxis::kX ? "x" : options.up == io::UpAxis::kY ? "y" : "z";
+  int holes = 0;
+  for (const geometry::Polygon& p : shape.polygons()) holes += static_cast<int>(p.holes.size());
+  const geometry::Box2 box = shape.bounds();
+  std::fprintf(stderr,
+               "pushgraph: %s %s: the mesh's footprint along %s%s, in its own frame and units (%zu polygon(s), %d "
+               "hole(s), %.4g x %.4g m); another up axis, scale or frame: pushgraph footprint %s --up/--scale/"
+               "--transform -o SHAPE.json\n",
+               what.c_str(), path.c_str(), up, options.up == io::UpAxis::kZ ? "" : " (a prism along it: its cross-section)",
+               shape.polygons().size(), holes, box.max.x() - box.min.x(),
+               box.max.y() - box.min.y(), path.c_str());
+  for (std::string w : report.warnings) {
+    // footprint's own flag is named --object; here that names the shape file.
+    const std::string flag = "--object NAME takes one";
+    if (const std::size_t at = w.find(flag); at != std::string::npos)
+      w.replace(at, flag.size(), "pushgraph footprint " + path + " --object NAME -o SHAPE.json takes one");
+    std::fprintf(stderr, "pushgraph: warning: %s %s: %s\n", what.c_str(), path.c_str(), w.c_str());
+  }
+  if (finger) {
+    if (const std::optional<geometry::Shape> disk = TessellatedDisk(shape)) {
+      const geometry::Vec2 centre = disk->polygons()[0].outer[0];
+      std::fprintf(stderr,
+                   "pushgraph: %s %s: its footprint is a regular %zu-gon, a tessellated cylinder: used as the disk "
+                   "of radius %.4g mm at (%.3f, %.3f) mm it approximates (a polygonal finger solves about 15x "
+                   "slower; pushgraph footprint %s -o SHAPE.json keeps the polygon)\n",
+                   what.c_str(), path.c_str(), shape.polygons()[0].outer.size(), 1e3 * disk->radius(),
+                   1e3 * centre.x(), 1e3 * centre.y(), path.c_str());
+      return *disk;
+    }
+  }
+  return shape;
+}
+
 }  // namespace
 
 geometry::Shape LoadShapeArgument(const std::string& path, const std::string& what) {
   std::string extension = std::filesystem::path(path).extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return std::tolower(c); });
   try {
-    if (extension == ".obj") {
-      // A mesh is read as `pushgraph footprint MESH` would (up z, metres, the file's own frame);
-      // said on stderr, since another axis or scale needs that command.
-      // A prism along x or y only (a probe's cylinder lying along y, as the MIT tip.obj) is meant
-      // by its cross-section: seen along z it would be its side view.
-      io::FootprintOptions options;
-      io::FootprintReport report;
-      geometry::Shape shape = io::MeshFootprint(path, options, &report);
-      // Objects keep z: a can lying along x is pushed by its 100 x 60 mm side, not its round end.
-      const bool finger = what.find("finger") != std::string::npos;
-      const auto& prisms = report.prism_axes;
-      if (finger && prisms.size() == 1 && prisms[0] != io::UpAxis::kZ) {
-        options.up = prisms[0];
-        report = {};
-        shape = io::MeshFootprint(path, options, &report);
-      }
-      const char* up = options.up == io::UpAxis::kX ? "x" : options.up == io::UpAxis::kY ? "y" : "z";
-      int holes = 0;
-      for (const geometry::Polygon& p : shape.polygons()) holes += static_cast<int>(p.holes.size());
-      const geometry::Box2 box = shape.bounds();
-      std::fprintf(stderr,
-                   "pushgraph: %s %s: the mesh's footprint along %s%s, in its own frame and units (%zu polygon(s), %d "
-                   "hole(s), %.4g x %.4g m); another up axis, scale or frame: pushgraph footprint %s --up/--scale/"
-                   "--transform -o SHAPE.json\n",
-                   what.c_str(), path.c_str(), up, options.up == io::UpAxis::kZ ? "" : " (a prism along it: its cross-section)",
-                   shape.polygons().size(), holes, box.max.x() - box.min.x(),
-                   box.max.y() - box.min.y(), path.c_str());
-      for (std::string w : report.warnings) {
-        // footprint's own flag is named --object; here that names the shape file.
-        const std::string flag = "--object NAME takes one";
-        if (const std::size_t at = w.find(flag); at != std::string::npos)
-          w.replace(at, flag.size(), "pushgraph footprint " + path + " --object NAME -o SHAPE.json takes one");
-        std::fprintf(stderr, "pushgraph: warning: %s %s: %s\n", what.c_str(), path.c_str(), w.c_str());
-      }
-      if (finger) {
-        if (const std::optional<geometry::Shape> disk = TessellatedDisk(shape)) {
-          const geometry::Vec2 centre = disk->polygons()[0].outer[0];
-          std::fprintf(stderr,
-                       "pushgraph: %s %s: its footprint is a regular %zu-gon, a tessellated cylinder: used as the disk "
-                       "of radius %.4g mm at (%.3f, %.3f) mm it approximates (a polygonal finger solves about 15x "
-                       "slower; pushgraph footprint %s -o SHAPE.json keeps the polygon)\n",
-                       what.c_str(), path.c_str(), shape.polygons()[0].outer.size(), 1e3 * disk->radius(),
-                       1e3 * centre.x(), 1e3 * centre.y(), path.c_str());
-          return *disk;
-        }
-      }
-      return shape;
-    }
+    if (extension == ".obj") return LoadMeshArgument(path, what);
     return geometry::LoadShapeJson(path);
   } catch (const std::exception& e) {
     std::string hint;
