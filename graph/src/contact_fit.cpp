@@ -162,6 +162,7 @@ Contacts PoolContacts(const std::vector<const push::Trajectory*>& recordings, co
       throw GraphError("registration: recording " + std::to_string(k) + " has another object or finger shape than the first");
     }
     const ContactPath path = MeasuredContactPath(traj, o);
+    pooled.t.insert(pooled.t.end(), path.t.begin(), path.t.end());
     pooled.q.insert(pooled.q.end(), path.q.begin(), path.q.end());
     pooled.relative.insert(pooled.relative.end(), path.relative.begin(), path.relative.end());
     pooled.finger.insert(pooled.finger.end(), path.finger.begin(), path.finger.end());
@@ -175,7 +176,44 @@ Contacts PoolContacts(const std::vector<const push::Trajectory*>& recordings, co
                      " finger samples in contact with an object pose near them (at least 8 needed)");
   }
   pooled.weight.assign(pooled.q.size(), 1.0);
+  pooled.members.assign(pooled.q.size(), 1);
   return pooled;
+}
+
+Contacts Contacts::StationaryMerged(double within, double min_span) const {
+  Contacts out;
+  out.recordings = recordings;
+  out.noise = noise;
+  for (std::size_t begin = 0; begin < q.size();) {
+    std::size_t end = begin + 1;
+    Vec2 mean = q[begin];
+    while (end < q.size() && recording[end] == recording[begin] && finger[end] == finger[begin] &&
+           (q[end] - mean).norm() <= within) {
+      mean += (q[end] - mean) / static_cast<double>(end - begin + 1);
+      ++end;
+    }
+    if (t[end - 1] - t[begin] < min_span) end = begin + 1;  // moving: the sample alone
+    Vec2 t_sum = Vec2::Zero();
+    double turn_sum = 0.0, weight_sum = 0.0;
+    int member_sum = 0;
+    for (std::size_t i = begin; i < end; ++i) {
+      t_sum += Vec2(relative[i].x, relative[i].y);
+      turn_sum += geometry::WrapAngle(relative[i].theta - relative[begin].theta);
+      weight_sum += weight[i];
+      member_sum += members[i];
+    }
+    const double n = static_cast<double>(end - begin);
+    out.t.push_back(0.5 * (t[begin] + t[end - 1]));
+    out.q.push_back(end - begin == 1 ? q[begin] : mean);
+    out.relative.push_back(Pose2{t_sum.x() / n, t_sum.y() / n, relative[begin].theta + turn_sum / n});
+    out.finger.push_back(finger[begin]);
+    out.radius.push_back(radius[begin]);
+    out.recording.push_back(recording[begin]);
+    out.weight.push_back(weight_sum);
+    out.members.push_back(member_sum);
+    begin = end;
+  }
+  return out;
 }
 
 // The shape as given against the contacts: median |gap| and the share penetrating beyond the
@@ -186,16 +224,18 @@ ShapeFitCheck CheckContacts(const Shape& shape, const Shape& finger, const Conta
   ContactFit fit(shape, c, finger, FingerAsDisk(finger), 1e-3, 1.0, 0.0);
   fit.UseExactFinger();
   const Placement identity = fit.Start();
+  // Weighted: a merged resting spot counts as the time it covers (Contacts::StationaryMerged).
   std::vector<double> gaps;
-  int penetrating = 0;
+  double penetrating = 0.0, total = 0.0;
   for (std::size_t i = 0; i < fit.size(); ++i) {
     const double g = fit.Gap(i, identity);
     gaps.push_back(std::abs(g));
-    penetrating += g < -check.tolerance ? 1 : 0;
+    penetrating += g < -check.tolerance ? c.weight[i] : 0.0;
+    total += c.weight[i];
   }
-  check.samples = static_cast<int>(gaps.size());
-  check.gap_median = Median(gaps);
-  check.penetration_share = static_cast<double>(penetrating) / std::max<std::size_t>(1, gaps.size());
+  check.samples = c.SampleCount();
+  check.gap_median = WeightedMedian(gaps, c.weight);
+  check.penetration_share = total > 0.0 ? penetrating / total : 0.0;
   check.fits = check.gap_median <= check.tolerance && check.penetration_share <= 0.1;
   return check;
 }

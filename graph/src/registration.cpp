@@ -27,6 +27,7 @@ namespace pushgraph::graph {
 
 using internal::Format;
 using internal::Median;
+using internal::WeightedMedian;
 using namespace internal::registration;  // the contacts, ContactFit and helpers (contact_fit.h)
 
 RegistrationOptions RegistrationOptionsFor(const EstimatorConfig& config) {
@@ -248,7 +249,9 @@ ShapeFitCheck CheckShapeFit(const push::Trajectory& trajectory, const Registrati
   std::vector<double> spans;
   const Contacts c = PoolContacts({&trajectory}, options, &spans);
   return CheckContacts(trajectory.object.shape, trajectory.finger.shape,
-                       c.Subsampled(options.max_refine_samples, spans, options.correlation_time), options);
+                       c.Subsampled(options.max_refine_samples, spans, options.correlation_time)
+                           .StationaryMerged(RestRadius(c.noise, options), kMinRestSpan),
+                       options);
 }
 
 RegistrationResult RegisterShape(const push::Trajectory& trajectory, const RegistrationOptions& options) {
@@ -262,15 +265,17 @@ RegistrationResult RegisterShape(const std::vector<const push::Trajectory*>& rec
   const Shape& file_shape = recordings.front()->object.shape;
   const Shape& finger = recordings.front()->finger.shape;
   const FingerDisk disk = FingerAsDisk(finger);
-  const Contacts search = all.Subsampled(o.max_search_samples, spans, o.correlation_time);
-  const Contacts refine = all.Subsampled(o.max_refine_samples, spans, o.correlation_time);
+  // A finger resting on the object: its samples, one boundary point, as one (Contacts::StationaryMerged).
+  const double merge_within = RestRadius(all.noise, o);
+  const Contacts search = all.Subsampled(o.max_search_samples, spans, o.correlation_time).StationaryMerged(merge_within, kMinRestSpan);
+  const Contacts refine = all.Subsampled(o.max_refine_samples, spans, o.correlation_time).StationaryMerged(merge_within, kMinRestSpan);
   RegistrationResult result;
   std::vector<double> radii;
   for (const Vec2& q : all.q) radii.push_back(q.norm());
   const double path_radius = Median(radii);
   // The smoothed path's noise is correlated over the correlation time; a fit of a few parameters
   // absorbs part of it, so the residuals' spread alone underestimates it: the bootstrap's floors it.
-  const double min_noise = std::max(3e-4, all.noise);
+  const double min_noise = std::max(kMinPathNoise, all.noise);
   // The smoothed path's noise: given, else estimated from the best fit's residuals below.
   const double start_noise = o.noise > 0.0 ? o.noise : std::max(2e-3, all.noise);
   const Vec2 q_mid(Median([&] { std::vector<double> v; for (auto& q : search.q) v.push_back(q.x()); return v; }()),
@@ -378,7 +383,7 @@ RegistrationResult RegisterShape(const std::vector<const push::Trajectory*>& rec
       if (o.noise <= 0.0 && !minima.empty()) {
         std::vector<double> gaps;
         for (std::size_t i = 0; i < fine.size(); ++i) gaps.push_back(std::abs(fine.Gap(i, minima[0])));
-        f.noise = std::max(min_noise, 1.4826 * Median(gaps));
+        f.noise = std::max(min_noise, 1.4826 * WeightedMedian(gaps, refine.weight));
         fine.set_noise(f.noise);
         for (Placement& c : minima) fine.Minimize(&c, all_active, 30);
         std::sort(minima.begin(), minima.end(), by_cost);
@@ -405,7 +410,7 @@ RegistrationResult RegisterShape(const std::vector<const push::Trajectory*>& rec
   result.symmetry_order = f.symmetry;
   result.rotation_observable = f.symmetry != 0;
   result.noise = noise;
-  result.samples = static_cast<int>(fit.size());
+  result.samples = refine.SampleCount();
 
   // Continuous scale (disk fingers), then the information at the solution.
   Active act;
@@ -439,10 +444,10 @@ RegistrationResult RegisterShape(const std::vector<const push::Trajectory*>& rec
     result.identity_cost = identity.cost;
     std::vector<double> gaps;
     for (std::size_t i = 0; i < as_given.size(); ++i) gaps.push_back(std::abs(as_given.Gap(i, as_given.Start())));
-    result.identity_gap_rms = 1.4826 * Median(gaps);
+    result.identity_gap_rms = 1.4826 * WeightedMedian(gaps, refine.weight);
     gaps.clear();
     for (std::size_t i = 0; i < fit.size(); ++i) gaps.push_back(std::abs(fit.Gap(i, best)));
-    result.aligned_gap_rms = 1.4826 * Median(gaps);
+    result.aligned_gap_rms = 1.4826 * WeightedMedian(gaps, refine.weight);
   }
 
   result.displacement = OutlineDisplacement(file_shape, result.transform);

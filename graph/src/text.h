@@ -26,4 +26,20 @@ inline double Median(std::vector<double> v) {
   return v[m];
 }
 
+/// The weighted median: the least value whose weights, with those of the smaller values, reach
+/// half the total; 0 for an empty vector.
+inline double WeightedMedian(const std::vector<double>& v, const std::vector<double>& w) {
+  std::vector<std::size_t> order(v.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return v[a] < v[b]; });
+  double total = 0.0;
+  for (double x : w) total += x;
+  double sum = 0.0;
+  for (std::size_t i : order) {
+    sum += w[i];
+    if (sum >= 0.5 * total) return v[i];
+  }
+  return order.empty() ? 0.0 : v[order.back()];
+}
+
 }  // namespace pushgraph::graph::internal

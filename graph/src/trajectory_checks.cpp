@@ -40,6 +40,27 @@ void CheckRange(double t, double value, double bound, const std::string& stream,
   }
 }
 
+// Positions in another unit than metres: a pushing recording moves slower than 5 m/s, and its
+// poses do not span 0.2 m at more than that (the default simulated push written in millimetres:
+// its finger spanning 60 "m" in 1.5 s; it ran, with the shape "1000 times too small" and every
+// residual 1e5 times its sigma).
+constexpr double kMaxPushSpeed = 5.0, kMinJudgedSpan = 0.2;  // m/s, m
+void CheckPositionUnits(const std::vector<push::PoseSample>& s, const std::string& stream) {
+  if (s.size() < 2 || !(s.back().t > s.front().t)) return;
+  Eigen::Vector2d low = s.front().pose.translation(), high = low;
+  for (const push::PoseSample& p : s) {
+    low = low.cwiseMin(p.pose.translation());
+    high = high.cwiseMax(p.pose.translation());
+  }
+  const double span = (high - low).norm(), duration = s.back().t - s.front().t;
+  if (span <= kMinJudgedSpan || span / duration <= kMaxPushSpeed) return;
+  std::ostringstream text;
+  text << "trajectory: streams." << stream << " spans " << span << " m in " << duration << " s (at least " << span / duration
+       << " m/s; a push is slower than " << kMaxPushSpeed << " m/s): are the positions in millimetres? Trajectory "
+       << "positions are in metres: divide x and y of every stream (and the contact points) by 1000";
+  throw GraphError(text.str());
+}
+
 // `repeats`: a time may repeat (contact_point: one row per contact).
 template <class Sample>
 void CheckSorted(const std::vector<Sample>& s, const std::string& stream, bool repeats = false) {
@@ -263,6 +284,10 @@ void ValidateTrajectory(const push::Trajectory& traj) {
   if (m.finger_pose.empty()) {
     throw GraphError("trajectory: no finger pose measurements (streams.finger_pose is empty)");
   }
+  CheckPositionUnits(m.finger_pose, "finger_pose");
+  CheckPositionUnits(m.object_pose, "object_pose");
+  for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k)
+    CheckPositionUnits(traj.extra_fingers[k].measured.finger_pose, "fingers[" + std::to_string(k + 1) + "].finger_pose");
   CheckFingerSize(traj.finger.shape, m.finger_pose, m.object_pose, traj.object.shape, "");
   for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k) {
     CheckFingerSize(traj.extra_fingers[k].finger.shape, traj.extra_fingers[k].measured.finger_pose, m.object_pose,

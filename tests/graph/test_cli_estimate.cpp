@@ -428,20 +428,30 @@ TEST_F(EstimateCli, AProbeTooSmallIsNamedBesideThePlacement) {
 // placement wins (the contacts of one push cannot tell a shift from a size), also near 1 mm; a
 // third recording where the size won by 5 (t=0.349 at 100 mm/s) is such a tie: the placement's
 // solve reaches 928.0 with the banded factorization and 935.7 without, against 930.6 for the size.
+// The second recording here is one too (the size 2136.3, a placement 2132.9 to 2133.2 as the
+// registration's details change): either is used, and the warning names both when the placement is.
 TEST_F(EstimateCli, AFingerSizeTheGraphPrefersIsUsedAndNamed) {
   if (Mit().empty()) GTEST_SKIP() << "no MIT data";
   for (const char* rec : {"100_i=0.000_s=0.075_t=0.000.h5", "20_i=0.000_s=0.675_t=0.698.h5"}) {
+    const bool tie = std::string(rec).rfind("20_", 0) == 0;
     const std::string out = dir() + "/sized.json";
     const pushgraph::testing::ToolRun r = EstimateMit(Mit() + "abs/ellip1/motion_surface=abs_shape=ellip1_a=0_v=" + rec,
                                                       "ellip1.obj", "", 0.009, kEllip1Mass, out);
     ASSERT_EQ(r.status, 0) << r.err;
-    EXPECT_NE(r.err.find("a wrong probe radius or object size? Estimated with that radius"), std::string::npos) << r.err;
     const nlohmann::json j = Load(out);
+    const double rms = j["metrics"]["object_position_rms"].get<double>();
+    EXPECT_LT(rms, 1.3e-3) << rec;
+    if (tie && !j["parameters"].contains("finger_radius")) {
+      EXPECT_NE(r.err.find("explains the contacts about as well"), std::string::npos) << r.err;
+      EXPECT_NE(r.err.find("check the probe radius"), std::string::npos) << r.err;
+      std::printf("[registration] ellip1 with a 9 mm probe: a placement used (a tie), object RMS %.2f mm\n", rms * 1e3);
+      continue;
+    }
+    EXPECT_NE(r.err.find("a wrong probe radius or object size? Estimated with that radius"), std::string::npos) << r.err;
     ASSERT_TRUE(j["parameters"].contains("finger_radius")) << rec;
-    const double radius = j["parameters"]["finger_radius"].get<double>(), rms = j["metrics"]["object_position_rms"].get<double>();
+    const double radius = j["parameters"]["finger_radius"].get<double>();
     std::printf("[registration] ellip1 with a 9 mm probe: radius used %.2f mm, object RMS %.2f mm\n", radius * 1e3, rms * 1e3);
     EXPECT_NEAR(radius, kProbe, 1.2e-3) << rec;  // 5.49 and 4.53 mm
-    EXPECT_LT(rms, 1.3e-3) << rec;
   }
 }
 

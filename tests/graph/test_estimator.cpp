@@ -516,6 +516,12 @@ TEST(Estimator, BadTrajectoriesGetClearErrors) {
   EXPECT_NE(message(epoch_ms).find("are the time stamps in milliseconds or microseconds?"), std::string::npos)
       << message(epoch_ms);
   EXPECT_EQ(message(far).find("milliseconds"), std::string::npos) << message(far);  // a position: no such hint
+  auto millimetres = t;  // positions in millimetres: the finger at 30+ m/s, refused with the unit named
+  for (auto* s : {&millimetres.measured.object_pose, &millimetres.measured.finger_pose})
+    for (auto& x : *s) x.pose = {x.pose.x * 1e3, x.pose.y * 1e3, x.pose.theta};
+  for (auto& x : millimetres.measured.contact_point) x.point *= 1e3;
+  EXPECT_NE(message(millimetres).find("streams.finger_pose spans"), std::string::npos) << message(millimetres);
+  EXPECT_NE(message(millimetres).find("are the positions in millimetres?"), std::string::npos) << message(millimetres);
 }
 
 TEST(Estimator, StepsFollowTheInputClocks) {
