@@ -203,7 +203,8 @@ std::vector<std::string> RegisterGroups(std::vector<EvaluationItem>& items, cons
     ro.estimate_scale = options.estimator.align_scale;
     try {
       const graph::RegistrationResult r = graph::RegisterShape(pooled, ro);
-      const bool align = options.estimator.align_shape == Align::kOn || !r.fits_as_given;
+      // A shape no unit makes the size of the paths is not placed (each estimate refuses it).
+      const bool align = options.estimator.align_shape == Align::kOn || (!r.fits_as_given && !r.size_mismatch);
       char head[160];
       std::snprintf(head, sizeof head, "%s: shape checked against %zu recordings together: ", group.c_str(), pooled.size());
       if (align) {
@@ -211,6 +212,9 @@ std::vector<std::string> RegisterGroups(std::vector<EvaluationItem>& items, cons
         lines.push_back(head + std::string(r.fits_as_given ? "fits as given; aligned anyway (align_shape on): "
                                                            : "does not fit as given (" + r.check.Describe() + "); aligned: ") +
                         r.Describe());
+      } else if (!r.fits_as_given) {
+        lines.push_back(std::string(head) + "does not fit as given (" + r.check.Describe() +
+                        ") and no unit makes it the size of the finger's paths: not aligned");
       } else {
         lines.push_back(head + std::string("fits as given (") + r.check.Describe() + ")");
       }

@@ -1,5 +1,6 @@
 #include "contact_fit.h"
 #include "graph_builder.h"
+#include "text.h"
 
 #include <ceres/normal_prior.h>
 
@@ -305,6 +306,15 @@ std::optional<std::string> UnobservedObjectNote(const push::Trajectory& t, Model
   return std::string(text);
 }
 
+// With RegistrationResult::size_mismatch: the shape against the finger's path, and what to check.
+std::string SizeMismatchText(const RegistrationResult& r) {
+  if (!r.size_mismatch) return "";
+  return internal::Format(": it is %.3g times the size of the finger's path around the object's origin, and no unit tried "
+                          "(metres, centimetres, millimetres, inches, 100 or 1000 times larger) makes it fit: check the "
+                          "shape file's size and units, and that the finger and object pose streams share one frame",
+                          r.size_ratio);
+}
+
 }  // namespace
 
 EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode mode,
@@ -374,6 +384,16 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
   // the whole graph can (dynamics, smoothing): each is estimated (batch, no covariances) and
   // the lowest final cost wins.
   const bool misfit = registration && !registration->fits_as_given;
+  // A shape no unit makes the size of the finger's path is refused: any placement found so is a
+  // guess (a finger stream 0.5 m off was "aligned" by a turn of 125 degrees, 9 m and the scale
+  // 1000), and without one the contact factors pull the object 0.4 m to the finger. align_shape
+  // "on" still aligns, "off" estimates as given.
+  if (misfit && registration->size_mismatch && config.align_shape == Align::kAuto) {
+    throw GraphError("shape check: the object's shape does not fit this recording as given (" +
+                     registration->check.Describe() + ")" + SizeMismatchText(*registration) +
+                     "; no placement of it in any unit explains the finger's path, so nothing is estimated "
+                     "(--align-shape off, or align_shape \"off\", estimates with the shape as given regardless)");
+  }
   const geometry::Shape& finger = trajectory.finger.shape;
   const double sized_radius = finger.radius() + (registration ? registration->size_offset : 0.0);
   const bool size_candidate = misfit && sized_radius > 0.0 &&
@@ -394,8 +414,8 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
   // "aligned" by a turn of 163 degrees.)
   const bool suspect = registration && registration->fits_as_given && registration->better_elsewhere &&
                        !registration->ambiguous && config.align_shape == Align::kAuto;
-  const bool will_align =
-      registration && (config.align_shape == Align::kOn || (config.align_shape == Align::kAuto && (misfit || suspect)));
+  const bool will_align = registration && (config.align_shape == Align::kOn ||
+                                            (config.align_shape == Align::kAuto && (misfit || suspect)));
   EstimatorConfig quick = config;
   quick.covariance = false;
   quick.diagnostics = false;
@@ -650,13 +670,7 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
   }
   if (alignment.checked && !alignment.check.fits) {
     std::string what = "the object's shape does not fit this recording as given (" + alignment.check.Describe() + ")";
-    if (registration->size_mismatch) {
-      char size[320];
-      std::snprintf(size, sizeof size, ": it is %.3g times the size of the finger's path around the object's origin, and "
-                    "no unit tried (metres, centimetres, millimetres, inches, 100 or 1000 times larger) makes it fit: "
-                    "check the shape file's size and units (and the object pose stream's frame)", registration->size_ratio);
-      what += size;
-    }
+    what += SizeMismatchText(*registration);
     if (size_wins) {
       char size[160];
       std::snprintf(size, sizeof size, "the finger %.1f mm %s than given (radius %.1f mm instead of %.1f mm)",
