@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 
 namespace pushgraph::graph::internal::registration {
 
@@ -192,7 +193,16 @@ Contacts Contacts::StationaryMerged(double within, double min_span) const {
       mean += (q[end] - mean) / static_cast<double>(end - begin + 1);
       ++end;
     }
-    if (t[end - 1] - t[begin] < min_span) end = begin + 1;  // moving: the sample alone
+    // Moving: too short a run, or one whose first and last thirds lie apart (a finger sliding
+    // slowly along a side stays near its running mean, but its thirds drift).
+    bool rests = t[end - 1] - t[begin] >= min_span;
+    if (rests) {
+      const std::size_t third = (end - begin) / 3;
+      Vec2 first = Vec2::Zero(), last = Vec2::Zero();
+      for (std::size_t i = 0; i < third; ++i) first += q[begin + i], last += q[end - 1 - i];
+      rests = third > 0 && (last - first).norm() / static_cast<double>(third) <= 0.5 * within;
+    }
+    if (!rests) end = begin + 1;  // the sample alone
     Vec2 t_sum = Vec2::Zero();
     double turn_sum = 0.0, weight_sum = 0.0;
     int member_sum = 0;

@@ -45,7 +45,7 @@ void CheckRange(double t, double value, double bound, const std::string& stream,
 // its finger spanning 60 "m" in 1.5 s; it ran, with the shape "1000 times too small" and every
 // residual 1e5 times its sigma).
 constexpr double kMaxPushSpeed = 5.0, kMinJudgedSpan = 0.2;  // m/s, m
-void CheckPositionUnits(const std::vector<push::PoseSample>& s, const std::string& stream) {
+void CheckPositionUnits(const push::Trajectory& traj, const std::vector<push::PoseSample>& s, const std::string& stream) {
   if (s.size() < 2 || !(s.back().t > s.front().t)) return;
   Eigen::Vector2d low = s.front().pose.translation(), high = low;
   for (const push::PoseSample& p : s) {
@@ -53,11 +53,34 @@ void CheckPositionUnits(const std::vector<push::PoseSample>& s, const std::strin
     high = high.cwiseMax(p.pose.translation());
   }
   const double span = (high - low).norm(), duration = s.back().t - s.front().t;
-  if (span <= kMinJudgedSpan || span / duration <= kMaxPushSpeed) return;
+  if (span <= kMinJudgedSpan) return;
+  // Which unit: the finger's distance from the object's origin over the object's size (in metres,
+  // the shape's), 0.2 to 1 for a push; 20 to 100 in centimetres, 200 to 1000 in millimetres. Beyond
+  // 20 it is no push in metres even when slow (a 5 cm/s push in centimetres moves at 3.8 "m/s").
+  const auto& fingers = traj.measured.finger_pose;
+  const auto& objects = traj.measured.object_pose;
+  std::vector<double> distances;
+  for (std::size_t i = 0, j = 0; i < fingers.size() && !objects.empty(); i += std::max<std::size_t>(1, fingers.size() / 200)) {
+    while (j + 1 < objects.size() && std::abs(objects[j + 1].t - fingers[i].t) <= std::abs(objects[j].t - fingers[i].t)) ++j;
+    distances.push_back((fingers[i].pose.translation() - objects[j].pose.translation()).norm());
+  }
+  const geometry::Box2 box = traj.object.shape.bounds();
+  const double size = std::max(box.max.x() - box.min.x(), box.max.y() - box.min.y());
+  const double ratio = size > 0.0 && !distances.empty() ? Median(distances) / size : 0.0;
+  if (span / duration <= kMaxPushSpeed && ratio <= 20.0) return;
+  const char* unit = ratio > 150.0 ? "millimetres" : ratio > 20.0 ? "centimetres" : nullptr;
   std::ostringstream text;
-  text << "trajectory: streams." << stream << " spans " << span << " m in " << duration << " s (at least " << span / duration
-       << " m/s; a push is slower than " << kMaxPushSpeed << " m/s): are the positions in millimetres? Trajectory "
-       << "positions are in metres: divide x and y of every stream (and the contact points) by 1000";
+  text << "trajectory: streams." << stream << " spans " << span << " m in " << duration << " s (" << span / duration
+       << " m/s at least) and the finger stays " << ratio << " times the object's size from it (median; a push in "
+       << "metres: below " << kMaxPushSpeed << " m/s, 0.2 to 1 times): ";
+  if (unit) {
+    text << "are the positions in " << unit << "? Trajectory positions are in metres: divide x and y of every stream "
+         << "(and the contact points) by " << (ratio > 150.0 ? 1000 : 100) << " (or are the finger and the object in "
+         << "different frames?)";
+  } else {
+    text << "are the positions in another unit than metres (millimetres: divide by 1000), or the time stamps in one "
+         << "too small?";
+  }
   throw GraphError(text.str());
 }
 
@@ -284,10 +307,10 @@ void ValidateTrajectory(const push::Trajectory& traj) {
   if (m.finger_pose.empty()) {
     throw GraphError("trajectory: no finger pose measurements (streams.finger_pose is empty)");
   }
-  CheckPositionUnits(m.finger_pose, "finger_pose");
-  CheckPositionUnits(m.object_pose, "object_pose");
+  CheckPositionUnits(traj, m.finger_pose, "finger_pose");
+  CheckPositionUnits(traj, m.object_pose, "object_pose");
   for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k)
-    CheckPositionUnits(traj.extra_fingers[k].measured.finger_pose, "fingers[" + std::to_string(k + 1) + "].finger_pose");
+    CheckPositionUnits(traj, traj.extra_fingers[k].measured.finger_pose, "fingers[" + std::to_string(k + 1) + "].finger_pose");
   CheckFingerSize(traj.finger.shape, m.finger_pose, m.object_pose, traj.object.shape, "");
   for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k) {
     CheckFingerSize(traj.extra_fingers[k].finger.shape, traj.extra_fingers[k].measured.finger_pose, m.object_pose,

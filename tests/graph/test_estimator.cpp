@@ -522,6 +522,13 @@ TEST(Estimator, BadTrajectoriesGetClearErrors) {
   for (auto& x : millimetres.measured.contact_point) x.point *= 1e3;
   EXPECT_NE(message(millimetres).find("streams.finger_pose spans"), std::string::npos) << message(millimetres);
   EXPECT_NE(message(millimetres).find("are the positions in millimetres?"), std::string::npos) << message(millimetres);
+  EXPECT_NE(message(millimetres).find("by 1000"), std::string::npos) << message(millimetres);
+  auto centimetres = t;  // and in centimetres: the factor read off the finger's distance against the object's size
+  for (auto* s : {&centimetres.measured.object_pose, &centimetres.measured.finger_pose})
+    for (auto& x : *s) x.pose = {x.pose.x * 1e2, x.pose.y * 1e2, x.pose.theta};
+  for (auto& x : centimetres.measured.contact_point) x.point *= 1e2;
+  EXPECT_NE(message(centimetres).find("are the positions in centimetres?"), std::string::npos) << message(centimetres);
+  EXPECT_NE(message(centimetres).find("by 100"), std::string::npos) << message(centimetres);
 }
 
 TEST(Estimator, StepsFollowTheInputClocks) {

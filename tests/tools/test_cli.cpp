@@ -288,6 +288,9 @@ TEST_F(CliTest, OutputsThatAreInputsAreRefusedAndInputsKept) {
   EXPECT_EQ(Exec("footprint " + shape + " --transform 0,0,6.2832 -o " + (dir_ / "t3.json").string() + " -q").err, "");
   const ToolRun millimetres = Exec("footprint " + shape + " --transform 20,0,0 -o " + (dir_ / "t4.json").string() + " -q");
   EXPECT_NE(millimetres.err.find("taken as metres"), std::string::npos) << millimetres.err;
+  // A shape scaled to millimetres takes its shift in millimetres (the docs' example was told to give 0.02).
+  const ToolRun scaled = Exec("footprint " + shape + " --scale 1000 --transform 20,-15,0.5 -o " + (dir_ / "t6.json").string() + " -q");
+  EXPECT_EQ(scaled.err.find("taken as metres"), std::string::npos) << scaled.err;
   const ToolRun huge = Exec("footprint " + shape + " --scale 1000 -o " + (dir_ / "t5.json").string() + " -q");
   // The suggestion is relative to the file: here the --scale given was the error.
   EXPECT_NE(huge.err.find("is the file in millimetres (--scale 1 in place of the --scale given"), std::string::npos)

@@ -57,9 +57,13 @@ void RegisterFootprint(CLI::App& app) {
                   << " is taken as radians (more than a full turn): for degrees give " << FormatDouble(pose.theta * M_PI / 180.0)
                   << "\n";
       }
-      if (std::hypot(pose.x, pose.y) > 1.0) {
+      // Judged against the shape's own size: after --scale 1000 the shape is in millimetres and so
+      // is a shift of 20 (the docs' own example was told to give 0.02).
+      const geometry::Box2 extent = shape.bounds();
+      const double size = std::max(extent.max.x() - extent.min.x(), extent.max.y() - extent.min.y());
+      if (std::hypot(pose.x, pose.y) > std::max(1.0, 10.0 * size)) {
         std::cerr << "footprint: warning: --transform's X,Y (" << FormatDouble(pose.x) << ", " << FormatDouble(pose.y)
-                  << ") are taken as metres (more than 1 m): for millimetres give " << FormatDouble(pose.x * 1e-3) << ","
+                  << ") are taken as metres (more than 1 m and ten times the shape's size): for millimetres give " << FormatDouble(pose.x * 1e-3) << ","
                   << FormatDouble(pose.y * 1e-3) << "\n";
       }
       shape = geometry::TransformShape(shape, pose, 1.0, args->mirror);
