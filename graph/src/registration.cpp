@@ -411,6 +411,7 @@ RegistrationResult RegisterShape(const std::vector<const push::Trajectory*>& rec
   result.rotation_observable = f.symmetry != 0;
   result.noise = noise;
   result.samples = refine.SampleCount();
+  for (double w : refine.weight) result.independent_samples += w;
 
   // Continuous scale (disk fingers), then the information at the solution.
   Active act;

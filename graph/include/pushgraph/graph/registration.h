@@ -170,6 +170,8 @@ struct RegistrationResult {
   double aligned_gap_rms = 0.0;   ///< the same with the transform
   double identity_cost = 0.0, aligned_cost = 0.0;  ///< Cauchy costs (including the prior)
   double noise = 0.0;             ///< noise scale used (m)
+  /// Independent contact samples the fit rests on (one per correlation_time of contact).
+  double independent_samples = 0.0;
   /// The fitted calibration gap of each recording (m, positive: the finger stays off the surface).
   std::vector<double> gaps;
   double displacement = 0.0;      ///< largest move of an outline point by the transform (m)
