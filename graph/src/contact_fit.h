@@ -102,6 +102,10 @@ struct Contacts {
   // to 20 in log-likelihood on every seed tried, and the graph then aligned it, the finger in a
   // hole). Shorter runs are a moving finger and stay as they are.
   Contacts StationaryMerged(double within, double min_span) const;
+  // What a fit reads: at most `count` samples (Subsampled), resting runs merged (StationaryMerged).
+  Contacts ForFit(int count, const std::vector<double>& spans, const RegistrationOptions& o) const {
+    return Subsampled(count, spans, o.correlation_time).StationaryMerged(RestRadius(noise, o), kMinRestSpan);
+  }
   int SampleCount() const {
     int n = 0;
     for (int m : members) n += m;

@@ -462,8 +462,10 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
   // of rect1 touched for 84 ms, its true shape judged off by 3.4 mm and "aligned" by (6.5, -4.2)
   // mm (3.69 mm against 2.60 as given). Warned, not aligned, under "auto".
   const bool too_little = registration && config.align_shape == Align::kAuto && registration->independent_samples < 3.0;
-  const bool will_align = registration && (config.align_shape == Align::kOn ||
-                                            (config.align_shape == Align::kAuto && (misfit || suspect) && !too_little));
+  // A misfit or suspicion there is data to place the shape by.
+  const bool placeable = (misfit || suspect) && !too_little;
+  const bool will_align =
+      registration && (config.align_shape == Align::kOn || (config.align_shape == Align::kAuto && placeable));
   EstimatorConfig quick = config;
   quick.covariance = false;
   quick.diagnostics = false;
@@ -486,12 +488,13 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
     refined->pose = geometry::Compose(frame.frame, t.pose);
     return cost;
   };
-  if (registration && (((misfit || suspect) && !too_little) || config.align_shape == Align::kOn) &&
+  if (registration && (placeable || config.align_shape == Align::kOn) &&
       (size_candidate || !registration->alternatives.empty() || will_align)) {
     const push::Trajectory judged = WithoutFinalRest(trajectory);
     if (judged.measured.object_pose.size() < trajectory.measured.object_pose.size()) {
-      alignment.notes.push_back(internal::Format("placements compared up to t = %.9g s, 0.3 s after the object last moved (the rest "
-                                       "after it left out)", judged.measured.object_pose.back().t));
+      alignment.notes.push_back(internal::Format("placements compared up to t = %.9g s, 0.3 s after the object last moved "
+                                                 "(the rest after it left out)",
+                                                 judged.measured.object_pose.back().t));
     }
     ShapeTransform best, refined;
     double best_cost = framed_cost(judged, registration->transform, &best, quick);
@@ -557,7 +560,8 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
       ShapeTransform nudge;
       nudge.pose = best.pose;
       const bool nudge_only = best.mirrored == units.mirrored &&
-                              internal::registration::OutlineDisplacement(scaled.object.shape, nudge) <= 3.0 * registration->check.tolerance;
+                              internal::registration::OutlineDisplacement(scaled.object.shape, nudge) <=
+                                  3.0 * registration->check.tolerance;
       if (cost <= best_cost + (nudge_only ? kFrameMargin : kTieMargin)) {
         units_win = true;
         best_cost = cost;
@@ -657,8 +661,7 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
   };
   if (frame_check && mode != Mode::kBatch) decide_frame(EstimateBatch(trajectory, model, quick).solver.final_cost);
   bool align = registration && (config.align_shape == Align::kOn ||
-                                (config.align_shape == Align::kAuto && (misfit || suspect) && !too_little && !size_wins &&
-                                 !identity_wins) ||
+                                (config.align_shape == Align::kAuto && placeable && !size_wins && !identity_wins) ||
                                 frame_wins);
   push::Trajectory aligned_trajectory;
   const push::Trajectory* working = &trajectory;

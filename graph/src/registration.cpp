@@ -248,9 +248,7 @@ ContactPath MeasuredContactPath(const push::Trajectory& traj, const Registration
 ShapeFitCheck CheckShapeFit(const push::Trajectory& trajectory, const RegistrationOptions& options) {
   std::vector<double> spans;
   const Contacts c = PoolContacts({&trajectory}, options, &spans);
-  return CheckContacts(trajectory.object.shape, trajectory.finger.shape,
-                       c.Subsampled(options.max_refine_samples, spans, options.correlation_time)
-                           .StationaryMerged(RestRadius(c.noise, options), kMinRestSpan),
+  return CheckContacts(trajectory.object.shape, trajectory.finger.shape, c.ForFit(options.max_refine_samples, spans, options),
                        options);
 }
 
@@ -265,10 +263,8 @@ RegistrationResult RegisterShape(const std::vector<const push::Trajectory*>& rec
   const Shape& file_shape = recordings.front()->object.shape;
   const Shape& finger = recordings.front()->finger.shape;
   const FingerDisk disk = FingerAsDisk(finger);
-  // A finger resting on the object: its samples, one boundary point, as one (Contacts::StationaryMerged).
-  const double merge_within = RestRadius(all.noise, o);
-  const Contacts search = all.Subsampled(o.max_search_samples, spans, o.correlation_time).StationaryMerged(merge_within, kMinRestSpan);
-  const Contacts refine = all.Subsampled(o.max_refine_samples, spans, o.correlation_time).StationaryMerged(merge_within, kMinRestSpan);
+  const Contacts search = all.ForFit(o.max_search_samples, spans, o);
+  const Contacts refine = all.ForFit(o.max_refine_samples, spans, o);
   RegistrationResult result;
   std::vector<double> radii;
   for (const Vec2& q : all.q) radii.push_back(q.norm());
@@ -502,12 +498,10 @@ RegistrationResult RegisterShape(const std::vector<const push::Trajectory*>& rec
     const double plausible = std::max(5e-3, 3.0 * disk.radius);
     // The placement has two more parameters (x, y, theta against the size): a BIC-like margin
     // of log(independent samples) for them.
-    double independent = 0.0;
-    for (double w : refine.weight) independent += w;
     // A wrong radius or size offsets every recording alike: recordings whose own gaps differ by
     // more than the fit tolerance (one side of a turned rectangle pushed in each) are a frame error.
     const double spread = identity.gap.size() > 0 ? (identity.gap.array() - result.size_offset).abs().maxCoeff() : 0.0;
-    result.size_explains = sized_cost <= placed_cost + std::log(std::max(2.0, independent)) &&
+    result.size_explains = sized_cost <= placed_cost + std::log(std::max(2.0, result.independent_samples)) &&
                            std::abs(result.size_offset) <= plausible && spread <= o.fit_tolerance &&
                            disk.radius + result.size_offset > 0.0 &&  // a finger, not a negative radius
                            std::abs(result.size_offset) >= 0.5 * o.gap_sigma;

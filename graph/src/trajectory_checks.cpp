@@ -45,7 +45,26 @@ void CheckRange(double t, double value, double bound, const std::string& stream,
 // its finger spanning 60 "m" in 1.5 s; it ran, with the shape "1000 times too small" and every
 // residual 1e5 times its sigma).
 constexpr double kMaxPushSpeed = 5.0, kMinJudgedSpan = 0.2;  // m/s, m
-void CheckPositionUnits(const push::Trajectory& traj, const std::vector<push::PoseSample>& s, const std::string& stream) {
+// The nearest finger 0 comes to the object's origin, over the object's size (in metres, the
+// shape's): 0.1 to 1 for a push; 10 to 100 in centimetres, 100 to 1000 in millimetres. Beyond 10 it
+// is no push in metres even when slow (a 5 cm/s push in centimetres moves at 3.8 "m/s"), or the
+// finger's and object's frames differ. The nearest, not the median: a finger that retreats 40 cm
+// from a 1 cm block after a brief push spends almost all of the recording far from it (median 24
+// sizes) and was refused. Noise only brings it nearer.
+double NearestFingerRatio(const push::Trajectory& traj) {
+  const auto& fingers = traj.measured.finger_pose;
+  const auto& objects = traj.measured.object_pose;
+  double nearest = INFINITY;
+  for (std::size_t i = 0, j = 0; i < fingers.size() && !objects.empty(); ++i) {
+    while (j + 1 < objects.size() && std::abs(objects[j + 1].t - fingers[i].t) <= std::abs(objects[j].t - fingers[i].t)) ++j;
+    nearest = std::min(nearest, (fingers[i].pose.translation() - objects[j].pose.translation()).norm());
+  }
+  const geometry::Box2 box = traj.object.shape.bounds();
+  const double size = std::max(box.max.x() - box.min.x(), box.max.y() - box.min.y());
+  return size > 0.0 && std::isfinite(nearest) ? nearest / size : 0.0;
+}
+
+void CheckPositionUnits(const std::vector<push::PoseSample>& s, const std::string& stream, double ratio) {
   if (s.size() < 2 || !(s.back().t > s.front().t)) return;
   Eigen::Vector2d low = s.front().pose.translation(), high = low;
   for (const push::PoseSample& p : s) {
@@ -53,26 +72,7 @@ void CheckPositionUnits(const push::Trajectory& traj, const std::vector<push::Po
     high = high.cwiseMax(p.pose.translation());
   }
   const double span = (high - low).norm(), duration = s.back().t - s.front().t;
-  if (span <= kMinJudgedSpan) return;
-  // Which unit: the finger's distance from the object's origin, where it comes nearest, over the
-  // object's size (in metres, the shape's): 0.1 to 1 for a push; 10 to 100 in centimetres, 100 to
-  // 1000 in millimetres. Beyond 10 it is no push in metres even when slow (a 5 cm/s push in
-  // centimetres moves at 3.8 "m/s"), or the finger's and object's frames differ.
-  const auto& fingers = traj.measured.finger_pose;
-  const auto& objects = traj.measured.object_pose;
-  std::vector<double> distances;
-  for (std::size_t i = 0, j = 0; i < fingers.size() && !objects.empty(); ++i) {
-    while (j + 1 < objects.size() && std::abs(objects[j + 1].t - fingers[i].t) <= std::abs(objects[j].t - fingers[i].t)) ++j;
-    distances.push_back((fingers[i].pose.translation() - objects[j].pose.translation()).norm());
-  }
-  const geometry::Box2 box = traj.object.shape.bounds();
-  const double size = std::max(box.max.x() - box.min.x(), box.max.y() - box.min.y());
-  // The nearest the finger comes: a finger that retreats 40 cm from a 1 cm block after a brief
-  // push spends almost all of the recording far from it (median 24 sizes, 5th percentile 13) and
-  // was refused. Noise only brings it nearer.
-  const double nearest = distances.empty() ? 0.0 : *std::min_element(distances.begin(), distances.end());
-  const double ratio = size > 0.0 ? nearest / size : 0.0;
-  if (span / duration <= kMaxPushSpeed && ratio <= 10.0) return;
+  if (span <= kMinJudgedSpan || (span / duration <= kMaxPushSpeed && ratio <= 10.0)) return;
   const char* unit = ratio > 100.0 ? "millimetres" : ratio > 10.0 ? "centimetres" : nullptr;
   std::ostringstream text;
   text << "trajectory: streams." << stream << " spans " << span << " m in " << duration << " s (" << span / duration
@@ -312,10 +312,12 @@ void ValidateTrajectory(const push::Trajectory& traj) {
   if (m.finger_pose.empty()) {
     throw GraphError("trajectory: no finger pose measurements (streams.finger_pose is empty)");
   }
-  CheckPositionUnits(traj, m.finger_pose, "finger_pose");
-  CheckPositionUnits(traj, m.object_pose, "object_pose");
+  const double finger_ratio = NearestFingerRatio(traj);
+  CheckPositionUnits(m.finger_pose, "finger_pose", finger_ratio);
+  CheckPositionUnits(m.object_pose, "object_pose", finger_ratio);
   for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k)
-    CheckPositionUnits(traj, traj.extra_fingers[k].measured.finger_pose, "fingers[" + std::to_string(k + 1) + "].finger_pose");
+    CheckPositionUnits(traj.extra_fingers[k].measured.finger_pose, "fingers[" + std::to_string(k + 1) + "].finger_pose",
+                       finger_ratio);
   CheckFingerSize(traj.finger.shape, m.finger_pose, m.object_pose, traj.object.shape, "");
   for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k) {
     CheckFingerSize(traj.extra_fingers[k].finger.shape, traj.extra_fingers[k].measured.finger_pose, m.object_pose,

@@ -63,8 +63,8 @@ void RegisterFootprint(CLI::App& app) {
       const double size = std::max(extent.max.x() - extent.min.x(), extent.max.y() - extent.min.y());
       if (std::hypot(pose.x, pose.y) > std::max(1.0, 10.0 * size)) {
         std::cerr << "footprint: warning: --transform's X,Y (" << FormatDouble(pose.x) << ", " << FormatDouble(pose.y)
-                  << ") are taken as metres (more than 1 m and ten times the shape's size): for millimetres give " << FormatDouble(pose.x * 1e-3) << ","
-                  << FormatDouble(pose.y * 1e-3) << "\n";
+                  << ") are taken as metres (more than 1 m and ten times the shape's size): for millimetres give "
+                  << FormatDouble(pose.x * 1e-3) << "," << FormatDouble(pose.y * 1e-3) << "\n";
       }
       shape = geometry::TransformShape(shape, pose, 1.0, args->mirror);
     }
