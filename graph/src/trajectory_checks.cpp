@@ -42,8 +42,8 @@ void CheckRange(double t, double value, double bound, const std::string& stream,
 
 // Positions in another unit than metres: a pushing recording moves slower than 5 m/s, and its
 // poses do not span 0.2 m at more than that (the default simulated push written in millimetres:
-// its finger spanning 60 "m" in 1.5 s; it ran, with the shape "1000 times too small" and every
-// residual 1e5 times its sigma).
+// its finger spanning 57 "m" in 1.5 s; it ran, with the shape "1000 times too small" and its
+// residuals 3e4 to 3e7 times their expected size).
 constexpr double kMaxPushSpeed = 5.0, kMinJudgedSpan = 0.2;  // m/s, m
 // The nearest finger 0 comes to the object's origin, over the object's size (in metres, the
 // shape's): 0.1 to 1 for a push; 10 to 100 in centimetres, 100 to 1000 in millimetres. Beyond 10 it
