@@ -382,6 +382,7 @@ EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode 
   auto add = [&front](const std::optional<std::string>& w) { if (w) front.push_back(*w); };
   add(internal::TimeUnitNote(trajectory));
   add(internal::YawUnitNote(trajectory));
+  add(internal::ShapeSizeNote(trajectory));
   if (!note.empty()) front.push_back(note);
   if (!glitch_note.empty()) front.push_back(glitch_note);
   add(internal::ForceDirectionNote(input));
@@ -462,8 +463,18 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
   // of rect1 touched for 84 ms, its true shape judged off by 3.4 mm and "aligned" by (6.5, -4.2)
   // mm (3.69 mm against 2.60 as given). Warned, not aligned, under "auto".
   const bool too_little = registration && config.align_shape == Align::kAuto && registration->independent_samples < 3.0;
+  // Time stamps that read as milliseconds (TimeUnitNote): the smoothing's and the graph's per-second
+  // noise scales are off by 1000, so their placement is no evidence (`pushgraph simulate --seed 7
+  // --duration 3` written in ms: its true notched block "aligned" by a turn of 46.5 degrees, 9.4 mm
+  // against 6.1 as given). Warned, not aligned, under "auto".
+  // The same for a file in centimetres or millimetres throughout (ShapeSizeNote): a notched block in
+  // cm was "aligned" by a shift of 7.8 "m".
+  const char* unit_doubt = internal::TimeUnitNote(trajectory)    ? "time stamps that read as milliseconds"
+                           : internal::ShapeSizeNote(trajectory) ? "lengths that read as centimetres or millimetres"
+                                                                 : nullptr;
+  const bool unit_gate = registration && config.align_shape == Align::kAuto && unit_doubt;
   // A misfit or suspicion there is data to place the shape by.
-  const bool placeable = (misfit || suspect) && !too_little;
+  const bool placeable = (misfit || suspect) && !too_little && !unit_gate;
   const bool will_align =
       registration && (config.align_shape == Align::kOn || (config.align_shape == Align::kAuto && placeable));
   EstimatorConfig quick = config;
@@ -634,7 +645,7 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
   bool frame_wins = false;
   // QS only: the CP and SDF graphs have no mechanics to place the support by, and on the
   // evaluation set their frame then followed the noise (ellip1 SDF incremental +4.9 %).
-  bool frame_check = registration && config.align_shape == Align::kAuto && model == Model::kQs && !too_little &&
+  bool frame_check = registration && config.align_shape == Align::kAuto && model == Model::kQs && !too_little && !unit_gate &&
                            registration->fits_as_given && !misfit && !suspect && !registration->weak_directions.empty();
   double frame_given_cost = 0.0, frame_cost = 0.0, frame_moved = 0.0;
   ShapeTransform frame_refined;
@@ -777,6 +788,9 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
         also = size;
       }
       warnings.push_back(what + "; " + AlignedText(*registration, alignment) + also);
+    } else if (misfit && unit_gate) {
+      warnings.push_back(what + "; not aligned on " + unit_doubt + " (the first warning): fix the units, then estimate "
+                                "again (estimates may be worse than the raw measurements)");
     } else if (misfit && too_little) {
       warnings.push_back(what + internal::Format("; too little contact to place it by (%.2f s): not aligned, check the shape "
                                                  "file (estimates may be worse than the raw measurements)",
@@ -819,7 +833,8 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
     // among them, no proof (the true notched block, pushed and left resting, was aligned by
     // -117.6 degrees so): the warning says the recording does not settle it instead.
     const std::string advice =
-        registration->ambiguous
+        unit_gate ? std::string("; not aligned on ") + unit_doubt + " (the first warning)"
+        : registration->ambiguous
             ? "; " + registration->ambiguity + ": this recording does not settle the placement, check the shape file's frame "
                                                "(pushes on several sides, registered together by pushgraph evaluate, fix more)"
             : ": if the shape file's frame is uncertain, --align-shape on aligns it";
@@ -827,7 +842,7 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
                                         "better %s (log-likelihood +%.1f)%s",
                                         registration->Describe().c_str(),
                                         registration->identity_cost - registration->aligned_cost,
-                                        suspect ? ", though the whole graph does not (the estimate uses the shape as given)" : "") +
+                                        suspect && !unit_gate ? ", though the whole graph does not (the estimate uses the shape as given)" : "") +
                        advice);
   }
   if (alignment.checked || !alignment.notes.empty()) result.shape_alignment = alignment;

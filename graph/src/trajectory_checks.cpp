@@ -509,6 +509,29 @@ std::optional<std::string> YawUnitNote(const push::Trajectory& traj) {
                 scatter, scatter * 180.0 / M_PI, half, rate, lo_t, hi_t);
 }
 
+std::optional<std::string> ShapeSizeNote(const push::Trajectory& traj) {
+  // Objects pushed on a table by a finger span centimetres to decimetres (MIT's: 9 to 16 cm); the
+  // shape's reach from its centroid beyond 1 m (2 m across) is a file in centimetres or millimetres
+  // from end to end: its shapes and positions agree, so no other check sees the unit, but the noise
+  // model's scales (m/s^2, the 5 mm tracker sigma of the defaults) are off by 100 or 1000.
+  const geometry::Shape& object = traj.object.shape;
+  if (object.empty()) return std::nullopt;
+  const double reach = geometry::RadiusAbout(object, geometry::CoreCentroid(object));
+  constexpr double kMaxReach = 1.0;  // m
+  if (!(reach > kMaxReach)) return std::nullopt;
+  // Positions on the shape's scale (the finger's nearest approach 0.1 to 1 object sizes, as in
+  // metres): a shape file alone in millimetres against positions in metres (about 1e-3 sizes) is
+  // the shape check's case, which finds its units.
+  if (NearestFingerRatio(traj) < 0.02) return std::nullopt;
+  const bool milli = reach > 100.0 * kMaxReach;
+  return Format("object: its shape reaches %.4g m from its centroid (%.4g m across) and the finger's radius is %.3g m: is "
+                "the whole file in %s? Trajectory files are in metres (shapes, positions, sigmas): a tabletop object read "
+                "in %s would be %.3g cm across. The noise model's scales do not fit such a push, and the estimate may be "
+                "worse than the measurements: divide every length by %d",
+                reach, 2.0 * reach, traj.finger.shape.radius(), milli ? "millimetres" : "centimetres",
+                milli ? "millimetres" : "centimetres", 2.0 * reach * (milli ? 0.1 : 1.0), milli ? 1000 : 100);
+}
+
 std::optional<std::string> MeasurementSigmaNote(const push::Trajectory& traj, const push::MeasurementSigmas& sigma) {
   const auto& m = traj.measured;
   // How far a stream's values range: a sigma ten times beyond it (and beyond 1 cm, 1 N) leaves its

@@ -289,6 +289,70 @@ TEST(Alignment, TooLittleContactIsNotAlignedOn) {
   }
 }
 
+// Time stamps in milliseconds: the smoothing's and the graph's per-second noise scales are off by
+// 1000, so what they prefer places nothing. `pushgraph simulate --duration 3 --seed 7` written in
+// milliseconds had its true notched block "aligned" by the frame check (turned by 46.5 degrees,
+// 9.4 mm against 6.1 mm as given); now the clock is warned about and nothing is aligned on it.
+TEST(Alignment, NothingIsAlignedOnTimeStampsInMilliseconds) {
+  for (unsigned seed : {3u, 7u}) {
+    push::PushPlan plan = DefaultNoisePlan(0.005, 0.05);
+    plan.duration = 3.0;
+    plan.seed = seed;
+    const push::Trajectory truth = push::Simulate(plan).trajectory;
+    for (const Misframe& m : {Misframe{"true", {}, 1.0}, Misframe{"30 deg", {0, 0, M_PI / 6}, 1.0}}) {
+      push::Trajectory t = truth;
+      t.object.shape = FileShape(truth.object.shape, m);
+      for (push::Streams* s : {&t.measured, &*t.ground_truth}) {
+        for (auto& x : s->object_pose) x.t *= 1e3;
+        for (auto& x : s->finger_pose) x.t *= 1e3;
+        for (auto& x : s->contact_point) x.t *= 1e3;
+        for (auto& x : s->force) x.t *= 1e3;
+      }
+      EstimatorConfig cfg = ApplyMeasurementSigmas({}, *t.measurement_sigmas);
+      cfg.covariance = false;
+      const EstimationResult r = Estimate(t, Model::kQs, Mode::kBatch, cfg);
+      ASSERT_FALSE(r.warnings.empty());
+      EXPECT_NE(r.warnings[0].find("are the times in milliseconds"), std::string::npos) << r.warnings[0];
+      ASSERT_TRUE(r.shape_alignment && r.shape_alignment->checked) << m.name;
+      EXPECT_FALSE(r.shape_alignment->aligned) << "seed " << seed << ", " << m.name;
+      if (HasWarning(r, "does not fit this recording as given"))
+        EXPECT_TRUE(HasWarning(r, "not aligned on time stamps that read as milliseconds")) << seed << ", " << m.name;
+    }
+  }
+}
+
+// A file in centimetres from end to end: shapes, positions and sigmas agree, so the size and
+// units checks pass, but the noise model's scales do not (the default push's notched block in cm
+// was "aligned" by a shift of 7.8 "m"). It is named, and nothing is aligned on it.
+TEST(Alignment, AFileInCentimetresThroughoutIsNamedAndNotAlignedOn) {
+  push::PushPlan plan = DefaultNoisePlan(0.005, 0.05);
+  plan.duration = 3.0;
+  plan.seed = 3;
+  push::Trajectory t = push::Simulate(plan).trajectory;
+  constexpr double kCm = 100.0;
+  t.object.shape = geometry::TransformShape(t.object.shape, Pose2{}, kCm);
+  t.finger.shape = geometry::TransformShape(t.finger.shape, Pose2{}, kCm);
+  for (push::Streams* s : {&t.measured, &*t.ground_truth}) {
+    for (auto& x : s->object_pose) x.pose.x *= kCm, x.pose.y *= kCm;
+    for (auto& x : s->finger_pose) x.pose.x *= kCm, x.pose.y *= kCm;
+    for (auto& x : s->contact_point) x.point *= kCm;
+  }
+  push::MeasurementSigmas& sigma = *t.measurement_sigmas;
+  sigma.object_trans *= kCm, sigma.finger_trans *= kCm, sigma.contact *= kCm;
+  EstimatorConfig cfg = ApplyMeasurementSigmas({}, sigma);
+  cfg.covariance = false;
+  const EstimationResult r = Estimate(t, Model::kQs, Mode::kBatch, cfg);
+  ASSERT_FALSE(r.warnings.empty());
+  EXPECT_NE(r.warnings[0].find("is the whole file in centimetres"), std::string::npos) << r.warnings[0];
+  EXPECT_NE(r.warnings[0].find("divide every length by 100"), std::string::npos) << r.warnings[0];
+  ASSERT_TRUE(r.shape_alignment && r.shape_alignment->checked);
+  EXPECT_FALSE(r.shape_alignment->aligned) << (r.warnings.size() > 1 ? r.warnings[1] : "");
+  // The same push in metres says nothing of the kind.
+  const push::Trajectory metres = push::Simulate(plan).trajectory;
+  const EstimationResult m = Estimate(metres, Model::kQs, Mode::kBatch, ApplyMeasurementSigmas({}, *metres.measurement_sigmas));
+  EXPECT_FALSE(HasWarning(m, "is the whole file in"));
+}
+
 TEST(Alignment, IncrementalModeUsesTheAlignedShape) {
   const push::Trajectory truth = NotchedPush(1.0, 0.0, 5);
   EstimatorConfig cfg = ApplyMeasurementSigmas({}, *truth.measurement_sigmas);
