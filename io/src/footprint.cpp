@@ -1,5 +1,5 @@
 // Mesh footprints: tinyobjloader for the mesh, CGAL Polygon_set_2 (Epeck) for the exact union
-// of the projected triangles (aggregated divide-and-conquer join). This is the io module's only
+// of the projected faces (aggregated divide-and-conquer join). This is the io module's only
 // CGAL Boolean-operations translation unit.
 #include <pushgraph/io/footprint.h>
 #include <pushgraph/io/trajectory_json.h>  // IoError
@@ -117,7 +117,7 @@ std::vector<geometry::Polygon> AssemblePolygons(const std::vector<geometry::Ring
 // tinyobjloader's number parser is not correctly rounded (it can be 1 ulp off); re-read the
 // vertex lines with strtod, which is. Returns empty if the file's vertex count differs.
 // A polygon face (4+ vertices) whose outline crosses itself in its own plane (a bow-tie quad):
-// the parser's fan triangulation then covers neither what the outline encloses nor its hull.
+// its fan triangulation (below) then covers neither what the outline encloses nor its hull.
 // The plane's normal by Newell's method; the outline projected along its largest component and
 // every pair of non-adjacent edges tested for a proper crossing (orientation signs).
 bool FaceCrossesItself(const std::vector<double>& xyz, const std::vector<long>& face) {
@@ -262,7 +262,9 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw IoError(path + ": is a directory, not a mesh file");
   tinyobj::ObjReaderConfig config;
-  config.triangulate = true;
+  // Faces as the file gives them: tinyobjloader's triangulation of a polygon face depends on the
+  // vertex it starts at (a U-shaped 8-gon listed from its fourth vertex had its notch filled).
+  config.triangulate = false;
   config.vertex_color = false;
   config.mtl_search_path = "";  // materials are irrelevant to a footprint
   tinyobj::ObjReader reader;
@@ -304,28 +306,56 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
       default: return {x, y};
     }
   };
-  std::vector<Polygon2> triangles;
+  // Each face's projection: a planar simple face seen along a direction not in its plane is a
+  // simple polygon, united as it is (exactly); a projection that is not simple (a face crossing
+  // itself, or a nearly vertical one folded by its vertices' rounding) is united as the fan of
+  // triangles from its first vertex, as a triangulating reader would.
+  std::vector<Polygon2> projected;
   for (const tinyobj::shape_t& s : reader.GetShapes()) {
     if (!options.object.empty() && s.name != options.object) continue;
     const auto& idx = s.mesh.indices;
-    for (std::size_t f = 0; f + 2 < idx.size(); f += 3) {
+    std::size_t first = 0;
+    for (std::size_t f = 0; f < s.mesh.num_face_vertices.size(); first += s.mesh.num_face_vertices[f], ++f) {
+      const std::size_t n = s.mesh.num_face_vertices[f];
+      if (n < 3 || first + n > idx.size()) continue;
       ++rep.faces;
-      Point p[3];
-      for (int k = 0; k < 3; ++k) {
-        const int vi = idx[f + k].vertex_index;
+      std::vector<Point> p;
+      for (std::size_t k = 0; k < n; ++k) {
+        const int vi = idx[first + k].vertex_index;
         if (vi < 0 || vi >= nv)
-          throw IoError(path + ": object '" + s.name + "' face " + std::to_string(f / 3) + " refers to missing vertex " +
+          throw IoError(path + ": object '" + s.name + "' face " + std::to_string(f) + " refers to missing vertex " +
                         std::to_string(vi + 1));
-        p[k] = project(vi);
+        p.push_back(project(vi));
       }
-      const CGAL::Orientation o = CGAL::orientation(p[0], p[1], p[2]);
-      if (o == CGAL::COLLINEAR) continue;
-      Polygon2 tri(p, p + 3);
-      if (o == CGAL::CLOCKWISE) tri.reverse_orientation();
-      triangles.push_back(std::move(tri));
+      bool used = false;
+      auto add = [&](Polygon2 polygon) {
+        const CGAL::Orientation o = polygon.orientation();
+        if (o == CGAL::COLLINEAR) return;
+        if (o == CGAL::CLOCKWISE) polygon.reverse_orientation();
+        projected.push_back(std::move(polygon));
+        used = true;
+      };
+      if (n == 3) {
+        if (CGAL::orientation(p[0], p[1], p[2]) != CGAL::COLLINEAR) add(Polygon2(p.begin(), p.end()));
+      } else {
+        std::vector<Point> ring;  // consecutive repeats dropped (a polygon's vertices must differ)
+        for (const Point& q : p)
+          if (ring.empty() || q != ring.back()) ring.push_back(q);
+        while (ring.size() > 1 && ring.front() == ring.back()) ring.pop_back();
+        Polygon2 polygon(ring.begin(), ring.end());
+        if (ring.size() >= 3 && polygon.is_simple()) {
+          if (polygon.area() != 0) add(std::move(polygon));
+        } else {
+          for (std::size_t k = 1; k + 1 < n; ++k)
+            if (CGAL::orientation(p[0], p[k], p[k + 1]) != CGAL::COLLINEAR) {
+              const Point tri[3] = {p[0], p[k], p[k + 1]};
+              add(Polygon2(tri, tri + 3));
+            }
+        }
+      }
+      rep.faces_used += used;
     }
   }
-  rep.faces_used = static_cast<int>(triangles.size());
   {
     std::vector<std::string> with_faces;
     std::vector<char> used(nv, 0);
@@ -380,9 +410,9 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
     }
   }
   if (rep.faces == 0) throw IoError(path + ": the mesh has no faces");
-  if (triangles.empty()) throw IoError(path + ": every face has zero area seen along the up axis (wrong --up?)");
+  if (projected.empty()) throw IoError(path + ": every face has zero area seen along the up axis (wrong --up?)");
   CGAL::Polygon_set_2<K> set;
-  set.join(triangles.begin(), triangles.end());
+  set.join(projected.begin(), projected.end());
   std::vector<PolygonWithHoles> parts;
   set.polygons_with_holes(std::back_inserter(parts));
   std::vector<geometry::Ring> loops;

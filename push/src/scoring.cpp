@@ -7,8 +7,16 @@
 namespace pushgraph::push {
 
 bool TruthPoseAt(const std::vector<PoseSample>& truth, double t, Eigen::Vector3d* pose) {
-  return StreamValueAt(truth, t, kTruthMaxGap, [](const PoseSample& s) { return Eigen::Vector3d(s.pose.vector()); },
-                       pose);
+  // theta along the shorter arc: a truth wrapped into [-pi, pi] went linearly from -3.133 to
+  // +3.138 between two samples, and the states between them were scored about 180 degrees off.
+  const auto it = std::lower_bound(truth.begin(), truth.end(), t - 1e-9, [](const PoseSample& a, double tt) { return a.t < tt; });
+  const geometry::Pose2* before = it != truth.begin() && it != truth.end() && std::abs(it->t - t) > 1e-9 ? &(it - 1)->pose : nullptr;
+  auto get = [before](const PoseSample& s) {
+    Eigen::Vector3d v = s.pose.vector();
+    if (before) v.z() = before->theta + geometry::WrapAngle(v.z() - before->theta);
+    return v;
+  };
+  return StreamValueAt(truth, t, kTruthMaxGap, get, pose);
 }
 
 bool TruthPointAt(const std::vector<PointSample>& truth, double t, Vec2* point) {
@@ -46,7 +54,8 @@ bool ObjectMovingAt(const std::vector<PoseSample>& truth, double t) {
     if (!TruthPoseAt(truth, tb, &b)) return false;
   }
   if (tb - ta <= 0.0) return false;
-  const Eigen::Vector3d v = (b - a) / (tb - ta);
+  Eigen::Vector3d v = (b - a) / (tb - ta);
+  v.z() = geometry::WrapAngle(b.z() - a.z()) / (tb - ta);
   return v.head<2>().norm() > kMovingSpeed || std::abs(v.z()) > kMovingAngularSpeed;
 }
 

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 namespace {
 
@@ -188,6 +189,27 @@ TEST_F(Footprint, UnionOfOverlappingAndOpenNonManifoldMeshes) {
   io::FootprintOptions mm;
   mm.scale = 0.001;
   EXPECT_DOUBLE_EQ(io::MeshFootprint(frame, mm).core_area(), 8.0e-6);
+}
+
+// A non-convex polygon face (a U, 8 vertices) gives its own area from whichever vertex it is
+// listed from, in either orientation: the OBJ reader's triangulation filled the notch when the
+// face started at the notch's corner (area 0.01 instead of 0.0072, no warning).
+TEST_F(Footprint, ANonConvexPolygonFaceIsUnitedAsItIs) {
+  const double u[8][2] = {{0, 0}, {0.1, 0}, {0.1, 0.1}, {0.07, 0.1}, {0.07, 0.03}, {0.03, 0.03}, {0.03, 0.1}, {0, 0.1}};
+  for (int start = 0; start < 8; ++start) {
+    for (int direction : {1, -1}) {
+      std::ostringstream obj;
+      for (const auto& v : u) obj << "v " << v[0] << " " << v[1] << " 0.5\n";
+      obj << "f";
+      for (int k = 0; k < 8; ++k) obj << " " << ((start + direction * k + 8) % 8) + 1;
+      obj << "\n";
+      io::FootprintReport report;
+      const geometry::Shape s = io::MeshFootprint(Write("u.obj", obj.str()), {}, &report);
+      EXPECT_NEAR(s.core_area(), 0.0072, 1e-15) << "from vertex " << start + 1 << ", direction " << direction;
+      EXPECT_EQ(report.faces, 1);
+      EXPECT_EQ(geometry::QueryPoint(s, geometry::Vec2(0.05, 0.08)).containment, geometry::Containment::kOutside);
+    }
+  }
 }
 
 TEST_F(Footprint, ClearErrors) {

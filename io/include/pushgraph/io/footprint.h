@@ -29,7 +29,7 @@ struct FootprintOptions {
 
 struct FootprintReport {
   std::vector<std::string> objects;  ///< object/group names in the file
-  int faces = 0;                     ///< triangles read (after triangulation)
+  int faces = 0;                     ///< faces read (a polygon face counts once)
   int faces_used = 0;                ///< with non-zero projected area
   int vertices_removed = 0;          ///< collinear or duplicate vertices dropped from the outline
   /// What the footprint may not be what was meant: several objects united (tri3.obj holds two

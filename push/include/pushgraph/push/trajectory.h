@@ -145,7 +145,7 @@ geometry::Pose2 PoseAtClamped(It first, It last, double t) {
 /// A time-sorted stream's value at t (e.g. ground truth at an estimate's time): the sample at t
 /// (within 1e-9 s), or the linear interpolation of its two neighbours when they are at most
 /// max_gap apart; false outside the stream or across a larger gap. `get` maps a sample to the
-/// interpolated quantity (for poses pose.vector(), theta linearly).
+/// interpolated quantity linearly (for poses, TruthPoseAt in scoring.h takes theta along the shorter arc).
 ///
 ///   Eigen::Vector3d x;
 ///   if (StreamValueAt(gt.object_pose, t, 0.1, [](const PoseSample& s) { return s.pose.vector(); }, &x)) ...
