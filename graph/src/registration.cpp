@@ -9,6 +9,7 @@
 #include <pushgraph/graph/registration.h>
 
 #include "contact_fit.h"
+#include "graph_builder.h"
 #include "text.h"
 
 #include <ceres/ceres.h>
@@ -34,6 +35,7 @@ RegistrationOptions RegistrationOptionsFor(const EstimatorConfig& config) {
   RegistrationOptions o;
   o.contact_max_gap = config.contact_max_gap;
   o.contact_force_threshold = config.contact_force_threshold;
+  o.contact_force_sigma = config.measurement.force;
   o.pose_sigma_trans = config.measurement.object_trans;
   o.pose_sigma_rot = config.measurement.object_rot;
   o.accel_trans = config.accel_trans;
@@ -151,6 +153,13 @@ ContactPath PathOf(const push::Trajectory& traj, const std::vector<push::PoseSam
     const auto& contact = extra ? extra->contact_point : traj.measured.contact_point;
     const auto& force = extra ? extra->force : traj.measured.force;
     const FingerDisk disk = FingerAsDisk(finger == 0 ? traj.finger.shape : traj.extra_fingers[finger - 1].finger.shape);
+    // A force stream that never shows a contact above its noise: the finger never touched (as the
+    // graph takes it; its noise crossing the threshold had a passing finger's path fitted).
+    if (contact.empty() && !any_contact_rows && !force.empty() &&
+        std::none_of(force.begin(), force.end(), [&](const push::ForceSample& s) {
+          return internal::ForceSaysTouching(force, s.t, o.contact_max_gap, o.contact_force_threshold, o.contact_force_sigma);
+        }))
+      continue;
     for (const push::PoseSample& f : fingers[finger]) {
       int k = -1;
       if (!contact.empty()) {

@@ -353,6 +353,34 @@ TEST(Alignment, AFileInCentimetresThroughoutIsNamedAndNotAlignedOn) {
   EXPECT_FALSE(HasWarning(m, "is the whole file in"));
 }
 
+// A finger passing 4 cm beside the object, with a force stream and no contact stream: one sample
+// against the 0.05 N threshold let the sensor's noise gate the finger in (61 % of its samples at
+// sigma 0.05 N), so every such step was in contact, the object pulled 2 cm to the finger's path
+// (3.25 mm against 2.80 raw, NEES 33) and the true shape "aligned" by 56 mm. A force stream that
+// never shows a contact above its noise now leaves the finger untouched, and says so.
+TEST(Alignment, AFingerThatNeverTouchesHasNoContact) {
+  push::PushPlan miss = DefaultNoisePlan(0.03, 0.05);
+  miss.waypoints = {Vec2(0.1, -0.05), Vec2(0.1, 0.05)};  // 4 cm beside the block's side
+  miss.seed = 5;
+  push::Trajectory passing = push::Simulate(miss).trajectory;
+  passing.measured.contact_point.clear();
+  for (Mode mode : {Mode::kBatch, Mode::kIncremental}) {
+    const EstimationResult p = Estimate(passing, Model::kQs, mode, ApplyMeasurementSigmas({}, *passing.measurement_sigmas));
+    for (const StateEstimate& s : p.states) EXPECT_FALSE(s.contact.has_value()) << "t = " << s.t;
+    EXPECT_TRUE(HasWarning(p, "no step is in contact"));
+    EXPECT_FALSE(p.shape_alignment && p.shape_alignment->aligned);
+    EXPECT_LT(p.metrics.at("object_position_rms"), p.metrics.at("measured_object_position_rms"));
+  }
+  // The same push through the object is gated in as before.
+  push::PushPlan through = DefaultNoisePlan(0.03, 0.05);
+  through.seed = 5;
+  push::Trajectory pushing = push::Simulate(through).trajectory;
+  pushing.measured.contact_point.clear();
+  const EstimationResult q = Estimate(pushing, Model::kQs, Mode::kBatch, ApplyMeasurementSigmas({}, *pushing.measurement_sigmas));
+  EXPECT_FALSE(HasWarning(q, "no step is in contact"));
+  EXPECT_GT(std::count_if(q.states.begin(), q.states.end(), [](const StateEstimate& s) { return s.contact.has_value(); }), 100);
+}
+
 TEST(Alignment, IncrementalModeUsesTheAlignedShape) {
   const push::Trajectory truth = NotchedPush(1.0, 0.0, 5);
   EstimatorConfig cfg = ApplyMeasurementSigmas({}, *truth.measurement_sigmas);

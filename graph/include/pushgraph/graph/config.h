@@ -92,7 +92,10 @@ struct EstimatorConfig {
   double random_walk_trans = 0.05;      ///< m/sqrt(s), zero-velocity prior
   double random_walk_rot = 0.5;         ///< rad/sqrt(s)
   // Contact gating: a step is in contact when a contact measurement (or, without a contact
-  // stream, a force of at least contact_force_threshold) lies within contact_max_gap of it;
+  // stream, a force of at least contact_force_threshold) lies within contact_max_gap of it; a
+  // finger whose force stream never shows a contact above its noise (the median of +-20 ms of
+  // samples at least max(contact_force_threshold, 5 force sigmas / sqrt(their count))) never
+  // touches (in the graph and the registration);
   // without either stream every step is in contact (the paper's constant-contact assumption).
   double contact_max_gap = 0.05;          ///< s
   double contact_force_threshold = 0.05;  ///< N

@@ -56,7 +56,7 @@ class MarginalPriorFactor : public ceres::CostFunction {
 
 /// Which measurement streams an online run will receive. They shape the graph as the
 /// recorded streams do in batch: contact is gated on the contact stream if there is one, else
-/// on the force stream (force above contact_force_threshold), else always on; and the
+/// on the force stream (force above contact_force_threshold, once a contact above its noise was seen), else always on; and the
 /// limit-surface load factor runs (limit_surface_load "auto") only when no force will arrive.
 struct OnlineStreams {
   bool contact_point = false;  ///< a tactile sensor reports contact points

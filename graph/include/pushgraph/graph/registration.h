@@ -93,9 +93,11 @@ struct RegistrationOptions {
   double misfit_evidence = 6.0;
   /// A best fit that moves no outline point further than this (m) is the shape as given.
   double min_displacement = 1e-3;
-  /// Contact gating as the estimator's (EstimatorConfig: contact_max_gap, contact_force_threshold).
+  /// Contact gating as the estimator's (EstimatorConfig: contact_max_gap, contact_force_threshold;
+  /// the force sigma decides whether a force stream shows any contact above its noise at all).
   double contact_max_gap = 0.05;
   double contact_force_threshold = 0.05;
+  double contact_force_sigma = 0.5;
   /// Smoothing: measurement sigmas when the trajectory has none, and the white-noise
   /// acceleration densities (EstimatorConfig's object_pose_sigma_*, accel_*).
   double pose_sigma_trans = 0.005, pose_sigma_rot = 0.05;
