@@ -246,6 +246,10 @@ class GraphBuilder {
   void StartNewProblem() { c_in_problem_ = mu_in_problem_ = frame_in_problem_ = false; }
   /// Parameter blocks of step i present in the problem.
   std::vector<double*> Blocks(int i);
+  /// Whether step i has the limit-surface load factor: always when use_load_factor_, and under
+  /// limit_surface_load "auto" at steps no force sample covers (beyond contact_max_gap and 1.5
+  /// force periods).
+  bool LoadFactorAt(int i) const;
   /// Makes c a shared variable of every D factor (QS only; the batch solver calls this when
   /// config.estimate_c). c_block() is then non-null once a D factor was added.
   void EnableCEstimation();
@@ -403,6 +407,7 @@ class GraphBuilder {
   bool c_in_problem_ = false;
   double c_var_[1] = {0.0};
   double f_max_ = 0.0;  ///< mu m g; 0 when the trajectory lacks mass or friction
+  double force_period_ = 0.0;  ///< the force stream's median sample period (s), 0 with under two samples
   double mu_surface_ = 0.0, normal_load_ = 0.0;  ///< the trajectory's mu and m g
   double eps_force_ = 0.0;  ///< cfg.eps_force, capped at f_max / 20 (a light object)
   bool estimate_mu_ = false;

@@ -74,8 +74,9 @@ struct EstimatorConfig {
   /// not estimated); the incremental mode refuses them (it keeps c and mu fixed).
   bool estimate_mu = false;
   double mu_prior_sigma = 0.3;  ///< relative
-  /// When the limit-surface load factor is used: kAuto (the default) only without a force
-  /// stream, where it is the sole information on the force magnitude; with force measurements
+  /// When the limit-surface load factor is used: kAuto (the default) only at steps no force
+  /// sample covers (no force stream, or one that stops or pauses), where it is the sole
+  /// information on the force magnitude; with force measurements
   /// it adds little and its rest/sliding gate (|V'| against eps_velocity) slows convergence
   /// 2-4x. JSON "limit_surface_load": "auto" | "on" | "off".
   enum class LimitSurfaceLoad { kAuto, kOn, kOff };
