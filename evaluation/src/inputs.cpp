@@ -3,6 +3,7 @@
 #include "internal.h"
 
 #include <pushgraph/evaluation/inputs.h>
+#include <pushgraph/geometry/json_check.h>
 #include <pushgraph/io/footprint.h>
 #include <pushgraph/io/mit_push.h>
 #include <pushgraph/io/trajectory_json.h>
@@ -225,7 +226,7 @@ InputKind DetectInputKind(const std::string& path) {
   try {
     doc = nlohmann::json::parse(in);
   } catch (const nlohmann::json::exception& e) {
-    throw EvaluationError(path + ": neither an HDF5 file nor valid JSON (" + e.what() + ")");
+    throw EvaluationError(path + ": neither an HDF5 file nor valid JSON (" + geometry::JsonSyntaxErrorText(e.what()) + ")");
   } catch (const std::exception& e) {
     throw EvaluationError(path + ": cannot read the file (" + e.what() + ")");
   }

@@ -82,4 +82,21 @@ std::string FindDuplicateJsonKey(const std::string& text) {
   return finder.found;
 }
 
+std::string JsonSyntaxErrorText(const std::string& what) {
+  // "invalid literal" (NaN, Infinity), or "expected digit after '-'" (-Infinity).
+  const bool literal = what.find("invalid literal") != std::string::npos || what.find("after '-'") != std::string::npos;
+  const std::size_t last = what.find("last read: '");
+  if (!literal || last == std::string::npos) return what;
+  // The token the parser stopped in: the last read text's tail after a separator.
+  std::string read = what.substr(last + 12);
+  if (const std::size_t end = read.rfind('\''); end != std::string::npos) read.erase(end);
+  const std::size_t start = read.find_last_of(" ,[:\t\n");
+  const std::string token = start == std::string::npos ? read : read.substr(start + 1);
+  const bool non_finite = !token.empty() && (token.find_first_of("NnIi") == 0 || token.rfind("-I", 0) == 0 ||
+                                             token.rfind("-i", 0) == 0);
+  if (!non_finite) return what;
+  return what + " (NaN or Infinity written as a number? JSON has neither, and a non-finite sample is no measurement: "
+                "leave that row out)";
+}
+
 }  // namespace pushgraph::geometry

@@ -48,7 +48,7 @@ Shape ParseShapeJson(const std::string& text, const std::string& source) {
   try {
     doc = json::parse(text);
   } catch (const json::exception& e) {  // syntax errors, and numbers that overflow a double
-    Fail(source, std::string("malformed JSON: ") + e.what());
+    Fail(source, "malformed JSON: " + JsonSyntaxErrorText(e.what()));
   }
   if (const std::string dup = FindDuplicateJsonKey(text); !dup.empty()) Fail(source, dup);
   if (!doc.is_object()) Fail(source, "top level must be an object with \"polygons\"");

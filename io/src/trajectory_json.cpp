@@ -118,6 +118,33 @@ class Reader {
   std::vector<Sample> Sorted(std::vector<Sample> rows, const std::vector<std::size_t>& row_of, const std::string& path,
                              bool repeats, int finger) const {
     const std::string whose = finger >= 0 ? " of finger " + std::to_string(finger) : "";
+    // Rows a little out of order (a logger's buffers) are sorted; a stream whose clock goes back
+    // by more than max(1 s, 100 median periods) is two recordings joined or a clock reset, which
+    // sorting would interleave into one nonsense push (a concatenated file ran, its shape
+    // "aligned" by a turn of 132 degrees, object NEES 2887).
+    if (rows.size() >= 3) {
+      std::vector<double> steps;
+      for (std::size_t i = 1; i < rows.size(); ++i)
+        if (rows[i].t > rows[i - 1].t) steps.push_back(rows[i].t - rows[i - 1].t);
+      double period = 0.0;
+      if (!steps.empty()) {
+        std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
+        period = steps[steps.size() / 2];
+      }
+      const double limit = std::max(1.0, 100.0 * period);
+      double latest = rows[0].t;
+      for (std::size_t i = 1; i < rows.size(); ++i) {
+        if (latest - rows[i].t > limit) {
+          std::ostringstream o;
+          o.precision(10);
+          o << "row [" << row_of[i] << "]" << whose << " goes back in time by " << latest - rows[i].t << " s (to t = "
+            << rows[i].t << " after t = " << latest << "; the stream's median period is " << period
+            << " s): are two recordings joined, or was the clock reset? A trajectory file holds one push";
+          Fail(path, o.str());
+        }
+        latest = std::max(latest, rows[i].t);
+      }
+    }
     if (notes_ != nullptr) {
       std::size_t late = 0, first = 0;
       double latest = rows.empty() ? 0.0 : rows[0].t;
@@ -252,7 +279,7 @@ Trajectory ParseTrajectoryJson(const std::string& text, const std::string& sourc
   try {
     doc = json::parse(text);
   } catch (const json::exception& e) {
-    throw IoError(source + ": malformed JSON: " + e.what());
+    throw IoError(source + ": malformed JSON: " + geometry::JsonSyntaxErrorText(e.what()));
   }
   if (const std::string dup = geometry::FindDuplicateJsonKey(text); !dup.empty()) throw IoError(source + ": " + dup);
   const Reader r(source, notes);

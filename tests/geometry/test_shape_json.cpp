@@ -206,5 +206,26 @@ TEST(ShapeJson, DuplicateKeysAreRefusedWithTheirPlace) {
   }
 }
 
+// NaN and Infinity written as numbers (Python's json.dump does) are named: the parser's own
+// message, "invalid literal; last read: '0.4, N'", does not say what is wrong.
+TEST(ShapeJson, NaNAndInfinityAreNamedInSyntaxErrors) {
+  for (const char* text : {R"({"polygons": [{"outer": [[0, 0], [1, NaN], [0, 1]]}]})",
+                           R"({"polygons": [{"outer": [[0, 0], [1, Infinity], [0, 1]]}]})",
+                           R"({"polygons": [{"outer": [[0, 0], [1, -Infinity], [0, 1]]}]})"}) {
+    try {
+      ParseShapeJson(text, "s.json");
+      ADD_FAILURE() << "accepted " << text;
+    } catch (const GeometryError& e) {
+      EXPECT_NE(std::string(e.what()).find("NaN or Infinity written as a number?"), std::string::npos) << e.what();
+    }
+  }
+  try {
+    ParseShapeJson(R"({"polygons": [{"outer": [[0, 0], [1, 0], [0, 1]]}], "radius": tru})", "s.json");
+    ADD_FAILURE() << "accepted";
+  } catch (const GeometryError& e) {
+    EXPECT_EQ(std::string(e.what()).find("NaN"), std::string::npos) << e.what();  // another mistake, not named so
+  }
+}
+
 }  // namespace
 }  // namespace pushgraph::geometry

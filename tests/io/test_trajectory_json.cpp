@@ -72,6 +72,18 @@ void ExpectError(const std::string& text, const std::string& needle) {
   }
 }
 
+// A stream whose clock goes back by more than max(1 s, 100 median periods): two recordings
+// joined (or a clock reset), refused naming the row; sorting interleaved such a file into one
+// nonsense push. A few rows out of order are still sorted.
+TEST(TrajectoryJson, AClockThatGoesBackIsRefused) {
+  std::string rows;
+  for (int i = 0; i <= 300; ++i) rows += (i ? "," : "") + std::string("[") + std::to_string(0.004 * i) + ", 1, 0]";
+  for (int i = 0; i <= 10; ++i) rows += ",[" + std::to_string(0.002 + 0.004 * i) + ", 2, 0]";
+  ExpectError(Doc(R"({"force": [)" + rows + "]}"), "streams.force: row [301] goes back in time by 1.198 s");
+  ExpectError(Doc(R"({"force": [)" + rows + "]}"), "are two recordings joined");
+  EXPECT_NO_THROW(ParseTrajectoryJson(Doc(R"({"force": [[0.0, 1, 0], [0.3, 1, 0], [0.1, 2, 0], [0.2, 3, 0]]})")));
+}
+
 TEST(TrajectoryJson, MeasurementSigmasRoundTripAndAreChecked) {
   const auto t = ParseTrajectoryJson(Doc(
       "{}", R"(, "measurement_sigmas": {"object_pose": [0.002, 0.02], "finger_pose": [0.0005, 0], "contact_point": 0.001, "force": 0.05})"));

@@ -15,4 +15,9 @@ namespace pushgraph::geometry {
 /// gives "" (the caller's parser reports the syntax error).
 std::string FindDuplicateJsonKey(const std::string& text);
 
+/// A JSON parser's syntax error `what`, with what it most likely means added where the parser's
+/// own words do not say: NaN or Infinity written as numbers (JSON has neither; Python's json.dump
+/// writes them), which the parser calls an "invalid literal".
+std::string JsonSyntaxErrorText(const std::string& what);
+
 }  // namespace pushgraph::geometry
