@@ -258,6 +258,25 @@ void Clean(std::vector<Row>* rows, const std::string& path, const char* name, Mi
   const int dropped = static_cast<int>(before - rows->size());
   rec->samples_reordered += reordered;
   rec->duplicates_dropped += dropped;
+  // Time stamps a corrupted file can hold and the estimator refuses (trajectory_checks.cpp's
+  // range and clock-jump rules): refused here, naming the row, not written to a trajectory file
+  // (a byte flip's 1.28e168 s was, and a 46-year contact phase reported).
+  std::vector<double> gaps;
+  for (std::size_t i = 1; i < rows->size(); ++i) gaps.push_back((*rows)[i][0] - (*rows)[i - 1][0]);
+  std::nth_element(gaps.begin(), gaps.begin() + gaps.size() / 2, gaps.end());
+  const double jump = std::max(10.0, 1000.0 * gaps[gaps.size() / 2]);
+  for (std::size_t i = 0; i < rows->size(); ++i) {
+    const double t = (*rows)[i][0];
+    std::ostringstream where;
+    where.precision(12);
+    where << path << ": dataset '" << name << "' sample " << i << " (in time order): time " << t;
+    if (std::abs(t) > 1e11) throw IoError(where.str() + " s is out of the supported range (|t| <= 1e11 s): a corrupted time stamp?");
+    if (i > 0 && t - (*rows)[i - 1][0] > jump) {
+      where << " s follows " << (*rows)[i - 1][0] << " s: a clock jump of more than max(10 s, 1000 median periods) "
+            << "(a corrupted time stamp?)";
+      throw IoError(where.str());
+    }
+  }
   if (reordered > 0) rec->notes.push_back(std::string(name) + ": sorted " + std::to_string(reordered) + " out-of-order samples");
   if (dropped > 0) rec->notes.push_back(std::string(name) + ": dropped " + std::to_string(dropped) + " duplicate time stamps");
 }
@@ -319,6 +338,16 @@ MitRecording ReadMitPush(const std::string& path, const MitReadOptions& o) {
   MitRecording rec;
   rec.file = path;
   for (int k = 0; k < 3; ++k) Clean(&Slot(raw, k), path, kDatasets[k], &rec);
+  // The three sensors record one push: their spans overlap (within the same 10 s).
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b)
+      if (Slot(raw, b).front()[0] - Slot(raw, a).back()[0] > 10.0) {
+        std::ostringstream o;
+        o.precision(12);
+        o << path << ": dataset '" << kDatasets[b] << "' starts at " << Slot(raw, b).front()[0] << " s, after '" << kDatasets[a]
+          << "' ended at " << Slot(raw, a).back()[0] << " s: the sensors' clocks do not overlap (a corrupted time stamp?)";
+        throw IoError(o.str());
+      }
 
   for (const Row& r : raw.tip) rec.streams.finger_pose.push_back({r[0], {r[1], r[2], 0.0}});
   double unwrapped = raw.object.front()[3];

@@ -201,6 +201,20 @@ TEST_F(MitPush, BrokenFilesGetClearErrors) {
   const std::string empty = (dir_ / "empty.h5").string();
   WriteH5(empty, {sets[0], {"object_pose", {}}, sets[2]});
   expect_error(empty, "object_pose");
+  // Corrupted time stamps (fuzzed byte flips were imported: a finger time of 1.28e168 s written
+  // out, a 46-year contact phase reported): refused as the estimator would, naming the sample.
+  auto far = sets;
+  far[0].second.back()[0] = 1.28e168;
+  WriteH5((dir_ / "far.h5").string(), far);
+  expect_error((dir_ / "far.h5").string(), "out of the supported range");
+  auto jump = sets;
+  jump[2].second[0][0] -= 1e8;
+  WriteH5((dir_ / "jump.h5").string(), jump);
+  expect_error((dir_ / "jump.h5").string(), "dataset 'ft_wrench' sample 1 (in time order)");
+  auto apart = sets;
+  for (Row& r : apart[1].second) r[0] += 100.0;
+  WriteH5((dir_ / "apart.h5").string(), apart);
+  expect_error((dir_ / "apart.h5").string(), "the sensors' clocks do not overlap");
   const std::string garbage = (dir_ / "garbage.h5").string();
   std::ofstream(garbage) << "not hdf5";
   expect_error(garbage, "not an HDF5 file");
