@@ -374,7 +374,7 @@ EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode 
   if (cleaned && !r.metrics.empty()) {
     // The raw tracker's errors are the stream as recorded, glitches included.
     for (const auto& [key, value] : ComputeMetrics(*before_glitches, r.states))
-      if (key.rfind("measured_object", 0) == 0) r.metrics[key] = value;
+      if (key.rfind("measured_object", 0) == 0 || key.rfind("measured_finger", 0) == 0) r.metrics[key] = value;
   }
   // The input's own warnings first, in this order: the clock and units, then what was left out,
   // then what the streams say against the physics of a push.

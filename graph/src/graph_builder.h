@@ -473,7 +473,7 @@ std::optional<std::string> ForceDirectionNote(const push::Trajectory& trajectory
 /// mu m g (and 5 force sigmas), or their fifth largest under 1/20 of it while the object moves over
 /// 1 cm (a quasi-static push needs about that load): another force unit, or a wrong mass or mu.
 std::optional<std::string> ForceScaleNote(const push::Trajectory& trajectory, double force_sigma);
-/// The object pose stream without its tracker glitches: samples more than max(1 cm, 10 scatters)
+/// The object and finger pose streams without their tracker glitches (the finger's floor 2 cm): samples more than max(1 cm, 10 scatters)
 /// or max(0.3 rad, 10 scatters) from the median of a window centred on them (+-max(0.1 s, 3
 /// periods)), when they are at most a tenth of the stream (more is the stream itself, left to the
 /// other checks); nullopt when there is none; `note` says how many, the first and the bounds.
