@@ -1,6 +1,7 @@
 // Graph assembly, batch and incremental solving, recovery, consistency and occlusion on
 // simulated pushes (push_generator.h) with the paper's noise.
 #include <pushgraph/graph/estimator.h>
+#include <pushgraph/limit_surface/support.h>
 #include <pushgraph/push/scoring.h>
 #include <pushgraph/graph/incremental.h>
 
@@ -220,6 +221,17 @@ TEST(Estimator, ForcesOrAMassInAnotherUnitAreNamed) {
   push::Trajectory grams = good;
   grams.object.mass *= 1000.0;
   EXPECT_TRUE(HasWarning(Estimate(grams, Model::kCp, Mode::kBatch), "or the mass or mu_surface too large"));
+  // kgf: 1/9.81 of the forces, within the factor of 20 above, named by the forces while the
+  // object moves (a hostile-user push in kgf: force NEES 673, no warning). A third of the forces
+  // (a mu_surface within a factor of 3) is not.
+  const push::Trajectory longer = GeneratePush(OffsetPush(3));
+  EXPECT_FALSE(HasWarning(Estimate(longer, Model::kCp, Mode::kBatch), "is the force in kgf"));
+  push::Trajectory kgf = longer;
+  for (auto& f : kgf.measured.force) f.force /= limit_surface::kStandardGravity;
+  EXPECT_TRUE(HasWarning(Estimate(kgf, Model::kCp, Mode::kBatch), "is the force in kgf"));
+  push::Trajectory third = longer;
+  for (auto& f : third.measured.force) f.force /= 3.0;
+  EXPECT_FALSE(HasWarning(Estimate(third, Model::kCp, Mode::kBatch), "is the force in kgf"));
 }
 
 // Tracker glitches (a sample 10 cm off among 25 Hz object poses) are left out with a warning
