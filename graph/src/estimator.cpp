@@ -74,6 +74,15 @@ QuasiStaticGeometry QuasiStaticGeometryFor(const push::Trajectory& traj,
                        first.what());
     }
   }
+  // c = tau_max / f_max is the support's mean distance from its centre of pressure (weighted by
+  // the pressure), so no pressure makes it longer than the object's reach from that centre: a
+  // given c beyond it is another unit (`{"c": 100}` ran as 100 m).
+  const double reach = geometry::RadiusAbout(shape, s.centre_of_pressure);
+  if (cfg.c > 1.5 * reach)
+    throw GraphError(internal::Format("config: c = %.6g m is longer than the object reaches from its centre of pressure "
+                                      "(%.3g m); c = tau_max / f_max is a mean distance of the support from that centre, "
+                                      "at most that reach: is it in another unit than metres?",
+                                      cfg.c, reach));
   g.c = (cfg.c > 0.0 ? cfg.c : s.c) * cfg.c_scale;
   g.centre_of_pressure = s.centre_of_pressure;
   return g;
@@ -371,6 +380,11 @@ EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode 
   std::optional<push::Trajectory> cleaned = internal::DropObjectPoseGlitches(*before_glitches, &glitch_note);
   const push::Trajectory& input = cleaned ? *cleaned : *before_glitches;
   EstimationResult r = EstimateValidated(input, model, mode, config);
+  // A covariance failure was only in RESULT.json's solver.covariance (NEES NaN, nothing said).
+  if (config.covariance && r.solver.covariance_status.find("failed") != std::string::npos)
+    r.warnings.push_back("covariances not computed: " + r.solver.covariance_status +
+                         "; the states are estimated, their sigmas and NEES are not (a noise model far from the data's, "
+                         "such as sigmas or accelerations near zero, makes the information matrix numerically singular)");
   if (cleaned && !r.metrics.empty()) {
     // The raw tracker's errors are the stream as recorded, glitches included.
     for (const auto& [key, value] : ComputeMetrics(*before_glitches, r.states))

@@ -482,6 +482,32 @@ TEST(Estimator, AForceStreamThatStopsHalfwayLeavesTheLoadToSizeTheRest) {
   }
 }
 
+// A configuration in other units or far from the data: a c longer than the object reaches
+// (`{"c": 100}` ran as 100 m) is refused; covariances that fail (accelerations of 1e-12 make the
+// information matrix singular) are said in a warning, not only in RESULT.json's solver status.
+TEST(Estimator, ACAndAFailedCovarianceAreSaid) {
+  const push::Trajectory t = GeneratePush(OffsetPush(3, 0.5));
+  EstimatorConfig c100;
+  c100.c = 100.0;
+  try {
+    Estimate(t, Model::kQs, Mode::kBatch, c100);
+    ADD_FAILURE() << "c = 100 m accepted";
+  } catch (const GraphError& e) {
+    EXPECT_NE(std::string(e.what()).find("another unit than metres"), std::string::npos) << e.what();
+  }
+  EstimatorConfig c3;
+  c3.c = 0.03;
+  EXPECT_NO_THROW(Estimate(t, Model::kQs, Mode::kBatch, c3));
+  EstimatorConfig stiff;
+  stiff.accel_trans = 1e-12;
+  stiff.accel_rot = 1e-12;
+  const EstimationResult r = Estimate(t, Model::kQs, Mode::kBatch, stiff);
+  ASSERT_NE(r.solver.covariance_status, "ok");
+  EXPECT_TRUE(HasWarning(r, "covariances not computed")) << r.solver.covariance_status;
+  for (const std::string& w : Estimate(t, Model::kQs, Mode::kBatch).warnings)
+    EXPECT_EQ(w.find("covariances not computed"), std::string::npos) << w;
+}
+
 TEST(Estimator, BadTrajectoriesGetClearErrors) {
   push::Trajectory t = GeneratePush(OffsetPush(1, 0.3));
   auto message = [](const push::Trajectory& tr) {
