@@ -78,7 +78,7 @@ QuasiStaticGeometry QuasiStaticGeometryFor(const push::Trajectory& traj,
   // the pressure), so no pressure makes it longer than the object's reach from that centre: a
   // given c beyond it is another unit (`{"c": 100}` ran as 100 m).
   const double reach = geometry::RadiusAbout(shape, s.centre_of_pressure);
-  if (cfg.c > 1.5 * reach)
+  if (cfg.c > reach * (1.0 + 1e-9))
     throw GraphError(internal::Format("config: c = %.6g m is longer than the object reaches from its centre of pressure "
                                       "(%.3g m); c = tau_max / f_max is a mean distance of the support from that centre, "
                                       "at most that reach: is it in another unit than metres?",

@@ -51,6 +51,20 @@ double NearestGap(const std::vector<Sample>& s, double t, int* index = nullptr) 
 
 }  // namespace
 
+bool ObjectSeenMoving(const std::vector<push::PoseSample>& poses, double sigma, std::size_t* scanned) {
+  if (poses.size() < 10) return false;
+  auto median_at = [&](std::size_t last) {  // of poses[last - 4 .. last]
+    std::vector<double> x, y;
+    for (std::size_t k = last - 4; k <= last; ++k) x.push_back(poses[k].pose.x), y.push_back(poses[k].pose.y);
+    return Vec2(Median(x), Median(y));
+  };
+  const Vec2 start = median_at(4);
+  const double bound = std::max(0.02, 4.0 * sigma);
+  for (std::size_t& i = *scanned; i < poses.size(); ++i)
+    if (i >= 9 && (median_at(i) - start).norm() > bound) return true;
+  return false;
+}
+
 bool ForceSaysTouching(const std::vector<push::ForceSample>& force, double t, double max_gap, double threshold,
                        double sigma) {
   int k = -1;
@@ -170,12 +184,16 @@ int GraphBuilder::AppendSteps(double until) {
   // Contact gating, on the samples received so far (all of them in batch): a finger touches
   // while its nearest contact sample is within contact_max_gap, or, without a contact stream,
   // while its nearest force sample is at least contact_force_threshold, once its force stream
-  // has shown a contact above its noise (ForceSaysTouching) anywhere; with neither, always.
+  // has shown a contact above its noise (ForceSaysTouching) anywhere or the object has been seen
+  // to move (ObjectSeenMoving); with neither stream, always.
   // The sensors are the trajectory's: a finger whose contact stream is empty while another
   // finger's is not never touched (its own force noise must not gate it in).
   force_contact_seen_.resize(num_fingers(), 0);
   force_samples_seen_.resize(num_fingers(), 0);
+  if (!streams_.contact_point && !object_moving_seen_)
+    object_moving_seen_ = ObjectSeenMoving(m.object_pose, cfg_.measurement.object_trans, &object_poses_seen_);
   for (int k = 0; k < num_fingers() && !streams_.contact_point; ++k) {
+    if (object_moving_seen_) force_contact_seen_[k] = 1;
     const auto& force = ForceRows(k);
     for (std::size_t& j = force_samples_seen_[k]; j < force.size() && !force_contact_seen_[k]; ++j)
       force_contact_seen_[k] = ForceSaysTouching(force, force[j].t, cfg_.contact_max_gap, cfg_.contact_force_threshold,

@@ -427,6 +427,8 @@ class GraphBuilder {
   /// above their noise (ForceSaysTouching) anywhere, and the first sample not yet looked at.
   std::vector<char> force_contact_seen_;
   std::vector<std::size_t> force_samples_seen_;
+  bool object_moving_seen_ = false;
+  std::size_t object_poses_seen_ = 0;
   std::unordered_map<ceres::ResidualBlockId, std::pair<FactorType, int>> origin_;  ///< for Describe
   double frame_sigma_centroid_ = 0.01, frame_sigma_theta_ = 0.2;
 };
@@ -502,6 +504,11 @@ double LongObjectGap(const push::Trajectory& trajectory);
 /// RMS (a light touch without a pushing model) and the QS force NEES 3.0 -> 7.7.
 bool ForceSaysTouching(const std::vector<push::ForceSample>& force, double t, double max_gap, double threshold,
                        double sigma);
+/// Whether the object is seen to move: the median position of five consecutive poses more than
+/// max(2 cm, 4 sigma) from that of the first five. Scans from *scanned (updated) so a growing
+/// stream costs its new samples only. Something moved it, so a force stream under its noise
+/// (a 50 g object pushed with 0.5 N noise) does not make the finger "never touching".
+bool ObjectSeenMoving(const std::vector<push::PoseSample>& poses, double sigma, std::size_t* scanned);
 /// The finger count (at most two) and every finger's shape; ValidateTrajectory's first checks.
 void ValidateFingers(const push::Trajectory& trajectory);
 /// The 95th percentile of `values` (non-empty).

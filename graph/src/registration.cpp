@@ -155,7 +155,9 @@ ContactPath PathOf(const push::Trajectory& traj, const std::vector<push::PoseSam
     const FingerDisk disk = FingerAsDisk(finger == 0 ? traj.finger.shape : traj.extra_fingers[finger - 1].finger.shape);
     // A force stream that never shows a contact above its noise: the finger never touched (as the
     // graph takes it; its noise crossing the threshold had a passing finger's path fitted).
+    std::size_t scanned = 0;
     if (contact.empty() && !any_contact_rows && !force.empty() &&
+        !internal::ObjectSeenMoving(traj.measured.object_pose, o.pose_sigma_trans, &scanned) &&
         std::none_of(force.begin(), force.end(), [&](const push::ForceSample& s) {
           return internal::ForceSaysTouching(force, s.t, o.contact_max_gap, o.contact_force_threshold, o.contact_force_sigma);
         }))

@@ -488,7 +488,16 @@ std::vector<bool> PoseGlitches(const std::vector<push::PoseSample>& s, const cha
   const std::vector<double>& position_gap = gaps.position;
   const std::vector<double>& angle_gap = gaps.angle;
   const double half = gaps.half;
-  const double bound_p = std::max(floor, 10.0 * gaps.Scatter(position_gap));
+  // A centred median cuts a sharp turn of the path by up to about v h / 2 (a finger's U-turn at
+  // 0.5 m/s: 22 mm, three true samples dropped), so the floor grows with the stream's fast
+  // motion: v the 95th percentile of its speed over the window's width.
+  std::vector<double> speeds;
+  for (std::size_t i = 0, j = 0; i < n; ++i) {
+    while (j + 1 < n && s[j].t - s[i].t < 2.0 * gaps.half) ++j;
+    if (s[j].t - s[i].t >= gaps.half) speeds.push_back((s[j].pose.translation() - s[i].pose.translation()).norm() / (s[j].t - s[i].t));
+  }
+  const double fast = speeds.empty() ? 0.0 : Percentile95(speeds);
+  const double bound_p = std::max({floor, fast * gaps.half, 10.0 * gaps.Scatter(position_gap)});
   const double bound_a = std::max(0.3, 10.0 * gaps.Scatter(angle_gap));
   std::vector<bool> glitch(n);
   std::vector<double> end_position(n, 0.0), end_angle(n, 0.0);
@@ -598,6 +607,10 @@ std::optional<std::string> ShapeSizeNote(const push::Trajectory& traj) {
   // metres): a shape file alone in millimetres against positions in metres (about 1e-3 sizes) is
   // the shape check's case, which finds its units.
   if (NearestFingerRatio(traj) < 0.02) return std::nullopt;
+  // And a finger of the same scale: a probe read in centimetres reaches 0.1 "m" or more (a 2.4 m
+  // box pushed by a 5 cm finger in metres was asked to divide by 100).
+  const geometry::Shape& finger = traj.finger.shape;
+  if (finger.empty() || !(geometry::RadiusAbout(finger, geometry::CoreCentroid(finger)) >= 0.1)) return std::nullopt;
   const bool milli = reach > 100.0 * kMaxReach;
   return Format("object: its shape reaches %.4g m from its centroid (%.4g m across) and the finger's radius is %.3g m: is "
                 "the whole file in %s? Trajectory files are in metres (shapes, positions, sigmas): a tabletop object read "
