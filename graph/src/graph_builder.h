@@ -427,6 +427,8 @@ class GraphBuilder {
   /// above their noise (ForceSaysTouching) anywhere, and the first sample not yet looked at.
   std::vector<char> force_contact_seen_;
   std::vector<std::size_t> force_samples_seen_;
+  /// Per finger: the first and last times its force stream showed a contact above its noise.
+  std::vector<double> force_contact_first_, force_contact_last_;
   bool object_moving_seen_ = false;
   std::size_t object_poses_seen_ = 0;
   std::unordered_map<ceres::ResidualBlockId, std::pair<FactorType, int>> origin_;  ///< for Describe

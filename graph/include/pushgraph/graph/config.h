@@ -96,7 +96,8 @@ struct EstimatorConfig {
   // stream, a force of at least contact_force_threshold) lies within contact_max_gap of it; a
   // finger whose force stream never shows a contact above its noise (the median of +-20 ms of
   // samples at least max(contact_force_threshold, 5 force sigmas / sqrt(their count))) never
-  // touches (in the graph and the registration);
+  // touches (in the graph and the registration), unless the object is seen to move, and steps
+  // before its first or after its last such contact (0.1 s to spare) are out of contact;
   // without either stream every step is in contact (the paper's constant-contact assumption).
   double contact_max_gap = 0.05;          ///< s
   double contact_force_threshold = 0.05;  ///< N
