@@ -289,8 +289,10 @@ std::optional<push::Trajectory> DropForceSpikes(const push::Trajectory& traj, st
   return out;
 }
 
+// `unit_doubt`: what the input checks found of its units ("time stamps that read as
+// milliseconds", ...; null: nothing), under which no shape is aligned.
 EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model model, Mode mode,
-                                   const EstimatorConfig& config);
+                                   const EstimatorConfig& config, const char* unit_doubt);
 
 // The longest stretch of the trajectory without an object pose (up to the finger stream's end),
 // when it is a long gap (internal::LongObjectGap): CP and SDF have no pushing model, so nothing
@@ -379,7 +381,12 @@ EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode 
   const push::Trajectory* before_glitches = repaired ? &*repaired : &trajectory;
   std::optional<push::Trajectory> cleaned = internal::DropObjectPoseGlitches(*before_glitches, &glitch_note);
   const push::Trajectory& input = cleaned ? *cleaned : *before_glitches;
-  EstimationResult r = EstimateValidated(input, model, mode, config);
+  const std::optional<std::string> time_unit = internal::TimeUnitNote(trajectory);
+  const std::optional<std::string> length_unit = internal::ShapeSizeNote(trajectory);
+  const char* unit_doubt = time_unit     ? "time stamps that read as milliseconds"
+                           : length_unit ? "lengths that read as centimetres or millimetres"
+                                         : nullptr;
+  EstimationResult r = EstimateValidated(input, model, mode, config, unit_doubt);
   // A covariance failure was only in RESULT.json's solver.covariance (NEES NaN, nothing said).
   if (config.covariance && r.solver.covariance_status.find("failed") != std::string::npos)
     r.warnings.push_back("covariances not computed: " + r.solver.covariance_status +
@@ -394,9 +401,9 @@ EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode 
   // then what the streams say against the physics of a push.
   std::vector<std::string> front;
   auto add = [&front](const std::optional<std::string>& w) { if (w) front.push_back(*w); };
-  add(internal::TimeUnitNote(trajectory));
+  add(time_unit);
   add(internal::YawUnitNote(trajectory));
-  add(internal::ShapeSizeNote(trajectory));
+  add(length_unit);
   if (!note.empty()) front.push_back(note);
   if (!glitch_note.empty()) front.push_back(glitch_note);
   add(internal::ForceDirectionNote(input));
@@ -416,7 +423,7 @@ EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode 
 namespace {
 
 EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model model, Mode mode,
-                                   const EstimatorConfig& config) {
+                                   const EstimatorConfig& config, const char* unit_doubt) {
   using Align = EstimatorConfig::AlignShape;
   // The shape against the recording: the check, then registration where asked or needed.
   ShapeAlignment alignment;
@@ -482,10 +489,7 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
   // --duration 3` written in ms: its true notched block "aligned" by a turn of 46.5 degrees, 9.4 mm
   // against 6.1 as given). Warned, not aligned, under "auto".
   // The same for a file in centimetres or millimetres throughout (ShapeSizeNote): a notched block in
-  // cm was "aligned" by a shift of 7.8 "m".
-  const char* unit_doubt = internal::TimeUnitNote(trajectory)    ? "time stamps that read as milliseconds"
-                           : internal::ShapeSizeNote(trajectory) ? "lengths that read as centimetres or millimetres"
-                                                                 : nullptr;
+  // cm was "aligned" by a shift of 7.8 "m". Both found once, by Estimate's input checks.
   const bool unit_gate = registration && config.align_shape == Align::kAuto && unit_doubt;
   // A misfit or suspicion there is data to place the shape by.
   const bool placeable = (misfit || suspect) && !too_little && !unit_gate;

@@ -27,7 +27,7 @@ void CheckFinite(bool ok, const std::string& stream, std::size_t i) {
 // 1.7e9 s, are fine; their double resolution is 2.4e-7 s), positions within the geometry's
 // +-1e6 m, forces within +-1e9 N (a plausible but wrong force is a sensor fault, DropForceSpikes;
 // one beyond this is a corrupt value).
-constexpr double kMaxTime = 1e11, kMaxForce = 1e9;
+constexpr double kMaxTime = push::kMaxTimeStamp, kMaxForce = 1e9;
 void CheckRange(double t, double value, double bound, const std::string& stream, std::size_t i, const char* what) {
   if (std::abs(t) > kMaxTime || std::abs(value) > bound) {
     std::ostringstream text;
@@ -104,8 +104,8 @@ void CheckSorted(const std::vector<Sample>& s, const std::string& stream, bool r
 // kClockJumpPeriods median periods). The estimator's states follow the clock, so such a gap
 // (a corrupted time stamp 1e9 s ahead) would cost memory and time in proportion to the gap, not
 // to the samples; it is refused with the stream and the sample.
-constexpr double kClockJumpSeconds = 10.0;
-constexpr double kClockJumpPeriods = 1000.0;
+using push::kClockJumpPeriods;
+using push::kClockJumpSeconds;
 
 template <class Sample>
 double MedianPeriod(const std::vector<Sample>& s) {

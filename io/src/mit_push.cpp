@@ -264,13 +264,14 @@ void Clean(std::vector<Row>* rows, const std::string& path, const char* name, Mi
   std::vector<double> gaps;
   for (std::size_t i = 1; i < rows->size(); ++i) gaps.push_back((*rows)[i][0] - (*rows)[i - 1][0]);
   std::nth_element(gaps.begin(), gaps.begin() + gaps.size() / 2, gaps.end());
-  const double jump = std::max(10.0, 1000.0 * gaps[gaps.size() / 2]);
+  const double jump = std::max(push::kClockJumpSeconds, push::kClockJumpPeriods * gaps[gaps.size() / 2]);
   for (std::size_t i = 0; i < rows->size(); ++i) {
     const double t = (*rows)[i][0];
     std::ostringstream where;
     where.precision(12);
     where << path << ": dataset '" << name << "' sample " << i << " (in time order): time " << t;
-    if (std::abs(t) > 1e11) throw IoError(where.str() + " s is out of the supported range (|t| <= 1e11 s): a corrupted time stamp?");
+    if (std::abs(t) > push::kMaxTimeStamp)
+      throw IoError(where.str() + " s is out of the supported range (|t| <= 1e11 s): a corrupted time stamp?");
     if (i > 0 && t - (*rows)[i - 1][0] > jump) {
       where << " s follows " << (*rows)[i - 1][0] << " s: a clock jump of more than max(10 s, 1000 median periods) "
             << "(a corrupted time stamp?)";
@@ -341,7 +342,7 @@ MitRecording ReadMitPush(const std::string& path, const MitReadOptions& o) {
   // The three sensors record one push: their spans overlap (within the same 10 s).
   for (int a = 0; a < 3; ++a)
     for (int b = 0; b < 3; ++b)
-      if (Slot(raw, b).front()[0] - Slot(raw, a).back()[0] > 10.0) {
+      if (Slot(raw, b).front()[0] - Slot(raw, a).back()[0] > push::kClockJumpSeconds) {
         std::ostringstream o;
         o.precision(12);
         o << path << ": dataset '" << kDatasets[b] << "' starts at " << Slot(raw, b).front()[0] << " s, after '" << kDatasets[a]

@@ -23,6 +23,13 @@
 
 namespace pushgraph::push {
 
+/// Time stamps every reader and the estimator accept: |t| up to kMaxTimeStamp s (epoch time,
+/// about 1.7e9 s, is fine), and no gap within or between streams longer than
+/// max(kClockJumpSeconds, kClockJumpPeriods median periods) (a corrupted stamp, not a recording).
+inline constexpr double kMaxTimeStamp = 1e11;
+inline constexpr double kClockJumpSeconds = 10.0;
+inline constexpr double kClockJumpPeriods = 1000.0;
+
 using geometry::Vec2;
 
 struct PoseSample {
