@@ -489,7 +489,7 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
   // --duration 3` written in ms: its true notched block "aligned" by a turn of 46.5 degrees, 9.4 mm
   // against 6.1 as given). Warned, not aligned, under "auto".
   // The same for a file in centimetres or millimetres throughout (ShapeSizeNote): a notched block in
-  // cm was "aligned" by a shift of 7.8 "m". Both found once, by Estimate's input checks.
+  // cm was "aligned" by a shift of 0.78 "m" (7.8 mm at its true scale). Both found once, by Estimate's input checks.
   const bool unit_gate = registration && config.align_shape == Align::kAuto && unit_doubt;
   // A misfit or suspicion there is data to place the shape by.
   const bool placeable = (misfit || suspect) && !too_little && !unit_gate;

@@ -324,7 +324,7 @@ TEST(Alignment, NothingIsAlignedOnTimeStampsInMilliseconds) {
 
 // A file in centimetres from end to end: shapes, positions and sigmas agree, so the size and
 // units checks pass, but the noise model's scales do not (the default push's notched block in cm
-// was "aligned" by a shift of 7.8 "m"). It is named, and nothing is aligned on it.
+// was "aligned" by a shift of 0.78 "m", 7.8 mm at its true scale). It is named, and nothing is aligned on it.
 TEST(Alignment, AFileInCentimetresThroughoutIsNamedAndNotAlignedOn) {
   push::PushPlan plan = DefaultNoisePlan(0.005, 0.05);
   plan.duration = 3.0;
