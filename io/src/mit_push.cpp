@@ -258,6 +258,9 @@ void Clean(std::vector<Row>* rows, const std::string& path, const char* name, Mi
   const int dropped = static_cast<int>(before - rows->size());
   rec->samples_reordered += reordered;
   rec->duplicates_dropped += dropped;
+  if (rows->size() < 2)  // every time stamp the same (found by fuzz_mit_json: the gap median read past an empty vector)
+    throw IoError(path + ": dataset '" + std::string(name) + "' has " + std::to_string(before) + " samples but " +
+                  std::to_string(rows->size()) + " distinct time stamp (need >= 2)");
   // Time stamps a corrupted file can hold and the estimator refuses (trajectory_checks.cpp's
   // range and clock-jump rules): refused here, naming the row, not written to a trajectory file
   // (a byte flip's 1.28e168 s was, and a 46-year contact phase reported).

@@ -215,6 +215,12 @@ TEST_F(MitPush, BrokenFilesGetClearErrors) {
   for (Row& r : apart[1].second) r[0] += 100.0;
   WriteH5((dir_ / "apart.h5").string(), apart);
   expect_error((dir_ / "apart.h5").string(), "the sensors' clocks do not overlap");
+  // Found by fuzz_mit_json: rows that all share one time stamp left one sample after the
+  // duplicates were dropped, and the clock-jump check read the median of no gaps.
+  auto same_time = sets;
+  for (Row& r : same_time[0].second) r[0] = 1.5;
+  WriteH5((dir_ / "same_time.h5").string(), same_time);
+  expect_error((dir_ / "same_time.h5").string(), "1 distinct time stamp (need >= 2)");
   const std::string garbage = (dir_ / "garbage.h5").string();
   std::ofstream(garbage) << "not hdf5";
   expect_error(garbage, "not an HDF5 file");
