@@ -51,6 +51,12 @@ double NearestGap(const std::vector<Sample>& s, double t, int* index = nullptr) 
 
 }  // namespace
 
+// The object's random walk where the finger is measured at rest (QS): 2 mm and 0.02 rad over a
+// second, a fraction of a tracker's noise; a slow creep under PoseStreamAtRest's bound (10 mm/s)
+// is not held still by more than that.
+constexpr double kRestWalkTrans = 2e-3;  // m / sqrt(s)
+constexpr double kRestWalkRot = 2e-2;    // rad / sqrt(s)
+
 bool ObjectSeenMoving(const std::vector<push::PoseSample>& poses, double sigma, std::size_t* scanned) {
   if (poses.size() < 10) return false;
   auto median_at = [&](std::size_t last) {  // of poses[last - 4 .. last]
@@ -63,6 +69,29 @@ bool ObjectSeenMoving(const std::vector<push::PoseSample>& poses, double sigma, 
   for (std::size_t& i = *scanned; i < poses.size(); ++i)
     if (i >= 9 && (median_at(i) - start).norm() > bound) return true;
   return false;
+}
+
+bool PoseStreamAtRest(const std::vector<push::PoseSample>& poses, double t, double sigma) {
+  // The window: long enough that 5 mm/s moves the stream by its bound below (320 sigma s/m),
+  // from 0.1 s to 2 s (0.16 s under a 0.5 mm tracker, 1.6 s under 5 mm): a slow push is not taken
+  // for rest, and a rest is found only where it lasts longer than the window's half.
+  const double half_window = std::clamp(320.0 * sigma, 0.1, 2.0);
+  const auto a = std::lower_bound(poses.begin(), poses.end(), t - half_window,
+                                  [](const push::PoseSample& p, double tt) { return p.t < tt; });
+  const auto b = std::upper_bound(poses.begin(), poses.end(), t + half_window,
+                                  [](double tt, const push::PoseSample& p) { return tt < p.t; });
+  const std::ptrdiff_t n = b - a;
+  if (n < 4 || (b - 1)->t - a->t < half_window) return false;  // too little to tell (a stream's ends, a gap)
+  const std::ptrdiff_t k = std::min<std::ptrdiff_t>(5, n / 2);  // samples in each end's median
+  auto median_of = [k](auto first) {
+    std::vector<double> x, y;
+    for (std::ptrdiff_t j = 0; j < k; ++j, ++first) x.push_back(first->pose.x), y.push_back(first->pose.y);
+    return Vec2(Median(x), Median(y));
+  };
+  // Two medians of k samples differ by about 1.25 sigma sqrt(2 / k) under Gaussian noise: four
+  // of those, and at least 1 mm.
+  const double bound = std::max(1e-3, 4.0 * 1.25 * sigma * std::sqrt(2.0 / static_cast<double>(k)));
+  return (median_of(b - k) - median_of(a)).norm() < bound;
 }
 
 bool ForceSaysTouching(const std::vector<push::ForceSample>& force, double t, double max_gap, double threshold,
@@ -975,6 +1004,16 @@ void GraphBuilder::AddKinematicFactors(ceres::Problem& problem, int i) {
     }
   } else {
     AddConstantVelocityFactors(problem, i);
+    // QS: the object moves only while the finger pushes it, so where the finger is measured at
+    // rest the object rests too (friction holds it): a tight random walk between its poses. The
+    // constant-velocity factor alone let a resting object wander with its tracker's noise, which
+    // the load factor had held still by accident (s3 of `simulate --seed 3 --duration 3`, the
+    // push ending at 1.1 s, without its force stream: 0.95 mm RMS at rest against 0.3 mm).
+    if (model_ == Model::kQs && i >= 1 && MeasuredAtRest(i) && MeasuredAtRest(i - 1)) {
+      const double dt = s.t - steps_[i - 1].t;
+      Add(problem, FactorType::kZeroVelocity, new RandomWalkFactor(dt, kRestWalkTrans, kRestWalkRot), nullptr,
+          {vars_[i - 1].x, v.x});
+    }
   }
   for (int k = 1; k <= other_fingers_; ++k) AddOtherFingerKinematicFactors(problem, i, k);
 }
@@ -1295,7 +1334,20 @@ void GraphBuilder::AddOneContactQuasiStatic(ceres::Problem& problem, int i, doub
   }
 }
 
+bool GraphBuilder::MeasuredAtRest(int i) const {
+  const auto& m = traj_.measured;
+  if (!m.finger_pose.empty()) return PoseStreamAtRest(m.finger_pose, steps_[i].t, cfg_.measurement.finger_trans);
+  return PoseStreamAtRest(m.object_pose, steps_[i].t, cfg_.measurement.object_trans);
+}
+
 bool GraphBuilder::LoadFactorAt(int i) const {
+  // The load lies on the limit surface only while the object slides. The factor's own gate
+  // (|V'| against eps_velocity) cannot tell rest from the estimate's jitter there (5 to 15 mm/s
+  // on a resting object under a 2 mm tracker): a finger resting against the object after its
+  // push, with no force stream, had its force driven to mu m g (1.13 N RMS against 0 N, NEES
+  // 41). Quasi-statically the object moves only while the finger does: where the finger is
+  // measured at rest (the object, without a finger stream), no load factor.
+  if (MeasuredAtRest(i)) return false;
   if (use_load_factor_) return true;
   // limit_surface_load "auto" with a force stream: where no force sample covers the step (a
   // stream that stops halfway, or a tactile sensor silent while a contact sensor still reports

@@ -250,6 +250,9 @@ class GraphBuilder {
   /// limit_surface_load "auto" at steps no force sample covers (beyond contact_max_gap and 1.5
   /// force periods).
   bool LoadFactorAt(int i) const;
+  /// The finger (the object, without a finger stream) measured at rest around step i
+  /// (PoseStreamAtRest): the object cannot slide there.
+  bool MeasuredAtRest(int i) const;
   /// Makes c a shared variable of every D factor (QS only; the batch solver calls this when
   /// config.estimate_c). c_block() is then non-null once a D factor was added.
   void EnableCEstimation();
@@ -511,6 +514,10 @@ bool ForceSaysTouching(const std::vector<push::ForceSample>& force, double t, do
 /// stream costs its new samples only. Something moved it, so a force stream under its noise
 /// (a 50 g object pushed with 0.5 N noise) does not make the finger "never touching".
 bool ObjectSeenMoving(const std::vector<push::PoseSample>& poses, double sigma, std::size_t* scanned);
+/// The stream's positions within a window of t (+-320 sigma s/m, 0.1 to 2 s; medians of up to five
+/// samples at both ends) move less than their noise allows (at least 1 mm); false where the window
+/// holds too few samples to tell.
+bool PoseStreamAtRest(const std::vector<push::PoseSample>& poses, double t, double sigma);
 /// The finger count (at most two) and every finger's shape; ValidateTrajectory's first checks.
 void ValidateFingers(const push::Trajectory& trajectory);
 /// The 95th percentile of `values` (non-empty).

@@ -482,6 +482,50 @@ TEST(Estimator, AForceStreamThatStopsHalfwayLeavesTheLoadToSizeTheRest) {
   }
 }
 
+// The finger stops and rests against the object (the push ends at about 1.1 s of 3 s), and
+// there is no force stream: the limit-surface load sizes the forces only while the object
+// slides. Its own gate (|V'| against eps_velocity) took the resting estimate's jitter for
+// sliding and drove the forces to mu m g (1.13 N RMS against a true 0 N, NEES 41); where the
+// finger is measured at rest the load is left out and the object held still instead.
+TEST(Estimator, AFingerRestingAfterItsPushLeavesTheForceFree) {
+  push::PushPlan plan;
+  plan.object.shape = geometry::LoadShapeJson(std::string(PUSHGRAPH_SOURCE_DIR) + "/data/shapes/notched_block.json");
+  plan.finger.shape = geometry::Shape::Disk(0.005);
+  plan.object.mass = 0.5;
+  plan.object.mu_surface = 0.3;
+  plan.finger.mu_contact = 0.4;
+  plan.waypoints = push::StraightPushPath(plan, 1.5707963267948966, 0.01, 0.005, 0.05);
+  plan.duration = 3.0;
+  plan.noise = push::DefaultNoise(push::NoiseKind::kGaussian);
+  plan.seed = 3;
+  push::Trajectory traj = push::Simulate(plan).trajectory;
+  traj.measured.force.clear();
+  EstimatorConfig cfg;
+  if (traj.measurement_sigmas) cfg = ApplyMeasurementSigmas(cfg, *traj.measurement_sigmas);
+  const double load = plan.object.mu_surface * plan.object.mass * 9.81;
+  for (Mode mode : {Mode::kBatch, Mode::kIncremental}) {
+    const EstimationResult r = Estimate(traj, Model::kQs, mode, cfg);
+    double at_rest = 0.0;
+    int n = 0;
+    for (const StateEstimate& s : r.states) {
+      Vec2 truth;
+      if (s.t < 1.6 || s.t > 2.6 || !s.force || !push::TruthForceAt(traj.ground_truth->force, s.t, &truth)) continue;
+      at_rest += s.force->norm();
+      ++n;
+      EXPECT_LT(truth.norm(), 1e-9) << "the push was meant to end before t = " << s.t;
+    }
+    ASSERT_GT(n, 100);
+    std::printf("[resting finger, %s] mean |f| at rest %.3f N (mu m g %.3f N), force RMS %.3f N, NEES %.2f; object %.2f mm "
+                "(raw %.2f), NEES %.2f\n",
+                mode == Mode::kBatch ? "batch" : "incremental", at_rest / n, load, r.metrics.at("force_rms"),
+                r.metrics.at("force_nees"), 1e3 * r.metrics.at("object_position_rms"),
+                1e3 * r.metrics.at("measured_object_position_rms"), r.metrics.at("object_pose_nees"));
+    EXPECT_LT(at_rest / n, 0.2 * load);
+    EXPECT_LT(r.metrics.at("force_nees"), 6.0);
+    EXPECT_LT(r.metrics.at("object_position_rms"), 0.3 * r.metrics.at("measured_object_position_rms"));
+  }
+}
+
 // A configuration in other units or far from the data: a c longer than the object reaches
 // (`{"c": 100}` ran as 100 m) is refused; covariances that fail (accelerations of 1e-12 make the
 // information matrix singular) are said in a warning, not only in RESULT.json's solver status.
