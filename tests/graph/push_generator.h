@@ -12,10 +12,13 @@
 #include <pushgraph/geometry/shape.h>
 #include <pushgraph/limit_surface/limit_surface.h>
 #include <pushgraph/limit_surface/support.h>
+#include <pushgraph/push/noise.h>
+#include <pushgraph/push/simulator.h>
 #include <pushgraph/push/trajectory.h>
 
 #include <cmath>
 #include <random>
+#include <string>
 
 namespace pushgraph::graph::testing {
 
@@ -146,6 +149,23 @@ inline push::Trajectory GeneratePush(const PushSpec& s) {
   }
   traj.ground_truth = gt;
   return traj;
+}
+
+/// The simulator's straight push of the project's notched block (0.5 kg, mu 0.3) by a 5 mm disk
+/// (mu 0.4), 5 cm at 5 cm/s from 5 mm away along `angle`, 1 cm off the centroid, with the
+/// simulator's Gaussian noise; `duration` 0 ends it with the path (longer: the finger rests).
+inline push::PushPlan NotchedBlockPushPlan(double angle, unsigned seed, double duration = 0.0) {
+  push::PushPlan plan;
+  plan.object.shape = geometry::LoadShapeJson(std::string(PUSHGRAPH_SOURCE_DIR) + "/data/shapes/notched_block.json");
+  plan.finger.shape = geometry::Shape::Disk(0.005);
+  plan.object.mass = 0.5;
+  plan.object.mu_surface = 0.3;
+  plan.finger.mu_contact = 0.4;
+  plan.waypoints = push::StraightPushPath(plan, angle, 0.01, 0.005, 0.05);
+  plan.duration = duration;
+  plan.noise = push::DefaultNoise(push::NoiseKind::kGaussian);
+  plan.seed = seed;
+  return plan;
 }
 
 }  // namespace pushgraph::graph::testing

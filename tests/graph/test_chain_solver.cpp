@@ -257,16 +257,7 @@ TEST(ChainSolver, SameMinimumAsCeresOnSimulatedPushes) {
   const push::Trajectory square = testing::GeneratePush(spec);
   ExpectSameMinimum(square, Model::kQs, "square, QS");
   ExpectSameMinimum(square, Model::kCp, "square, CP");
-  push::PushPlan plan;
-  plan.object.shape = geometry::LoadShapeJson(std::string(PUSHGRAPH_SOURCE_DIR) + "/data/shapes/notched_block.json");
-  plan.finger.shape = geometry::Shape::Disk(0.005);
-  plan.object.mass = 0.5;
-  plan.object.mu_surface = 0.3;
-  plan.finger.mu_contact = 0.4;
-  plan.waypoints = push::StraightPushPath(plan, 0.7, 0.01, 0.005, 0.05);
-  plan.noise = push::DefaultNoise(push::NoiseKind::kGaussian);
-  plan.seed = 3;
-  ExpectSameMinimum(push::Simulate(plan).trajectory, Model::kQs, "notched block, QS");
+  ExpectSameMinimum(push::Simulate(testing::NotchedBlockPushPlan(0.7, 3)).trajectory, Model::kQs, "notched block, QS");
 }
 
 TEST(ChainSolver, SameMinimumAsCeresOnARealRecording) {

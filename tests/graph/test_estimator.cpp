@@ -488,16 +488,7 @@ TEST(Estimator, AForceStreamThatStopsHalfwayLeavesTheLoadToSizeTheRest) {
 // sliding and drove the forces to mu m g (1.13 N RMS against a true 0 N, NEES 41); where the
 // finger is measured at rest the load is left out and the object held still instead.
 TEST(Estimator, AFingerRestingAfterItsPushLeavesTheForceFree) {
-  push::PushPlan plan;
-  plan.object.shape = geometry::LoadShapeJson(std::string(PUSHGRAPH_SOURCE_DIR) + "/data/shapes/notched_block.json");
-  plan.finger.shape = geometry::Shape::Disk(0.005);
-  plan.object.mass = 0.5;
-  plan.object.mu_surface = 0.3;
-  plan.finger.mu_contact = 0.4;
-  plan.waypoints = push::StraightPushPath(plan, 1.5707963267948966, 0.01, 0.005, 0.05);
-  plan.duration = 3.0;
-  plan.noise = push::DefaultNoise(push::NoiseKind::kGaussian);
-  plan.seed = 3;
+  const push::PushPlan plan = testing::NotchedBlockPushPlan(1.5707963267948966, 3, /*duration=*/3.0);
   push::Trajectory traj = push::Simulate(plan).trajectory;
   traj.measured.force.clear();
   EstimatorConfig cfg;
