@@ -14,6 +14,7 @@
 #include "minkowski_obstacle.h"
 #include "rounded_boundary.h"
 #include "shape_pair_witness.h"
+#include "exact.h"
 #include "shape_impl.h"
 
 #include <Eigen/LU>
@@ -421,9 +422,20 @@ ShapePairResult ShapePairQuerier::Impl::QuerySampled(const Pose2& object_pose, c
     if (w.sd < best.sd) best = w, best_inside = inside;
   }
   ShapePairResult r;
+  // A vertex on the other's boundary and none inside: edges that lie along each other (two
+  // squares side by side, shifted along a common edge) overlap with no vertex inside, and
+  // touching ones do not; only the exact path can tell (the sampled answer said "apart" for
+  // squares overlapping by half their area).
+  // Rounding puts such a vertex just inside or outside (1e-18 m deep under a turn, the overlap
+  // 0.05 m): within 1e-12 of the shapes' size the sampled answer is a guess either way.
+  double size = Between(object_pose, finger_pose).translation().norm();
+  for (const Vec2& f : finger.impl().vertices) size = std::max(size, f.norm());
+  for (const Vec2& o : object.impl().vertices) size = std::max(size, o.norm());
+  if (std::abs(best.sd) <= 1e-12 * size) return QueryExact(object_pose, finger_pose, J);
   if (best.sd > 0.0) {
     // Cores may still cross with no vertex inside (two thin bars in a cross): the sampled
-    // answer would be wrong, so such configurations take the exact path.
+    // answer would be wrong, so such configurations take the exact path (exact orientations of
+    // the transformed vertices).
     const Shape::Impl& fi = finger.impl();
     const Shape::Impl& oi = object.impl();
     const Pose2 rel = Between(object_pose, finger_pose);
@@ -434,10 +446,9 @@ ShapePairResult ShapePairQuerier::Impl::QuerySampled(const Pose2& object_pose, c
       for (int k : nearby) {
         const Vec2& u = oi.vertices[oi.edges[k]];
         const Vec2& v = oi.vertices[oi.next[oi.edges[k]]];
-        const auto side = [](const Vec2& p, const Vec2& q, const Vec2& x) {
-          return (q - p).x() * (x - p).y() - (q - p).y() * (x - p).x();
-        };
-        if (side(a, b, u) * side(a, b, v) < 0 && side(u, v, a) * side(u, v, b) < 0) return QueryExact(object_pose, finger_pose, J);
+        if (exact::OrientationSign(a, b, u) * exact::OrientationSign(a, b, v) < 0 &&
+            exact::OrientationSign(u, v, a) * exact::OrientationSign(u, v, b) < 0)
+          return QueryExact(object_pose, finger_pose, J);
       }
     }
   }

@@ -477,6 +477,32 @@ TEST(ShapePairPolygon, VertexSamplingErrorIsBoundedAndReported) {
   ::testing::Test::RecordProperty("vertex_sampling_mean_error", std::to_string(overlaps ? sum_err / overlaps : 0.0));
 }
 
+// Two squares whose edges lie along each other: every vertex of each is on the other's boundary
+// or outside, none inside, yet they overlap (the fast path said "apart", signed distance 0, for
+// squares overlapping by half: `pushgraph penetration sq.json sq.json --finger-pose 0.05,0,0
+// --fast`). Side by side they only touch.
+TEST(ShapePairPolygon, VertexSamplingSeesSquaresOverlappingAlongTheirEdges) {
+  const Shape square = Shape::FromPolygons({Polygon{{{0, 0}, {0.1, 0}, {0.1, 0.1}, {0, 0.1}}, {}}});
+  ShapePairQuerier::Options vs;
+  vs.method = ShapePairQuerier::Method::kVertexSampling;
+  const ShapePairQuerier exact(square, square), fast(square, square, vs);
+  for (double turn : {0.0, 0.3, -1.2}) {
+    const Pose2 object{0.01, -0.02, turn};
+    for (const Vec2& shift : {Vec2(0.05, 0.0), Vec2(0.0, 0.05), Vec2(0.0, 0.0), Vec2(0.1, 0.0), Vec2(0.1, 0.1),
+                              Vec2(0.02, 0.1)}) {
+      const Pose2 finger = Compose(object, Pose2{shift.x(), shift.y(), 0.0});
+      const ShapePairResult e = exact.Query(object, finger), f = fast.Query(object, finger);
+      const std::string ctx = "turn " + std::to_string(turn) + ", shift (" + std::to_string(shift.x()) + ", " +
+                              std::to_string(shift.y()) + ")";
+      // Turned, the side-by-side squares' rounded vertices may overlap by 1e-17: the exact path's
+      // answer on those coordinates, which the fast one must give too.
+      EXPECT_EQ(f.intersecting, e.intersecting) << ctx;
+      EXPECT_NEAR(f.signed_distance, e.signed_distance, 1e-12) << ctx;
+      if (std::abs(shift.x()) + std::abs(shift.y()) < 0.1 - 1e-9) EXPECT_NEAR(e.depth, 0.1 - shift.norm(), 1e-12) << ctx;
+    }
+  }
+}
+
 TEST(ShapePairPolygon, VertexSamplingIsExactForDiskFingers) {
   std::mt19937_64 rng(706);
   ShapePairQuerier::Options vs;
