@@ -402,6 +402,7 @@ EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode 
   std::vector<std::string> front;
   auto add = [&front](const std::optional<std::string>& w) { if (w) front.push_back(*w); };
   add(time_unit);
+  add(internal::StreamOverlapNote(trajectory));
   add(internal::YawUnitNote(trajectory));
   add(length_unit);
   if (!note.empty()) front.push_back(note);

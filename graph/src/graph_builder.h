@@ -471,6 +471,9 @@ void ValidateTrajectory(const push::Trajectory& trajectory);
 /// sensor in milliseconds reads 4 s apart, and the noise model's per-second scales then no longer
 /// fit the data. Empty otherwise.
 std::optional<std::string> TimeUnitNote(const push::Trajectory& trajectory);
+/// Two of the trajectory's streams whose time spans do not overlap at all (a clock offset, a
+/// stream from another recording), named with their spans.
+std::optional<std::string> StreamOverlapNote(const push::Trajectory& trajectory);
 /// A warning when the measured force does negative work on the object over the samples where it
 /// is above a quarter of its 95th percentile (f . v summed, v the finger's velocity over +-0.1 s):
 /// a quasi-static push takes positive work from the finger, so such a stream has its sign flipped

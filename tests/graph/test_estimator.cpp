@@ -211,6 +211,27 @@ TEST(Estimator, AForceThatDoesNegativeWorkIsNamed) {
 
 // Forces 1000 times the object's friction load (millinewtons), or a mass 1000 times too large
 // against them (grams), are named with the load.
+// Streams of one push that share no time (the finger, contact and force streams shifted by 2 s
+// against the object's ran with no word, object 3.4 mm against 1.35 aligned) are named; streams
+// that overlap in part (a tracker that starts late) are not.
+TEST(Estimator, StreamsThatShareNoTimeAreNamed) {
+  const push::Trajectory good = GeneratePush(OffsetPush(3, 0.5));
+  EXPECT_FALSE(HasWarning(Estimate(good, Model::kCp, Mode::kBatch), "share no time"));
+  push::Trajectory late = good;
+  late.measured.object_pose.erase(late.measured.object_pose.begin(), late.measured.object_pose.begin() +
+                                                                          late.measured.object_pose.size() / 2);
+  EXPECT_FALSE(HasWarning(Estimate(late, Model::kCp, Mode::kBatch), "share no time"));
+  push::Trajectory shifted = good;
+  const double span = good.measured.object_pose.back().t - good.measured.object_pose.front().t;
+  for (auto& s : shifted.measured.finger_pose) s.t += span + 0.5;
+  for (auto& s : shifted.measured.contact_point) s.t += span + 0.5;
+  for (auto& s : shifted.measured.force) s.t += span + 0.5;
+  shifted.ground_truth.reset();
+  const EstimationResult r = Estimate(shifted, Model::kCp, Mode::kBatch);
+  EXPECT_TRUE(HasWarning(r, "streams: object_pose (")) << (r.warnings.empty() ? "" : r.warnings[0]);
+  EXPECT_TRUE(HasWarning(r, "share no time"));
+}
+
 TEST(Estimator, ForcesOrAMassInAnotherUnitAreNamed) {
   const push::Trajectory good = GeneratePush(OffsetPush(3, 0.5));
   const EstimationResult plain = Estimate(good, Model::kCp, Mode::kBatch);
