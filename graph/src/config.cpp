@@ -292,7 +292,12 @@ void ValidateConfig(const EstimatorConfig& cfg) {
     throw GraphError("config key 'incremental_window_steps' must be >= 3 (0: unset)");
   }
   if (cfg.incremental_window < cfg.incremental_update_every) {
-    throw GraphError("config: incremental_window must be >= incremental_update_every");
+    // Name both values: the user may have set only one (incremental_window 2 against the default
+    // update every 5 was refused naming a key that was not in the file).
+    throw GraphError("config: incremental_window (" + std::to_string(cfg.incremental_window) +
+                     " object periods) must be >= incremental_update_every (" + std::to_string(cfg.incremental_update_every) +
+                     "; its default is 5): the window must hold the samples of one update; lower incremental_update_every "
+                     "with it");
   }
 }
 

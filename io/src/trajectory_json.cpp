@@ -58,6 +58,16 @@ class Reader {
     return v;
   }
 
+  // A friction coefficient: [0, 10], the command line's range (mu_surface 50 in a file ran, the
+  // forces of a push without a force stream sized by it to 157 N against a true 1.5 N).
+  double Friction(const json& value, const std::string& path) const {
+    const double v = NonNegative(value, path);
+    if (v > 10.0)
+      Fail(path, "must be at most 10 (a friction coefficient: rubber on rubber is about 1; the command line's --mu "
+                 "takes [0, 10]), got " + Text(v));
+    return v;
+  }
+
   static std::string Text(double v) {
     std::ostringstream o;
     o << v;
@@ -294,7 +304,7 @@ Trajectory ParseTrajectoryJson(const std::string& text, const std::string& sourc
   t.object.shape = r.ShapeOf(r.Require(object, "shape", "object"), "object.shape");
   t.object.mass = r.Number(r.Require(object, "mass", "object"), "object.mass");
   if (!(t.object.mass > 0.0)) r.Fail("object.mass", "must be > 0 (kg), got " + r.Text(t.object.mass));
-  t.object.mu_surface = r.NonNegative(r.Require(object, "mu_surface", "object"), "object.mu_surface");
+  t.object.mu_surface = r.Friction(r.Require(object, "mu_surface", "object"), "object.mu_surface");
   if (object.contains("pressure")) {
     if (!object["pressure"].is_string() || object["pressure"].get<std::string>() != "uniform")
       r.Fail("object.pressure", "only \"uniform\" is supported in trajectory files, got " + object["pressure"].dump());
@@ -308,7 +318,7 @@ Trajectory ParseTrajectoryJson(const std::string& text, const std::string& sourc
     r.CheckKeys(finger, {"shape", "mu_contact"}, path);
     push::FingerDescription f;
     f.shape = r.ShapeOf(r.Require(finger, "shape", path), path + ".shape");
-    f.mu_contact = r.NonNegative(r.Require(finger, "mu_contact", path), path + ".mu_contact");
+    f.mu_contact = r.Friction(r.Require(finger, "mu_contact", path), path + ".mu_contact");
     return f;
   };
   if (doc.contains("finger")) {

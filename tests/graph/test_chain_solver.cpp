@@ -473,6 +473,16 @@ TEST(ChainSolver, ConfigIntegersOutOfRangeAreErrors) {
       }
     }
   }
+  // A window shorter than the default update interval names both values (it named only the key
+  // the user had not set).
+  try {
+    ParseEstimatorConfig(R"({"incremental_window": 2})", "cfg.json");
+    ADD_FAILURE() << "incremental_window 2 accepted";
+  } catch (const GraphError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("incremental_window (2 object periods) must be >= incremental_update_every (5;"), std::string::npos)
+        << what;
+  }
 }
 
 }  // namespace

@@ -317,7 +317,7 @@ TEST(Estimator, AYawInDegreesIsNamed) {
 }
 
 // Measurement sigmas far beyond the values their stream takes (1000 m for a 5 cm push) leave
-// its samples no weight and are named; so is an object seen once.
+// its samples no weight and are named; so are an object and a finger seen once.
 TEST(Estimator, SigmasBeyondTheDataAndASingleObjectSampleAreNamed) {
   const push::Trajectory good = GeneratePush(OffsetPush(3, 0.5));
   EXPECT_FALSE(HasWarning(Estimate(good, Model::kCp, Mode::kBatch), "measurement sigmas:"));
@@ -330,6 +330,10 @@ TEST(Estimator, SigmasBeyondTheDataAndASingleObjectSampleAreNamed) {
   once.measured.object_pose.resize(1);
   EXPECT_TRUE(HasWarning(Estimate(once, Model::kQs, Mode::kBatch), "object_pose: only 1 sample: "));
   EXPECT_FALSE(HasWarning(Estimate(good, Model::kQs, Mode::kBatch), "object_pose: only"));
+  push::Trajectory finger_once = good;
+  finger_once.measured.finger_pose.resize(1);
+  EXPECT_TRUE(HasWarning(Estimate(finger_once, Model::kQs, Mode::kBatch), "finger_pose: only 1 sample: "));
+  EXPECT_FALSE(HasWarning(Estimate(good, Model::kQs, Mode::kBatch), "finger_pose: only"));
 }
 
 // Joint estimation of c: started 40% too high, the estimate moves towards the value of the

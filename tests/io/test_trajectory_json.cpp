@@ -189,6 +189,13 @@ TEST(TrajectoryJson, SeveralFingersBadInputNamesRowAndFinger) {
   ExpectError(R"({"format": "pushgraph-trajectory-1", "object": {"shape": )" + kShape +
                   R"(, "mass": 1, "mu_surface": 0.25}, "fingers": [{"shape": )" + kFinger + R"(, "mu_contact": -1}]})",
               "fingers[0].mu_contact");
+  // Friction coefficients beyond the command line's [0, 10] (mu_surface 50 ran, forces of 157 N).
+  ExpectError(R"({"format": "pushgraph-trajectory-1", "object": {"shape": )" + kShape +
+                  R"(, "mass": 1, "mu_surface": 50}, "fingers": [{"shape": )" + kFinger + R"(, "mu_contact": 0.3}]})",
+              "object.mu_surface: must be at most 10");
+  ExpectError(R"({"format": "pushgraph-trajectory-1", "object": {"shape": )" + kShape +
+                  R"(, "mass": 1, "mu_surface": 0.3}, "fingers": [{"shape": )" + kFinger + R"(, "mu_contact": 11}]})",
+              "fingers[0].mu_contact: must be at most 10");
   // A single finger's contact_point may repeat a time (a finger wedged in a notch); other
   // streams may not.
   EXPECT_EQ(ParseTrajectoryJson(Doc(R"({"contact_point": [[0.1, 0, 0], [0.1, 1, 0]]})")).measured.contact_point.size(), 2u);
