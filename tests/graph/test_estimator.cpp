@@ -232,6 +232,26 @@ TEST(Estimator, StreamsThatShareNoTimeAreNamed) {
   EXPECT_TRUE(HasWarning(r, "share no time"));
 }
 
+// Model noise scales 100 times or more from their defaults are named (quasi_static_sigma 1e-4
+// ran to an object 30 mm off against 7.3 raw, the diagnostics blaming the sensors); 10 times is
+// not.
+TEST(Estimator, NoiseScalesFarFromTheirDefaultsAreNamed) {
+  const push::Trajectory good = GeneratePush(OffsetPush(3, 0.5));
+  EXPECT_FALSE(HasWarning(Estimate(good, Model::kQs, Mode::kBatch), "config:"));
+  EstimatorConfig near;
+  near.quasi_static_sigma *= 10.0;
+  near.accel_trans /= 10.0;
+  EXPECT_FALSE(HasWarning(Estimate(good, Model::kQs, Mode::kBatch, near), "config:"));
+  EstimatorConfig stiff;
+  stiff.quasi_static_sigma = 1e-4;
+  stiff.accel_rot = 1000.0;
+  const EstimationResult r = Estimate(good, Model::kQs, Mode::kBatch, stiff);
+  ASSERT_FALSE(r.warnings.empty());
+  EXPECT_EQ(r.warnings[0].rfind("config: ", 0), 0u) << r.warnings[0];
+  EXPECT_NE(r.warnings[0].find("quasi_static_sigma 0.0001 (0.000333 times its default 0.3)"), std::string::npos) << r.warnings[0];
+  EXPECT_NE(r.warnings[0].find("accel_rot 1e+03 (200 times its default 5)"), std::string::npos) << r.warnings[0];
+}
+
 TEST(Estimator, ForcesOrAMassInAnotherUnitAreNamed) {
   const push::Trajectory good = GeneratePush(OffsetPush(3, 0.5));
   const EstimationResult plain = Estimate(good, Model::kCp, Mode::kBatch);
