@@ -53,6 +53,11 @@ double SecondsSince(Clock::time_point t) { return std::chrono::duration<double>(
 constexpr double kMinRelativeDecrease = 1e-3;
 constexpr double kMinDiagonal = 1e-6, kMaxDiagonal = 1e32;
 
+// A step accepted under this much damping (relative to diag(J^T J)) is a gradient step of a
+// vanishing size: its small change says the solver is stuck (a residual that jumps next to the
+// current point rejects every real step), not that it converged.
+constexpr double kStallDamping = 1e3;
+
 // weight * Ja^T Jb into the lower triangle, sizes known at compile time where M, R, C > 0 (the
 // loops then unroll: the accumulation was a fifth of a QS batch solve with run-time sizes). The
 // same products in the same order either way, so the same sums.
@@ -105,6 +110,12 @@ ChainSolver::Impl::PairKernel KernelFor(int m, int rows, int cols, bool diagonal
   }
   if (k != nullptr) return k;
   return diagonal ? &AccumulatePair<0, 0, 0, true> : &AccumulatePair<0, 0, 0, false>;
+}
+
+std::string FormatNumber(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", v);
+  return text;
 }
 
 std::string DefaultDescription(int index, const ChainSolver::Impl::Residual& r) {
@@ -425,6 +436,43 @@ Eigen::VectorXd ChainSolver::Impl::SolveIteration(const Eigen::VectorXd& rhs) {
   return x;
 }
 
+std::string ChainSolver::Impl::LargestJump(const ChainSolverOptions& options, const Eigen::VectorXd& x,
+                                           const Eigen::VectorXd& near) {
+  // Each residual block's cost at the solution and at the last rejected point next to it.
+  auto block_costs = [this](const Eigen::VectorXd& at, std::vector<double>* costs) {
+    Scatter(at);
+    costs->assign(residuals.size(), 0.0);
+    std::vector<double> r;
+    for (std::size_t k = 0; k < residuals.size(); ++k) {
+      const Residual& b = residuals[k];
+      if (b.constant) continue;
+      r.resize(b.m);
+      if (!b.cost->Evaluate(param_ptrs.data() + b.param_begin, r.data(), nullptr)) {
+        (*costs)[k] = INFINITY;
+        continue;
+      }
+      double sq = 0.0;
+      for (double v : r) sq += v * v;
+      if (b.loss != nullptr) {
+        double rho[3];
+        b.loss->Evaluate(sq, rho);
+        sq = rho[0];
+      }
+      (*costs)[k] = 0.5 * sq;
+    }
+  };
+  std::vector<double> here, there;
+  block_costs(near, &there);
+  block_costs(x, &here);
+  int worst = -1;
+  for (std::size_t k = 0; k < residuals.size(); ++k)
+    if (!residuals[k].constant && (worst < 0 || there[k] - here[k] > there[worst] - here[worst])) worst = static_cast<int>(k);
+  if (worst < 0) return "no residual to name";
+  return "the largest jump, " + FormatNumber(here[worst]) + " to " + FormatNumber(there[worst]) + " for a step of " +
+         FormatNumber((near - x).norm()) + ": " + Describe(options, worst) +
+         " (a residual not smooth there: a contact feature that switches, a shape corner)";
+}
+
 ChainSolver::ChainSolver(ceres::Problem& problem) : impl_(std::make_unique<Impl>(problem)) {}
 ChainSolver::~ChainSolver() = default;
 ChainSolver::ChainSolver(ChainSolver&&) noexcept = default;
@@ -442,7 +490,7 @@ ChainSolverSummary ChainSolver::Solve(const ChainSolverOptions& options) {
     summary.termination = "no variable parameter blocks";
     return summary;
   }
-  Eigen::VectorXd x, x_trial, step;
+  Eigen::VectorXd x, x_trial, step, rejected_trial;
   s.Gather(x);
   double cost = 0.0;
   int failed = -1;
@@ -534,6 +582,7 @@ ChainSolverSummary ChainSolver::Solve(const ChainSolverOptions& options) {
                    summary.iterations, cost, evaluated ? trial_cost : NAN, model_decrease, rho, lambda, step.norm());
     }
     if (evaluated && rho > kMinRelativeDecrease) {
+      const double lambda_used = lambda;
       ++summary.successful_steps;
       const double change = cost - trial_cost;
       x.swap(x_trial);
@@ -544,7 +593,11 @@ ChainSolverSummary ChainSolver::Solve(const ChainSolverOptions& options) {
       lambda *= std::max(1.0 / 3.0, 1.0 - std::pow(2.0 * rho - 1.0, 3));
       lambda = std::max(lambda, 1e-16);
       nu = 2.0;
-      if (change <= options.function_tolerance * cost) {
+      if (change <= options.function_tolerance * cost && lambda_used >= kStallDamping && rejected_trial.size() == s.n) {
+        summary.termination = "stalled: every step but vanishing ones raised the cost (damping " +
+                              FormatNumber(lambda_used) + "); " + s.LargestJump(options, x, rejected_trial);
+        break;
+      } else if (change <= options.function_tolerance * cost) {
         summary.converged = true;
         summary.termination = "function tolerance";
       } else if (gradient_converged(x, s.gradient)) {
@@ -553,12 +606,14 @@ ChainSolverSummary ChainSolver::Solve(const ChainSolverOptions& options) {
       }
     } else {
       ++summary.unsuccessful_steps;
+      if (evaluated) rejected_trial = x_trial;
       s.Scatter(x);
       lambda *= nu;
       nu *= 2.0;
     }
   }
-  if (!summary.converged) summary.termination = "iteration limit (" + std::to_string(options.max_iterations) + ")";
+  if (!summary.converged && summary.termination.empty())
+    summary.termination = "iteration limit (" + std::to_string(options.max_iterations) + ")";
   s.Scatter(x);
   summary.final_cost = cost + fixed_cost;
   summary.total_s = SecondsSince(start);

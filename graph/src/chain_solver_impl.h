@@ -63,6 +63,9 @@ struct ChainSolver::Impl {
   bool FactorizeAtCurrentValues(std::string* error);
   std::string Describe(const ChainSolverOptions& options, int residual) const;
   std::string DescribeUnknown(int unknown) const;
+  // The residual block whose cost rises most from x to `near` (a rejected point next to it),
+  // described; leaves the blocks at x.
+  std::string LargestJump(const ChainSolverOptions& options, const Eigen::VectorXd& x, const Eigen::VectorXd& near);
 
   ceres::Problem* problem = nullptr;
   std::vector<Block> blocks;                          // in the order they were added (time order)

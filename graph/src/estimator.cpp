@@ -162,9 +162,18 @@ EstimationResult EstimateBatch(const push::Trajectory& traj, Model model, const 
     const bool at_limit = summary.termination.find("iteration") != std::string::npos;
     // max_iterations bounds each stage (motion only, contacts, the full model); the result's
     // iterations are their sum.
-    r.warnings.push_back("the batch solve's last stage stopped at its iteration limit (" + std::to_string(cfg.max_iterations) +
-                         " per stage) before converging" + (at_limit ? std::string(" (max_iterations in the config raises it)")
-                                                           : ": " + summary.termination));
+    if (summary.termination.rfind("stalled", 0) == 0) {
+      // The chain solver's stall: a residual that jumps next to the start held every state where
+      // it began (an L-shaped finger's forces stayed at their measurements, force RMS 0.74 N
+      // against 0.73 raw, with no word).
+      r.warnings.push_back("the batch solve's last stage " + summary.termination +
+                           "; the states may be left near their starting values (--mode incremental, or another "
+                           "finger_angle_resolution, may get past it)");
+    } else {
+      r.warnings.push_back("the batch solve's last stage stopped at its iteration limit (" + std::to_string(cfg.max_iterations) +
+                           " per stage) before converging" + (at_limit ? std::string(" (max_iterations in the config raises it)")
+                                                             : ": " + summary.termination));
+    }
   }
   r.solver.updates = 1;
   r.solver.max_update_time_s = r.solver.mean_update_time_s = r.solver.time_s;

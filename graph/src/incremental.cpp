@@ -120,6 +120,7 @@ struct FixedLagSmoother {
   double total_update_time = 0.0;
   double last_cost = 0.0;
   bool window_converged = true;  // the last window solve met a tolerance (not its iteration cap)
+  std::string window_termination;  // and why it stopped
   // In the order the steps were marginalized; a deque: appending never moves the older ones (a
   // vector's doubling at 32768 steps moved them all in one update: 4.3 ms).
   std::deque<StepConditional> conditionals;
@@ -395,6 +396,7 @@ struct FixedLagSmoother {
     stats.iterations += summary.iterations;
     last_cost = summary.final_cost;
     window_converged = summary.converged;
+    window_termination = summary.termination;
     // States leaving the window (keep at least three steps for the V factors).
     std::vector<int> leaving;
     const double t_now = builder.steps()[next_step - 1].t;
@@ -441,6 +443,7 @@ struct FixedLagSmoother {
       stats.iterations += summary.iterations;
       last_cost = summary.final_cost;
       window_converged = summary.converged;
+      window_termination = summary.termination;
       chain = std::move(summary.chain);
     }
     Record(rest, chain.get());
@@ -464,7 +467,10 @@ struct FixedLagSmoother {
     r.solver.mean_update_time_s = stats.updates > 0 ? update_sum / stats.updates : 0.0;
     builder.DropUnobservableForces(r);
     r.metrics = ComputeMetrics(traj, r.states);
-    if (!window_converged) {
+    if (!window_converged && window_termination.rfind("stalled", 0) == 0) {
+      r.warnings.push_back("incremental: the last window's solve " + window_termination +
+                           "; the newest states may be left near their starting values");
+    } else if (!window_converged) {
       r.warnings.push_back("incremental: the last window's solve stopped at incremental_max_iterations (" +
                            std::to_string(cfg.incremental_max_iterations) +
                            ") without meeting its tolerance; the newest states may not be converged");

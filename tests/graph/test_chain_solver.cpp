@@ -13,6 +13,7 @@
 #include "graph/push_generator.h"
 
 #include <ceres/ceres.h>
+#include <ceres/normal_prior.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -190,6 +191,45 @@ TEST(ChainSolver, StepsThatFailToEvaluateAreRejected) {
     EXPECT_GT(x, 0.9);
     EXPECT_GT(s.unsuccessful_steps, 0);
   }
+}
+
+// A residual that jumps right next to the start (a contact feature that switches): every real
+// step raises the cost, and the step finally accepted under a huge damping changes it by nothing.
+// That is a stall, not convergence: said, with the residual that jumps (an L-shaped finger's
+// forces stayed at their measurements and the solve reported "function tolerance").
+class JumpsAboveZero : public ceres::SizedCostFunction<1, 1> {
+ public:
+  bool Evaluate(double const* const* p, double* r, double** J) const override {
+    r[0] = p[0][0] > 1e-9 ? 1000.0 : 0.0;
+    if (J != nullptr && J[0] != nullptr) J[0][0] = 0.0;
+    return true;
+  }
+};
+
+TEST(ChainSolver, AStallIsSaidWithTheResidualThatJumps) {
+  double x = 0.0;
+  ceres::Problem problem;
+  ceres::Matrix a(1, 1);
+  ceres::Vector b(1);
+  a(0, 0) = 10.0;
+  b(0) = 2.0;
+  problem.AddResidualBlock(new ceres::NormalPrior(a, b), nullptr, &x);
+  const ceres::ResidualBlockId jump = problem.AddResidualBlock(new JumpsAboveZero, nullptr, &x);
+  ChainSolverOptions options;
+  options.describe = [&](ceres::ResidualBlockId id) { return id == jump ? std::string("the jump factor") : "the prior"; };
+  ChainSolver solver(problem);
+  const ChainSolverSummary s = solver.Solve(options);
+  EXPECT_FALSE(s.converged);
+  EXPECT_EQ(s.termination.rfind("stalled", 0), 0u) << s.termination;
+  EXPECT_NE(s.termination.find("the jump factor"), std::string::npos) << s.termination;
+  EXPECT_LT(x, 1e-6);
+  // A smooth problem converges as before.
+  double y = 0.0;
+  ceres::Problem smooth;
+  smooth.AddResidualBlock(new ceres::NormalPrior(a, b), nullptr, &y);
+  ChainSolver plain(smooth);
+  EXPECT_TRUE(plain.Solve().converged);
+  EXPECT_NEAR(y, 2.0, 1e-9);
 }
 
 TEST(ChainSolver, NamesTheFactorThatIsNotFiniteAtTheStart) {

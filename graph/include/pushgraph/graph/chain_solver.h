@@ -54,8 +54,12 @@ struct ChainSolverSummary {
   int unsuccessful_steps = 0;
   double initial_cost = 0.0;   ///< 1/2 sum rho(|r|^2)
   double final_cost = 0.0;
-  bool converged = false;      ///< a tolerance was met (else: the iteration limit)
-  std::string termination;     ///< which tolerance, or why it stopped
+  bool converged = false;      ///< a tolerance was met (else: the iteration limit, or a stall)
+  /// Which tolerance, or why it stopped: "iteration limit (N)", or "stalled: ..." when the only
+  /// step accepted came under a damping of 1e3 or more and changed the cost by less than the
+  /// function tolerance (a residual that jumps next to the current point rejects every real
+  /// step; the text names the residual block whose cost rose most on the last rejected step).
+  std::string termination;
   int unknowns = 0;
   long hessian_nonzeros = 0;   ///< stored lower triangle of J^T J
   long factor_nonzeros = 0;    ///< of its Cholesky factor
