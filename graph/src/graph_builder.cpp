@@ -72,10 +72,10 @@ bool ObjectSeenMoving(const std::vector<push::PoseSample>& poses, double sigma, 
 }
 
 bool PoseStreamAtRest(const std::vector<push::PoseSample>& poses, double t, double sigma) {
-  // The window: long enough that 5 mm/s moves the stream by its bound below (320 sigma s/m),
-  // from 0.1 s to 2 s (0.16 s under a 0.5 mm tracker, 1.6 s under 5 mm): a slow push is not taken
+  // The window: long enough that 8 mm/s moves the stream by its bound below (200 sigma s/m),
+  // from 0.1 s to 1 s (0.1 s under a 0.5 mm tracker, 1 s under 5 mm): a slow push is not taken
   // for rest, and a rest is found only where it lasts longer than the window's half.
-  const double half_window = std::clamp(320.0 * sigma, 0.1, 2.0);
+  const double half_window = std::clamp(200.0 * sigma, 0.1, 1.0);
   const auto a = std::lower_bound(poses.begin(), poses.end(), t - half_window,
                                   [](const push::PoseSample& p, double tt) { return p.t < tt; });
   const auto b = std::upper_bound(poses.begin(), poses.end(), t + half_window,

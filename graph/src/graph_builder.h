@@ -517,7 +517,7 @@ bool ForceSaysTouching(const std::vector<push::ForceSample>& force, double t, do
 /// stream costs its new samples only. Something moved it, so a force stream under its noise
 /// (a 50 g object pushed with 0.5 N noise) does not make the finger "never touching".
 bool ObjectSeenMoving(const std::vector<push::PoseSample>& poses, double sigma, std::size_t* scanned);
-/// The stream's positions within a window of t (+-320 sigma s/m, 0.1 to 2 s; medians of up to five
+/// The stream's positions within a window of t (+-200 sigma s/m, 0.1 to 1 s; medians of up to five
 /// samples at both ends) move less than their noise allows (at least 1 mm); false where the window
 /// holds too few samples to tell.
 bool PoseStreamAtRest(const std::vector<push::PoseSample>& poses, double t, double sigma);
