@@ -54,9 +54,12 @@ constexpr double kMinRelativeDecrease = 1e-3;
 constexpr double kMinDiagonal = 1e-6, kMaxDiagonal = 1e32;
 
 // A step accepted under this much damping (relative to diag(J^T J)) is a gradient step of a
-// vanishing size: its small change says the solver is stuck (a residual that jumps next to the
-// current point rejects every real step), not that it converged.
+// vanishing size: its small change says the solver is stuck, not that it converged, when the
+// step rejected before it raised the cost by at least kStallRise (in cost units, and 0.1 % of
+// the cost): a residual that jumps next to the current point. Near a minimum, rounding rejects
+// steps too, but they raise the cost by far less (a flat pusher's push: 0.005).
 constexpr double kStallDamping = 1e3;
+constexpr double kStallRise = 1.0;
 
 // weight * Ja^T Jb into the lower triangle, sizes known at compile time where M, R, C > 0 (the
 // loops then unroll: the accumulation was a fifth of a QS batch solve with run-time sizes). The
@@ -490,7 +493,8 @@ ChainSolverSummary ChainSolver::Solve(const ChainSolverOptions& options) {
     summary.termination = "no variable parameter blocks";
     return summary;
   }
-  Eigen::VectorXd x, x_trial, step, rejected_trial;
+  Eigen::VectorXd x, x_trial, step, rejected_trial;  // the last rejected point, and how much it raised the cost
+  double rejected_rise = 0.0;
   s.Gather(x);
   double cost = 0.0;
   int failed = -1;
@@ -593,7 +597,8 @@ ChainSolverSummary ChainSolver::Solve(const ChainSolverOptions& options) {
       lambda *= std::max(1.0 / 3.0, 1.0 - std::pow(2.0 * rho - 1.0, 3));
       lambda = std::max(lambda, 1e-16);
       nu = 2.0;
-      if (change <= options.function_tolerance * cost && lambda_used >= kStallDamping && rejected_trial.size() == s.n) {
+      if (change <= options.function_tolerance * cost && lambda_used >= kStallDamping && rejected_trial.size() == s.n &&
+          rejected_rise >= std::max(kStallRise, 1e-3 * cost)) {
         summary.termination = "stalled: every step but vanishing ones raised the cost (damping " +
                               FormatNumber(lambda_used) + "); " + s.LargestJump(options, x, rejected_trial);
         break;
@@ -606,7 +611,10 @@ ChainSolverSummary ChainSolver::Solve(const ChainSolverOptions& options) {
       }
     } else {
       ++summary.unsuccessful_steps;
-      if (evaluated) rejected_trial = x_trial;
+      if (evaluated) {
+        rejected_trial = x_trial;
+        rejected_rise = trial_cost - cost;
+      }
       s.Scatter(x);
       lambda *= nu;
       nu *= 2.0;

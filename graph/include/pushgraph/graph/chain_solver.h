@@ -57,8 +57,9 @@ struct ChainSolverSummary {
   bool converged = false;      ///< a tolerance was met (else: the iteration limit, or a stall)
   /// Which tolerance, or why it stopped: "iteration limit (N)", or "stalled: ..." when the only
   /// step accepted came under a damping of 1e3 or more and changed the cost by less than the
-  /// function tolerance (a residual that jumps next to the current point rejects every real
-  /// step; the text names the residual block whose cost rose most on the last rejected step).
+  /// function tolerance while the step rejected before it had raised the cost by 1 or more (and
+  /// 0.1 % of it): a residual that jumps next to the current point; the text names the residual
+  /// block whose cost rose most on that rejected step.
   std::string termination;
   int unknowns = 0;
   long hessian_nonzeros = 0;   ///< stored lower triangle of J^T J
