@@ -97,6 +97,12 @@ void CheckSorted(const std::vector<Sample>& s, const std::string& stream, bool r
       throw GraphError("trajectory: streams." + stream + " is not " + (repeats ? "increasing" : "strictly increasing") +
                        " in time at sample " + std::to_string(i));
     }
+    // As the trajectory reader: less than a nanosecond apart is one time stamp written twice.
+    if (!repeats && s[i].t - s[i - 1].t < 1e-9) {
+      throw GraphError(Format("trajectory: streams.%s samples %zu and %zu are %.3g s apart: less than 1 ns, the same "
+                              "time stamp written twice?",
+                              stream.c_str(), i - 1, i, s[i].t - s[i - 1].t));
+    }
   }
 }
 

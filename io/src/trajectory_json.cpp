@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -173,11 +174,22 @@ class Reader {
     std::vector<Sample> sorted;
     sorted.reserve(rows.size());
     for (std::size_t i = 0; i < order.size(); ++i) {
-      if (!repeats && i > 0 && rows[order[i]].t == rows[order[i - 1]].t) {
+      // Less than a nanosecond apart is the same time stamp too (two rows 1e-12 s apart and 3 cm
+      // different were read as a 30 km/s jump); no sensor samples that fast, and a clock near
+      // 1e9 s (Unix time) cannot even tell such times apart.
+      constexpr double kSameTime = 1e-9;  // s
+      if (!repeats && i > 0 && rows[order[i]].t - rows[order[i - 1]].t < kSameTime) {
         std::ostringstream o;
         o.precision(17);
-        o << "rows [" << row_of[order[i - 1]] << "] and [" << row_of[order[i]] << "]" << whose
-          << " have the same time stamp " << rows[order[i]].t;
+        o << "rows [" << row_of[order[i - 1]] << "] and [" << row_of[order[i]] << "]" << whose;
+        if (rows[order[i]].t == rows[order[i - 1]].t) {
+          o << " have the same time stamp " << rows[order[i]].t;
+        } else {
+          char gap[32];
+          std::snprintf(gap, sizeof gap, "%.3g", rows[order[i]].t - rows[order[i - 1]].t);
+          o << " are " << gap << " s apart (t = " << rows[order[i - 1]].t << " and "
+            << rows[order[i]].t << "): less than 1 ns, the same time stamp written twice?";
+        }
         Fail(path, o.str());
       }
       sorted.push_back(rows[order[i]]);

@@ -250,6 +250,31 @@ TEST(Estimator, NoiseScalesFarFromTheirDefaultsAreNamed) {
   EXPECT_EQ(r.warnings[0].rfind("config: ", 0), 0u) << r.warnings[0];
   EXPECT_NE(r.warnings[0].find("quasi_static_sigma 0.0001 (0.000333 times its default 0.3)"), std::string::npos) << r.warnings[0];
   EXPECT_NE(r.warnings[0].find("accel_rot 1e+03 (200 times its default 5)"), std::string::npos) << r.warnings[0];
+  // A function tolerance that stops the solves early (1e10: one iteration), not a tight one.
+  EstimatorConfig loose;
+  loose.function_tolerance = 1e10;
+  EXPECT_TRUE(HasWarning(Estimate(good, Model::kQs, Mode::kBatch, loose), "config: function_tolerance 1e+10"));
+  EstimatorConfig tight;
+  tight.function_tolerance = 1e-12;
+  EXPECT_FALSE(HasWarning(Estimate(good, Model::kQs, Mode::kBatch, tight), "config:"));
+}
+
+// Samples of one stream less than a nanosecond apart are one time stamp written twice (1e-12 s
+// apart and 3 cm different ran as a 30 km/s jump): refused naming the samples, as the reader does.
+TEST(Estimator, SamplesLessThanANanosecondApartAreRefused) {
+  push::Trajectory t = GeneratePush(OffsetPush(3, 0.5));
+  auto& poses = t.measured.object_pose;
+  push::PoseSample twin = poses[5];
+  twin.t += 1e-12;
+  twin.pose.x += 0.03;
+  poses.insert(poses.begin() + 6, twin);
+  try {
+    Estimate(t, Model::kCp, Mode::kBatch);
+    ADD_FAILURE() << "accepted";
+  } catch (const GraphError& e) {
+    EXPECT_NE(std::string(e.what()).find("streams.object_pose samples 5 and 6 are 1e-12 s apart"), std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(Estimator, ForcesOrAMassInAnotherUnitAreNamed) {

@@ -112,6 +112,12 @@ TEST(TrajectoryJson, BadInputNamesFileAndPath) {
   ExpectError(Doc(R"({"force": [[0.0, 0, 1.0, 0.0]]})"), "with one finger the rows carry no finger index");
   ExpectError(Doc(R"({"force": [[0, 1e999, 2]]})"), "malformed JSON");
   ExpectError(Doc(R"({"force": [[0, 1, 2], [0, 1, 2]]})"), "same time stamp");
+  // Less than a nanosecond apart: the same time stamp too (1e-12 s apart and 3 cm different was
+  // read as a 30 km/s jump); a microsecond apart is two samples.
+  ExpectError(Doc(R"({"object_pose": [[0.5, 0, 0, 0], [0.500000000001, 0.03, 0, 0]]})"),
+              "streams.object_pose: rows [0] and [1] are 1e-12 s apart");
+  ExpectError(Doc(R"({"object_pose": [[0.5, 0, 0, 0], [0.500000000001, 0.03, 0, 0]]})"), "less than 1 ns");
+  EXPECT_EQ(ParseTrajectoryJson(Doc(R"({"object_pose": [[0.5, 0, 0, 0], [0.500001, 0, 0, 0]]})")).measured.object_pose.size(), 2u);
   ExpectError(Doc(R"({"velocity": []})"), "unknown field \"velocity\"");
   std::string bad_format = Doc("{}");
   bad_format.replace(bad_format.find("trajectory-1"), 12, "trajectory-9");
