@@ -348,7 +348,9 @@ TEST(ShapePairPolygon, ExactMatchesMinkowskiOracle) {
           EXPECT_NEAR(q.Query(op, moved(r.depth)).signed_distance, 0.0, 1e-9) << ctx;
           // (Rounded: at a concave corner of the grown obstacle the free region is a wedge that
           // need not contain the direction of the move, so going further can overlap again.)
-          if (rf == 0.0) EXPECT_GT(q.Query(op, moved(r.depth + 1e-6)).signed_distance, 0.0) << ctx;
+          if (rf == 0.0) {
+            EXPECT_GT(q.Query(op, moved(r.depth + 1e-6)).signed_distance, 0.0) << ctx;
+          }
           EXPECT_LT(q.Query(op, moved(r.depth - 1e-6)).signed_distance, 0.0) << ctx;
         }
       }
@@ -498,7 +500,9 @@ TEST(ShapePairPolygon, VertexSamplingSeesSquaresOverlappingAlongTheirEdges) {
       // answer on those coordinates, which the fast one must give too.
       EXPECT_EQ(f.intersecting, e.intersecting) << ctx;
       EXPECT_NEAR(f.signed_distance, e.signed_distance, 1e-12) << ctx;
-      if (std::abs(shift.x()) + std::abs(shift.y()) < 0.1 - 1e-9) EXPECT_NEAR(e.depth, 0.1 - shift.norm(), 1e-12) << ctx;
+      if (std::abs(shift.x()) + std::abs(shift.y()) < 0.1 - 1e-9) {
+        EXPECT_NEAR(e.depth, 0.1 - shift.norm(), 1e-12) << ctx;
+      }
     }
   }
 }
