@@ -599,6 +599,7 @@ ChainSolverSummary ChainSolver::Solve(const ChainSolverOptions& options) {
       nu = 2.0;
       if (change <= options.function_tolerance * cost && lambda_used >= kStallDamping && rejected_trial.size() == s.n &&
           rejected_rise >= std::max(kStallRise, 1e-3 * cost)) {
+        summary.stalled = true;
         summary.termination = "stalled: every step but vanishing ones raised the cost (damping " +
                               FormatNumber(lambda_used) + "); " + s.LargestJump(options, x, rejected_trial);
         break;

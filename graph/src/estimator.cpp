@@ -162,7 +162,7 @@ EstimationResult EstimateBatch(const push::Trajectory& traj, Model model, const 
     const bool at_limit = summary.termination.find("iteration") != std::string::npos;
     // max_iterations bounds each stage (motion only, contacts, the full model); the result's
     // iterations are their sum.
-    if (summary.termination.rfind("stalled", 0) == 0) {
+    if (summary.stalled) {
       // The chain solver's stall: a residual that jumps next to the start held every state where
       // it began (an L-shaped finger's forces stayed at their measurements, force RMS 0.74 N
       // against 0.73 raw, with no word).

@@ -52,7 +52,7 @@ double NearestGap(const std::vector<Sample>& s, double t, int* index = nullptr) 
 }  // namespace
 
 // The object's random walk where the finger is measured at rest (QS): 2 mm and 0.02 rad over a
-// second, a fraction of a tracker's noise; a slow creep under PoseStreamAtRest's bound (10 mm/s)
+// second, a fraction of a tracker's noise; a slow creep under PoseStreamAtRest's bound (8 mm/s)
 // is not held still by more than that.
 constexpr double kRestWalkTrans = 2e-3;  // m / sqrt(s)
 constexpr double kRestWalkRot = 2e-2;    // rad / sqrt(s)
@@ -434,6 +434,7 @@ SolveOutcome GraphBuilder::Solve(ceres::Problem& problem, int max_iterations, do
   out.iterations = summary.iterations;
   out.final_cost = summary.final_cost;
   out.converged = summary.converged;
+  out.stalled = summary.stalled;
   out.termination = summary.termination;
   out.evaluation_s = summary.evaluate_s;
   out.linear_solve_s = summary.linear_solve_s;

@@ -116,6 +116,7 @@ struct SolveOutcome {
   int iterations = 0;
   double final_cost = 0.0;
   bool converged = false;
+  bool stalled = false;  ///< the chain solver's stall (ChainSolverSummary::stalled)
   std::string termination;
   double evaluation_s = 0.0, linear_solve_s = 0.0, factor_flops = 0.0;  ///< chain solver only
   /// The chain solver that ran (its factor serves the covariances); null for Ceres.

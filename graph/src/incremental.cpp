@@ -120,7 +120,8 @@ struct FixedLagSmoother {
   double total_update_time = 0.0;
   double last_cost = 0.0;
   bool window_converged = true;  // the last window solve met a tolerance (not its iteration cap)
-  std::string window_termination;  // and why it stopped
+  bool window_stalled = false;     // or stalled (window_termination says where)
+  std::string window_termination;
   // In the order the steps were marginalized; a deque: appending never moves the older ones (a
   // vector's doubling at 32768 steps moved them all in one update: 4.3 ms).
   std::deque<StepConditional> conditionals;
@@ -396,6 +397,7 @@ struct FixedLagSmoother {
     stats.iterations += summary.iterations;
     last_cost = summary.final_cost;
     window_converged = summary.converged;
+    window_stalled = summary.stalled;
     window_termination = summary.termination;
     // States leaving the window (keep at least three steps for the V factors).
     std::vector<int> leaving;
@@ -443,6 +445,7 @@ struct FixedLagSmoother {
       stats.iterations += summary.iterations;
       last_cost = summary.final_cost;
       window_converged = summary.converged;
+      window_stalled = summary.stalled;
       window_termination = summary.termination;
       chain = std::move(summary.chain);
     }
@@ -467,7 +470,7 @@ struct FixedLagSmoother {
     r.solver.mean_update_time_s = stats.updates > 0 ? update_sum / stats.updates : 0.0;
     builder.DropUnobservableForces(r);
     r.metrics = ComputeMetrics(traj, r.states);
-    if (!window_converged && window_termination.rfind("stalled", 0) == 0) {
+    if (window_stalled) {
       r.warnings.push_back("incremental: the last window's solve " + window_termination +
                            "; the newest states may be left near their starting values");
     } else if (!window_converged) {

@@ -220,6 +220,7 @@ TEST(ChainSolver, AStallIsSaidWithTheResidualThatJumps) {
   ChainSolver solver(problem);
   const ChainSolverSummary s = solver.Solve(options);
   EXPECT_FALSE(s.converged);
+  EXPECT_TRUE(s.stalled);
   EXPECT_EQ(s.termination.rfind("stalled", 0), 0u) << s.termination;
   EXPECT_NE(s.termination.find("the jump factor"), std::string::npos) << s.termination;
   EXPECT_LT(x, 1e-6);

@@ -55,6 +55,7 @@ struct ChainSolverSummary {
   double initial_cost = 0.0;   ///< 1/2 sum rho(|r|^2)
   double final_cost = 0.0;
   bool converged = false;      ///< a tolerance was met (else: the iteration limit, or a stall)
+  bool stalled = false;        ///< stopped by a stall (termination says which residual jumps)
   /// Which tolerance, or why it stopped: "iteration limit (N)", or "stalled: ..." when the only
   /// step accepted came under a damping of 1e3 or more and changed the cost by less than the
   /// function tolerance while the step rejected before it had raised the cost by 1 or more (and
