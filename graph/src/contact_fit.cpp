@@ -1,6 +1,7 @@
 // Contacts of recordings and the helpers of shape registration (contact_fit.h).
 #include "contact_fit.h"
 
+#include <pushgraph/graph/chain_solver.h>
 #include <pushgraph/graph/factors.h>
 
 #include "text.h"
@@ -111,13 +112,11 @@ std::vector<push::PoseSample> Smoothed(const std::vector<push::PoseSample>& in, 
                                                         ConstantVelocitySigma(accel_r, dt1, dt2)),
                              nullptr, &x[3 * i - 6], &x[3 * i - 3], &x[3 * i]);
   }
-  ceres::Solver::Options options;
-  options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-  options.max_num_iterations = 10;
+  // The chain solver (chain_solver.h): the poses are added in time order, so J^T J is banded.
+  ChainSolverOptions options;
+  options.max_iterations = 10;
   options.function_tolerance = 1e-4;
-  options.logging_type = ceres::SILENT;
-  ceres::Solver::Summary summary;
-  ceres::Solve(options, &problem, &summary);
+  ChainSolver(problem).Solve(options);
   std::vector<push::PoseSample> out = in;
   for (int i = 0; i < n; ++i) out[i].pose = {x[3 * i], x[3 * i + 1], x[3 * i + 2]};
   return out;

@@ -318,7 +318,7 @@ class ContactFit {
 bool SamePlacement(const Shape& outline, const std::vector<Vec2>& samples, const Placement& a, const Placement& b,
                    double tolerance);
 /// A pose stream smoothed by the estimator's motion-only prior: pose measurements and the
-/// white-noise-acceleration constant-velocity factor (factors.h), solved with Ceres.
+/// white-noise-acceleration constant-velocity factor (factors.h), solved by the chain solver.
 std::vector<push::PoseSample> Smoothed(const std::vector<push::PoseSample>& in, double sigma_t, double sigma_r,
                                        double accel_t, double accel_r);
 /// The white noise of a pose stream from its own samples (robust second differences).
