@@ -196,7 +196,9 @@ TEST_F(EstimateCli, ForcesWithoutAScaleAreLeftOutWithAWarning) {
   // QS with the load factor (auto: no force stream, mass and mu known): forces reported.
   const pushgraph::testing::ToolRun r = Tool("estimate " + in + " --model qs -o " + out);
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_FALSE(Load(out).contains("warnings"));
+  ASSERT_TRUE(Load(out).contains("warnings"));  // only what sizes the forces
+  ASSERT_EQ(Load(out)["warnings"].size(), 1u) << r.err;
+  EXPECT_NE(r.err.find("no force stream: the qs model infers the forces"), std::string::npos) << r.err;
   EXPECT_TRUE(Load(out)["states"][75].contains("force"));
 }
 

@@ -582,6 +582,11 @@ TEST(Estimator, AFingerRestingAfterItsPushLeavesTheForceFree) {
                 r.metrics.at("force_nees"), 1e3 * r.metrics.at("object_position_rms"),
                 1e3 * r.metrics.at("measured_object_position_rms"), r.metrics.at("object_pose_nees"));
     EXPECT_LT(at_rest / n, 0.2 * load);
+    // What sizes the forces without a force stream is said, with its value.
+    char scale[64];
+    std::snprintf(scale, sizeof scale, "mu_surface x mass x g = %.3g N", load);
+    EXPECT_TRUE(HasWarning(r, "no force stream: the qs model infers the forces")) << r.warnings.size();
+    EXPECT_TRUE(HasWarning(r, scale)) << scale;
     EXPECT_LT(r.metrics.at("force_nees"), 6.0);
     EXPECT_LT(r.metrics.at("object_position_rms"), 0.3 * r.metrics.at("measured_object_position_rms"));
   }
@@ -900,7 +905,8 @@ TEST(Estimator, ForcesWithoutAScaleAreNotReported) {
       EXPECT_EQ(r.metrics.count("force_rms"), 0u);
     }
     const EstimationResult with_load = Estimate(t, Model::kQs, mode);  // auto: the load factor runs
-    EXPECT_TRUE(with_load.warnings.empty());
+    ASSERT_EQ(with_load.warnings.size(), 1u);  // what sizes them
+    EXPECT_NE(with_load.warnings[0].find("no force stream: the qs model infers the forces"), std::string::npos);
     EXPECT_TRUE(with_load.states[50].force.has_value());
     EXPECT_EQ(Estimate(t, Model::kYu, mode).warnings.size(), 1u);  // the baseline has no load factor
   }
