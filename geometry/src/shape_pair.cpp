@@ -93,6 +93,8 @@ struct ShapePairQuerier::Impl {
   Options options;
   bool point_finger = false;
   Vec2 finger_centre{0, 0};
+  // max |f| over the finger's core vertices: no point of its core boundary lies farther from its origin.
+  double finger_reach = 0.0;
   Shape inflated_object;  // point fingers: the object with radius ro + rf
 
   struct CachedObstacle {
@@ -209,7 +211,12 @@ FeatureMotion ShapePairQuerier::Impl::MotionAt(const Vec2& c_contact, double phi
     }
     pairs.push_back(p);
   }
+  // An object vertex touches the finger only within its reach of the finger's origin (a bound
+  // with a margin, so a cheap test that never drops a pair): without it every vertex of a
+  // detailed object was queried against the finger, most of a polygonal finger's solve time.
+  const double reach = (finger_reach + std::abs(rf) + tol) * (1.0 + 1e-9) + tol;
   for (const Vec2& o : oi.vertices) {
+    if ((o - c_contact).squaredNorm() > reach * reach) continue;
     const Vec2 local = R.transpose() * (o - c_contact);
     const PointQuery q = QueryPoint(finger, local);
     if (std::abs(q.signed_distance + rf) > tol || q.feature.kind == BoundaryFeature::Kind::kVertex) continue;
@@ -466,6 +473,7 @@ ShapePairQuerier::ShapePairQuerier(Shape object, Shape finger, Options options) 
   impl_->options = options;
   const Shape::Impl& f = impl_->finger.impl();
   impl_->point_finger = f.edges.empty();
+  for (const Vec2& v : f.vertices) impl_->finger_reach = std::max(impl_->finger_reach, v.norm());
   if (impl_->point_finger) {
     impl_->finger_centre = f.vertices[0];
     impl_->inflated_object = impl_->object.WithRadius(impl_->object.radius() + impl_->finger.radius());

@@ -243,7 +243,7 @@ geometry::Shape LoadMeshArgument(const std::string& path, const std::string& wha
       const geometry::Vec2 centre = disk->polygons()[0].outer[0];
       std::fprintf(stderr,
                    "pushgraph: %s %s: its footprint is a regular %zu-gon, a tessellated cylinder: used as the disk "
-                   "of radius %.4g mm at (%.3f, %.3f) mm it approximates (a polygonal finger solves about 15x "
+                   "of radius %.4g mm at (%.3f, %.3f) mm it approximates (a polygonal finger solves 6 to 13x "
                    "slower; pushgraph footprint %s -o SHAPE.json keeps the polygon)\n",
                    what.c_str(), path.c_str(), shape.polygons()[0].outer.size(), 1e3 * disk->radius(),
                    1e3 * centre.x(), 1e3 * centre.y(), path.c_str());
