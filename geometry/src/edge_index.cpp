@@ -8,9 +8,11 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <mutex>
 #include <numeric>
 
 namespace pushgraph::geometry {
@@ -182,6 +184,18 @@ struct EdgeIndex::Impl {
   std::vector<Sector> sectors;
   void BuildStrips(const std::vector<int>& ring_breaks);
   void NearestEdges(const Vec2& p, std::vector<int>* out) const;
+
+  // The grid is built on the kQueriesBeforeGrid-th query: it costs about a thousand strip-tree
+  // queries, and a shape made for a few queries (a Minkowski obstacle at one relative angle of a
+  // polygonal finger) would pay it for nothing. Until then the strip tree answers (the same
+  // candidates' superset; the choice among them is exact either way).
+  static constexpr int kQueriesBeforeGrid = 256;
+  Box2 bounds;
+  bool grid_pending = false;
+  mutable std::atomic<int> queries{0};
+  mutable std::atomic<bool> grid_ready{false};
+  mutable std::once_flag grid_once;
+  void BuildGrid();
 };
 
 void EdgeIndex::Impl::BuildStrips(const std::vector<int>& ring_breaks) {
@@ -325,7 +339,14 @@ void EdgeIndex::Build(const std::vector<Vec2>& vertices, const std::vector<int>&
   for (int k = 1; k < n; ++k)
     if (next[edges[k - 1]] != edges[k]) ring_breaks.push_back(k);
   m.BuildStrips(ring_breaks);
+  m.bounds = bounds;
+  m.grid_pending = true;
+}
 
+void EdgeIndex::Impl::BuildGrid() {
+  Impl& m = *this;
+  const Box2& bounds = m.bounds;
+  const int n = static_cast<int>(m.a.size());
   // Grid over the bounds plus a margin of a quarter of the size, 2^k x 2^k cells with about 16
   // cells per edge, so that a cell is small against the features and its candidate list short.
   const Vec2 size = bounds.max - bounds.min;
@@ -423,7 +444,18 @@ void EdgeIndex::Build(const std::vector<Vec2>& vertices, const std::vector<int>&
 
 EdgeIndex::Span EdgeIndex::Candidates(const Vec2& p) const {
   const Impl& m = *impl_;
-  if (m.nx == 0) return {m.all_edges.data(), static_cast<int>(m.all_edges.size())};
+  if (!m.grid_pending) return {m.all_edges.data(), static_cast<int>(m.all_edges.size())};
+  thread_local std::vector<int> scratch;
+  if (!m.grid_ready.load(std::memory_order_acquire)) {
+    if (m.queries.fetch_add(1, std::memory_order_relaxed) + 1 < Impl::kQueriesBeforeGrid) {
+      m.NearestEdges(p, &scratch);
+      return {scratch.data(), static_cast<int>(scratch.size())};
+    }
+    std::call_once(m.grid_once, [&m] {
+      const_cast<Impl&>(m).BuildGrid();
+      m.grid_ready.store(true, std::memory_order_release);
+    });
+  }
   const double fx = (p.x() - m.grid.min.x()) * m.inv_cell_x;
   const double fy = (p.y() - m.grid.min.y()) * m.inv_cell_y;
   if (fx >= 0.0 && fy >= 0.0 && fx < m.nx && fy < m.ny) {
@@ -431,7 +463,6 @@ EdgeIndex::Span EdgeIndex::Candidates(const Vec2& p) const {
     if (!m.fallback[cell]) return {m.cell_edges.data() + m.cell_start[cell], m.cell_start[cell + 1] - m.cell_start[cell]};
   }
   // Outside the grid, or in a fallback cell.
-  thread_local std::vector<int> scratch;
   m.NearestEdges(p, &scratch);
   return {scratch.data(), static_cast<int>(scratch.size())};
 }

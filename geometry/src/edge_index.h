@@ -6,7 +6,8 @@
 // some point of the cell: those whose distance to the cell is at most the cell's upper bound on
 // the nearest-edge distance), and a strip tree (chains of edges in chord-aligned rectangles and,
 // where they bend like arcs, annular sectors) searched by branch and bound for points outside the
-// grid and in cells whose lists would be long. A query reads O(log n) nodes plus the features tied
+// grid, in cells whose lists would be long, and for every point until the 256th query builds the
+// grid (a shape queried a few times, a Minkowski obstacle at one angle, never pays for it). A query reads O(log n) nodes plus the features tied
 // with the nearest to within rounding. A Boost.Geometry R-tree answers box queries (validation).
 // Candidate lists are filters only; the final choice among candidates is made with exact
 // predicates.

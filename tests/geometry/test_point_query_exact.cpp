@@ -395,7 +395,13 @@ TEST(PointQueryExact, DetailedShapesAtTheirHardestPoints) {
       const Vec2& v = ring[std::uniform_int_distribution<std::size_t>(0, ring.size() - 1)(rng)];
       pts.push_back(centre + (0.02 + 0.96 * unit(rng)) * (v - centre));  // a spoke
     }
-    for (const Vec2& p : pts) CheckAgainstOracle(shape, oracle, p, name, &stats);
+    // Both ways of the edge index (edge_index.h): a shape's first 256 queries read its strip
+    // tree, later ones its grid (built on the 256th). The same points on a fresh copy, then on
+    // one warmed past the threshold.
+    const Shape fresh = Shape::FromPolygons(shape.polygons(), shape.radius());
+    for (const Vec2& p : pts) CheckAgainstOracle(fresh, oracle, p, name + " (strip tree)", &stats);
+    for (int i = 0; i < 300; ++i) (void)QueryPoint(shape, centre + size * Vec2(unit(rng) - 0.5, unit(rng) - 0.5));
+    for (const Vec2& p : pts) CheckAgainstOracle(shape, oracle, p, name + " (grid)", &stats);
   }
   EXPECT_EQ(stats.failures, 0) << "of " << stats.points << " points";
 }
