@@ -162,6 +162,23 @@ TEST(Estimator, TimeStampsInMillisecondsAreNamed) {
 
 // A friction load below a millinewton (1e-30 kg, or 1e-5 kg: a mass in the wrong unit) is refused by the
 // models with forces, naming the load, mass and mu; the contact-point model has no force and runs.
+// A finger file in millimetres read as metres holds the whole push inside it: refused, naming the
+// units, whether it is a rounded disk or a polygon (a 32-gon probe in mm ran 51 s to 2.5 m off).
+TEST(Estimator, AFingerInMillimetresIsRefused) {
+  push::Trajectory t = GeneratePush(OffsetPush(3, 0.5));
+  for (const geometry::Shape& finger : {geometry::Shape::Disk(4.7), geometry::Shape::RegularPolygon(32, 4.7)}) {
+    t.finger.shape = finger;
+    try {
+      Estimate(t, Model::kQs, Mode::kBatch);
+      ADD_FAILURE() << "a finger of " << finger.num_vertices() << " vertices, 4.7 m, was accepted";
+    } catch (const GraphError& e) {
+      EXPECT_NE(std::string(e.what()).find("Is the finger's shape file in millimetres?"), std::string::npos) << e.what();
+    }
+  }
+  t.finger.shape = geometry::Shape::RegularPolygon(32, 0.0047);  // the probe in metres
+  EXPECT_NO_THROW(Estimate(t, Model::kCp, Mode::kBatch));
+}
+
 TEST(Estimator, AFrictionLoadBelowAMillinewtonIsRefused) {
   push::Trajectory t = GeneratePush(OffsetPush(3, 0.5));
   t.measured.force.clear();
