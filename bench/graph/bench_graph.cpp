@@ -106,6 +106,28 @@ void BM_RegisterShape(benchmark::State& state) {
 }
 BENCHMARK(BM_RegisterShape)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond)->Iterations(1);
 
+// A polygonal finger against the disk it tessellates (range(0) 0: the 5 mm disk, the peer; 1: a
+// 32-gon of the same circumradius, as `pushgraph footprint tip.obj` gives): every contact factor's
+// shape-pair query then goes through the Minkowski obstacle of the pair at its relative angle.
+void BM_BatchQsPolygonFinger(benchmark::State& state) {
+  push::Trajectory traj = Push(1000);
+  if (state.range(0) == 1) traj.finger.shape = geometry::Shape::RegularPolygon(32, traj.finger.shape.radius());
+  graph::EstimatorConfig cfg;
+  cfg.covariance = false;
+  cfg.diagnostics = false;
+  cfg.align_shape = graph::EstimatorConfig::AlignShape::kOff;
+  graph::SolverStats stats;
+  for (auto _ : state) {
+    const graph::EstimationResult r = graph::Estimate(traj, graph::Model::kQs, graph::Mode::kBatch, cfg);
+    stats = r.solver;
+    benchmark::DoNotOptimize(r.states.data());
+  }
+  state.SetLabel(state.range(0) == 1 ? "32-gon finger" : "disk finger");
+  state.counters["iterations"] = stats.iterations;
+  state.counters["solver_ms"] = 1e3 * stats.time_s;
+}
+BENCHMARK(BM_BatchQsPolygonFinger)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(1);
+
 void BM_BatchQs(benchmark::State& s) { Batch(s, graph::Model::kQs, false); }
 void BM_BatchQsWithCovariance(benchmark::State& s) { Batch(s, graph::Model::kQs, true); }
 // The peer of the covariances: ceres::Covariance (SPARSE_QR) for the marginals.

@@ -54,7 +54,9 @@ std::string RegistrationResult::Describe() const {
   // How sure: one push often leaves the position along its side to the centroid prior, and
   // without the sigmas a placement 15 mm off read as exact.
   if (sigma.x() > 0.0 || sigma.y() > 0.0) {
-    s += rotation_observable ? Format(" (sigma %.1f deg, %.1f and %.1f mm)", sigma.z() * 180.0 / kPi, sigma.x() * 1e3, sigma.y() * 1e3)
+    // A sigma of a half turn or more is no sigma (a strip of a side view read "sigma 680500 deg").
+    const std::string turn = sigma.z() < kPi ? Format("%.1f deg", sigma.z() * 180.0 / kPi) : std::string("over 180 deg: the turn is not fixed");
+    s += rotation_observable ? Format(" (sigma %s, %.1f and %.1f mm)", turn.c_str(), sigma.x() * 1e3, sigma.y() * 1e3)
                              : Format(" (sigma %.1f and %.1f mm)", sigma.x() * 1e3, sigma.y() * 1e3);
   }
   if (transform.mirrored) s = "mirrored (y -> -y), " + s;
