@@ -4,6 +4,7 @@
 #include <pushgraph/geometry/errors.h>
 
 #include <cmath>
+#include <limits>
 #include <map>
 #include <string>
 #include <tuple>
@@ -71,13 +72,28 @@ std::vector<ContactPoint> FindContacts(const Shape& object, const Pose2& object_
 
   // Every vertex of `vertex_rings` against every edge of `edge_rings`; `object_has_edge` says
   // which shape owns the edges (the normal is flipped to point out of the object).
+  // A vertex counts only within reach of an edge: |gap + radii| is its distance to the edge, and
+  // the gap lies in [-max_depth, tolerance]. Edges whose box, grown by that reach (and a relative
+  // margin), misses the vertices' box are skipped before the per-vertex work: a finger against an
+  // object of 10000 edges spent half the estimate here, once per step.
+  const double reach = std::max(radii + options.tolerance, options.max_depth - radii);
   auto pairs = [&](const std::vector<PlacedRing>& edge_rings, const std::vector<PlacedRing>& vertex_rings,
                    bool object_has_edge) {
+    Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (const PlacedRing& vr : vertex_rings)
+      for (const Vec2& v : vr.points) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+    if (!(lo.x() <= hi.x())) return;
+    const double margin = reach + 1e-9 * (std::max(hi.cwiseAbs().maxCoeff(), lo.cwiseAbs().maxCoeff()) + reach);
+    lo -= Vec2::Constant(margin);
+    hi += Vec2::Constant(margin);
     for (const PlacedRing& er : edge_rings) {
       const int ring_size = static_cast<int>(er.points.size());
       for (int e = 0; e < EdgeCount(er); ++e) {
         const Vec2& a = er.points[e];
         const Vec2& b = er.points[(e + 1) % ring_size];
+        if (std::max(a.x(), b.x()) < lo.x() || std::min(a.x(), b.x()) > hi.x() || std::max(a.y(), b.y()) < lo.y() ||
+            std::min(a.y(), b.y()) > hi.y())
+          continue;
         const Vec2 d = b - a;
         const double length2 = d.squaredNorm();
         const Vec2 outward = Vec2(d.y(), -d.x()) / std::sqrt(length2);  // interior on the left

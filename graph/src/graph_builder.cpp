@@ -14,6 +14,7 @@
 #include <Eigen/Cholesky>
 
 #include <algorithm>
+#include <set>
 #include <cstdio>
 #include <chrono>
 #include <cmath>
@@ -560,15 +561,14 @@ std::vector<std::pair<GraphBuilder::ContactFeature, Vec2>> GraphBuilder::NearbyC
     return {};
   }
   std::vector<std::pair<ContactFeature, Vec2>> distinct;
+  // Each feature once, in the order found (a set: a detailed object near the finger has
+  // thousands of features within the tolerance, and a linear search made this quadratic).
+  std::set<std::tuple<bool, int, int, int>> seen;
   for (const geometry::ContactPoint& c : found) {
     ContactFeature f;
     f.edge = c.object_feature;
     f.vertex = c.kind != geometry::ContactPoint::Kind::kFingerVertexObjectEdge;
-    const bool seen = std::any_of(distinct.begin(), distinct.end(), [&](const auto& d) {
-      return d.first.vertex == f.vertex && d.first.edge.polygon == f.edge.polygon && d.first.edge.ring == f.edge.ring &&
-             d.first.edge.index == f.edge.index;
-    });
-    if (!seen) distinct.push_back({f, c.object_point});
+    if (seen.insert({f.vertex, f.edge.polygon, f.edge.ring, f.edge.index}).second) distinct.push_back({f, c.object_point});
   }
   return distinct;
 }
