@@ -141,13 +141,22 @@ class ContactFit {
     set_noise(noise);
   }
 
-  void UseExactFinger() {
-    if (disk_.exact || querier_) return;
+  /// The exact finger (polygonal fingers) through `shared` when it queries this fit's shape and
+  /// finger (the same shape impl): its Minkowski obstacles, one per relative angle, are then built
+  /// once for every fit of one candidate file instead of once per fit. Returns the querier used.
+  std::shared_ptr<const geometry::ShapePairQuerier> UseExactFinger(std::shared_ptr<const geometry::ShapePairQuerier> shared = {}) {
+    if (disk_.exact) return nullptr;
+    if (querier_) return querier_;
+    if (shared && &shared->object().impl() == &shape_.impl() && &shared->finger().impl() == &finger_.impl()) {
+      querier_ = std::move(shared);
+      return querier_;
+    }
     geometry::ShapePairQuerier::Options o;
     o.angle_cache_resolution = 5e-3;
     o.max_cached_angles = 2048;
     o.check_rounded_depth = false;
-    querier_ = std::make_unique<geometry::ShapePairQuerier>(shape_, finger_, o);
+    querier_ = std::make_shared<const geometry::ShapePairQuerier>(shape_, finger_, o);
+    return querier_;
   }
   void set_noise(double noise) {
     noise_ = noise;
@@ -311,7 +320,7 @@ class ContactFit {
   Vec2 centroid_;
   double prior_sigma_, gap_sigma_;
   double noise_ = 1e-3, cauchy_ = 2e-3, a_ = 2.0;
-  std::unique_ptr<geometry::ShapePairQuerier> querier_;
+  std::shared_ptr<const geometry::ShapePairQuerier> querier_;
 };
 
 /// Whether placements a and b of a shape coincide on its outline within tolerance.

@@ -315,6 +315,7 @@ RegistrationResult RegisterShape(const std::vector<const push::Trajectory*>& rec
     double scale = 1.0;
     bool mirrored = false;
     std::shared_ptr<Shape> shape;      // the file's shape scaled (and mirrored): placed by T only
+    std::shared_ptr<const geometry::ShapePairQuerier> exact_finger;  // shared by its exact fits
     std::vector<Placement> placements;  // refined, best first
     int symmetry = 1;
     double radius = 0.0;
@@ -383,7 +384,7 @@ RegistrationResult RegisterShape(const std::vector<const push::Trajectory*>& rec
       }
       // Refinement with exact queries; the noise from the best fit's residuals unless given.
       ContactFit fine(*f.shape, refine, finger, disk, start_noise, prior_sigma, o.gap_sigma);
-      fine.UseExactFinger();
+      f.exact_finger = fine.UseExactFinger();
       Active all_active;
       all_active.rotation = f.symmetry != 0;
       for (Placement& c : minima) fine.Minimize(&c, all_active, 30);
@@ -407,14 +408,14 @@ RegistrationResult RegisterShape(const std::vector<const push::Trajectory*>& rec
   std::vector<double> costs;
   for (const FileCandidate& f : files) {
     ContactFit c(*f.shape, refine, finger, disk, files.front().noise, o.centroid_prior * f.radius, o.gap_sigma);
-    c.UseExactFinger();
+    c.UseExactFinger(f.exact_finger);
     costs.push_back(c.Cost(f.placements[0]) + (f.mirrored ? 6.0 : 0.0));
   }
   const std::size_t best_file = static_cast<std::size_t>(std::min_element(costs.begin(), costs.end()) - costs.begin());
   const FileCandidate& f = files[best_file];
   const double noise = f.noise;
   ContactFit fit(*f.shape, refine, finger, disk, noise, o.centroid_prior * f.radius, o.gap_sigma);
-  fit.UseExactFinger();
+  fit.UseExactFinger(f.exact_finger);
   Placement best = f.placements[0];
   result.symmetry_order = f.symmetry;
   result.rotation_observable = f.symmetry != 0;
@@ -448,7 +449,7 @@ RegistrationResult RegisterShape(const std::vector<const push::Trajectory*>& rec
   // The shape as given, scored by the same fit, and the gap statistics.
   {
     ContactFit as_given(file_shape, refine, finger, disk, noise, o.centroid_prior * file_radius, o.gap_sigma);
-    as_given.UseExactFinger();
+    as_given.UseExactFinger(f.exact_finger);  // the same shape when the file won as given
     Placement identity = as_given.Start();
     as_given.Minimize(&identity, Active{false, false, false, true}, 20);  // its own calibration gaps
     result.identity_cost = identity.cost;
@@ -500,7 +501,7 @@ RegistrationResult RegisterShape(const std::vector<const push::Trajectory*>& rec
   // placement on the data and the centroid prior (gap priors left out of both).
   if (!result.fits_as_given) {
     ContactFit sized(file_shape, refine, finger, disk, noise, o.centroid_prior * file_radius, 1.0);
-    sized.UseExactFinger();
+    sized.UseExactFinger(f.exact_finger);
     // From the shape as given, the gaps first, then a local refinement of the placement.
     Placement identity = sized.Start();
     sized.Minimize(&identity, Active{false, false, false, true}, 30);
