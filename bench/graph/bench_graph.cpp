@@ -33,17 +33,17 @@ const push::Trajectory& Push(int steps) {
   return it->second;
 }
 
-// range(1): 0 the chain solver, 1 Ceres (the default, the peer). Registration and the
-// self-diagnosis are left out (they do not depend on the solver); every solver stage is in.
-void Batch(benchmark::State& state, graph::Model model, bool covariance,
-           graph::EstimatorConfig::CovarianceMethod method = graph::EstimatorConfig::CovarianceMethod::kSelectedInversion) {
-  const auto& traj = Push(static_cast<int>(state.range(0)));
+// One batch estimate of `traj` by the chain solver or Ceres (the peer). The self-diagnosis is
+// left out and no shape is aligned; the shape check (BM_RegisterShape) still runs, whichever
+// solver; every solver stage is in.
+void BatchOn(benchmark::State& state, const push::Trajectory& traj, bool ceres, graph::Model model, bool covariance,
+             graph::EstimatorConfig::CovarianceMethod method = graph::EstimatorConfig::CovarianceMethod::kSelectedInversion) {
   graph::EstimatorConfig cfg;
   cfg.covariance = covariance;
   cfg.covariance_method = method;
   cfg.diagnostics = false;
   cfg.align_shape = graph::EstimatorConfig::AlignShape::kOff;
-  cfg.solver = state.range(1) == 1 ? graph::EstimatorConfig::Solver::kCeres : graph::EstimatorConfig::Solver::kChain;
+  cfg.solver = ceres ? graph::EstimatorConfig::Solver::kCeres : graph::EstimatorConfig::Solver::kChain;
   graph::SolverStats stats;
   for (auto _ : state) {
     const graph::EstimationResult r = graph::Estimate(traj, model, graph::Mode::kBatch, cfg);
@@ -51,7 +51,6 @@ void Batch(benchmark::State& state, graph::Model model, bool covariance,
     benchmark::DoNotOptimize(r.states.data());
   }
   state.SetLabel(stats.name);
-  state.counters["steps"] = static_cast<double>(state.range(0));
   state.counters["iterations"] = stats.iterations;
   state.counters["solver_ms"] = 1e3 * stats.time_s;
   if (stats.factor_flops > 0.0) {
@@ -62,6 +61,13 @@ void Batch(benchmark::State& state, graph::Model model, bool covariance,
     state.counters["final_stage_linear_ms"] = 1e3 * stats.linear_solve_time_s;
     state.counters["factor_mflop"] = 1e-6 * stats.factor_flops;
   }
+}
+
+// range(0): steps; range(1): 0 the chain solver, 1 Ceres.
+void Batch(benchmark::State& state, graph::Model model, bool covariance,
+           graph::EstimatorConfig::CovarianceMethod method = graph::EstimatorConfig::CovarianceMethod::kSelectedInversion) {
+  BatchOn(state, Push(static_cast<int>(state.range(0))), state.range(1) == 1, model, covariance, method);
+  state.counters["steps"] = static_cast<double>(state.range(0));
 }
 
 // The same square with every side cut into equal collinear edges: the same geometry, so the same
@@ -112,19 +118,8 @@ BENCHMARK(BM_RegisterShape)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond
 void BM_BatchQsPolygonFinger(benchmark::State& state) {
   push::Trajectory traj = Push(1000);
   if (state.range(0) == 1) traj.finger.shape = geometry::Shape::RegularPolygon(32, traj.finger.shape.radius());
-  graph::EstimatorConfig cfg;
-  cfg.covariance = false;
-  cfg.diagnostics = false;
-  cfg.align_shape = graph::EstimatorConfig::AlignShape::kOff;
-  graph::SolverStats stats;
-  for (auto _ : state) {
-    const graph::EstimationResult r = graph::Estimate(traj, graph::Model::kQs, graph::Mode::kBatch, cfg);
-    stats = r.solver;
-    benchmark::DoNotOptimize(r.states.data());
-  }
+  BatchOn(state, traj, /*ceres=*/false, graph::Model::kQs, /*covariance=*/false);
   state.SetLabel(state.range(0) == 1 ? "32-gon finger" : "disk finger");
-  state.counters["iterations"] = stats.iterations;
-  state.counters["solver_ms"] = 1e3 * stats.time_s;
 }
 BENCHMARK(BM_BatchQsPolygonFinger)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(1);
 

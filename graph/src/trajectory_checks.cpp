@@ -145,10 +145,11 @@ void CheckNoClockJump(const std::vector<Sample>& s, const std::string& stream, d
   }
 }
 
-// A rounded finger whose rounding radius exceeds every finger-object distance of the recording
-// plus both shapes' reach would hold the whole object inside it at every sample: its file is in
+// A finger whose origin lies deeper inside it than every finger-object distance of the recording
+// plus the object's reach would hold the whole object inside it at every sample: its file is in
 // other units (a probe of radius 4.7 given in millimetres was read as 4.7 m, and the shape check
-// then "aligned" the object 4 m away). The object's own units the registration detects.
+// then "aligned" the object 4 m away; a 32-gon probe in millimetres ran for 51 s to an object
+// 2.5 m off the tracker's, exit 0). The object's own units the registration detects.
 void CheckFingerSize(const geometry::Shape& finger, const std::vector<push::PoseSample>& finger_pose,
                      const std::vector<push::PoseSample>& object_pose, const geometry::Shape& object, const std::string& who) {
   if (finger.empty() || finger_pose.empty() || object_pose.empty()) return;
@@ -158,29 +159,16 @@ void CheckFingerSize(const geometry::Shape& finger, const std::vector<push::Pose
     while (k + 1 < object_pose.size() && std::abs(object_pose[k + 1].t - f.t) <= std::abs(object_pose[k].t - f.t)) ++k;
     farthest = std::max(farthest, (f.pose.translation() - object_pose[k].pose.translation()).norm());
   }
-  // The finger's core (its radius aside) and the object reach this far from their origins.
-  const double finger_core = geometry::RadiusAbout(finger, geometry::Vec2::Zero()) - finger.radius();
   const double object_reach = geometry::RadiusAbout(object, geometry::Vec2::Zero());
-  const double bound = farthest + finger_core + object_reach;
-  // A polygonal finger likewise: the depth of its origin inside it beyond the whole push (a 32-gon
-  // probe in millimetres ran for 51 s to an object 2.5 m off the tracker's, exit 0).
+  // How deep the finger's origin lies inside it (a disk's: its radius), rounded or polygonal alike.
   const double depth = -geometry::QueryPoint(finger, geometry::Vec2::Zero()).signed_distance;
-  if (finger.radius() <= bound && depth > farthest + object_reach) {
-    throw GraphError(Format("trajectory: %sthe finger's shape covers %.6g m about its origin, more than the whole push: the "
-                            "finger stays within %.3g m of the object's origin and the object within %.3g m of it, so at "
-                            "every sample the finger would hold the whole object inside it. Is the finger's shape file "
-                            "in millimetres? Shape files are in metres (pushgraph footprint FILE --scale 0.001 converts one)",
-                            who.c_str(), depth, farthest, object_reach));
-  }
-  if (finger.radius() <= bound) return;
-  char text[600];
-  std::snprintf(text, sizeof text,
-                "trajectory: %sthe finger's radius %.6g m is larger than the whole push: the finger stays within %.3g m of "
-                "the object's origin and the object within %.3g m of it, so at every sample the finger would hold the whole "
-                "object inside it. Is the finger's shape file in millimetres? Shape files are in metres (pushgraph footprint "
-                "FILE --scale 0.001 converts one)",
-                who.c_str(), finger.radius(), farthest, object_reach);
-  throw GraphError(text);
+  if (!(depth > farthest + object_reach)) return;
+  throw GraphError(Format("trajectory: %sthe finger's shape covers %.6g m about its origin (its rounding radius %.6g m), "
+                          "more than the whole push: the finger stays within %.3g m of the object's origin and the object "
+                          "within %.3g m of it, so at every sample the finger would hold the whole object inside it. Is the "
+                          "finger's shape file in millimetres? Shape files are in metres (pushgraph footprint FILE --scale "
+                          "0.001 converts one)",
+                          who.c_str(), depth, finger.radius(), farthest, object_reach));
 }
 
 }  // namespace

@@ -160,8 +160,6 @@ TEST(Estimator, TimeStampsInMillisecondsAreNamed) {
   }
 }
 
-// A friction load below a millinewton (1e-30 kg, or 1e-5 kg: a mass in the wrong unit) is refused by the
-// models with forces, naming the load, mass and mu; the contact-point model has no force and runs.
 // A finger file in millimetres read as metres holds the whole push inside it: refused, naming the
 // units, whether it is a rounded disk or a polygon (a 32-gon probe in mm ran 51 s to 2.5 m off).
 TEST(Estimator, AFingerInMillimetresIsRefused) {
@@ -179,6 +177,8 @@ TEST(Estimator, AFingerInMillimetresIsRefused) {
   EXPECT_NO_THROW(Estimate(t, Model::kCp, Mode::kBatch));
 }
 
+// A friction load below a millinewton (1e-30 kg, or 1e-5 kg: a mass in the wrong unit) is refused by the
+// models with forces, naming the load, mass and mu; the contact-point model has no force and runs.
 TEST(Estimator, AFrictionLoadBelowAMillinewtonIsRefused) {
   push::Trajectory t = GeneratePush(OffsetPush(3, 0.5));
   t.measured.force.clear();
