@@ -1,4 +1,5 @@
 #include "graph_builder.h"
+#include "text.h"
 
 #include <ceres/normal_prior.h>
 
@@ -50,7 +51,7 @@ std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder, c
                   << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
                   << " s (Jacobian " << t.jacobian << ", J^T J " << t.normal_equations << ", Cholesky "
                   << t.factorization << ", selected inversion " << t.inversion << "), smallest pivot ratio "
-                  << marginals.min_pivot_ratio() << "\n";
+                  << marginals.min_pivot_ratio() << (marginals.extended_precision() ? ", in long double (the double pass refused a pivot)" : "") << "\n";
       }
       get = [&](double* b, double* out) {
         const Eigen::MatrixXd m = marginals.Covariance(b);
@@ -82,7 +83,7 @@ std::string ComputeCovariances(ceres::Problem& problem, GraphBuilder& builder, c
         }
         for (const auto& [block, name] : blocks) {
           if (block != bad) continue;
-          marginals_error += " [step " + std::to_string(i) + ", t = " + std::to_string(builder.steps()[i].t) +
+          marginals_error += " [step " + std::to_string(i) + ", t = " + StepTime(builder.steps()[i].t, builder.steps().front().t) +
                              ", " + name + "]";
         }
       }

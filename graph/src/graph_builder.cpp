@@ -388,9 +388,7 @@ std::string GraphBuilder::Describe(ceres::ResidualBlockId id) const {
   const auto [type, step] = it->second;
   std::string s = std::string(FactorTypeName(type)) + " factor";
   if (step >= 0 && step < static_cast<int>(steps_.size())) {
-    char t[48];
-    std::snprintf(t, sizeof t, "%.9g", steps_[step].t);
-    s += " at step " + std::to_string(step) + " (t = " + t + " s)";
+    s += " at step " + std::to_string(step) + " (t = " + internal::StepTime(steps_[step].t, steps_.front().t) + ")";
   } else {
     s += " (shared by the trajectory)";
   }

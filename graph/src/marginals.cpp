@@ -20,6 +20,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <numeric>
 #include <stdexcept>
 #include <unordered_map>
@@ -32,9 +33,21 @@ namespace {
 // divided by the smallest ratio (a simulated push with C and S made stiff on purpose, ratios
 // 2e-3 to 3e-14; MIT ellip1 recordings at their full rate, about 3e-8, where 250 Hz steps make
 // V stiff: errors 1e-6 to 5e-6). Below 1e-9 (accepted_pivot_ratio_'s default) it could lose more
-// than 4 digits: refuse (the estimator then uses the QR); below kSingular the direction has no
-// information of its own.
+// than 4 digits in double: the factorization and inversion are then redone in extended precision
+// (long double: a 64-bit significand on x86, eps 5.4e-20 against 1.1e-16), where the same 4 digits
+// hold down to a ratio 2000 times smaller (ExtendedPivotRatio); below that, refuse (the estimator
+// then uses the QR); below kSingular the direction has no information of its own.
 constexpr double kSingular = 1e-14;
+
+// The accepted ratio scaled to long double's rounding (the error bound is eps / ratio); where
+// long double is double (MSVC), nothing is gained and the extended pass is skipped.
+double ExtendedPivotRatio(double accepted) {
+  const double gain = static_cast<double>(std::numeric_limits<long double>::epsilon()) / std::numeric_limits<double>::epsilon();
+  return std::max(accepted * gain, kSingular);
+}
+bool HaveExtendedPrecision() {
+  return std::numeric_limits<long double>::epsilon() < std::numeric_limits<double>::epsilon();
+}
 
 std::string FormatRatio(double ratio) {
   char text[32];
@@ -73,6 +86,7 @@ bool SparseMarginals::Compute(ceres::Problem& problem) {
   impl_.reset();
   error_.clear();
   failed_block_ = nullptr;
+  extended_precision_ = false;
   auto impl = std::make_unique<Impl>();
   std::vector<double*> all, variable;
   problem.GetParameterBlocks(&all);
@@ -142,8 +156,36 @@ bool SparseMarginals::Compute(ceres::Problem& problem) {
   impl->perm = llt.permutationP().indices();
   Eigen::VectorXd h_diag(n);
   for (int a = 0; a < n; ++a) h_diag[impl->perm[a]] = H.coeff(a, a);
-  const bool ok = SelectedInverse(llt.matrixL().nestedExpression(), h_diag, variable, *impl, phase);
+  bool ok = SelectedInverse(llt.matrixL().nestedExpression(), h_diag, variable, *impl, phase, accepted_pivot_ratio_);
+  if (!ok && ill_conditioned_) ok = ComputeExtended(J, variable, *impl);
   if (ok) impl_ = std::move(impl);
+  return ok;
+}
+
+bool SparseMarginals::ComputeExtended(const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>>& J,
+                                      const std::vector<double*>& variable, Impl& impl) {
+  if (!HaveExtendedPrecision()) return false;
+  // J^T J formed, factorized and inverted in long double: J's entries are exact in it, so the
+  // squaring of J's condition costs the extended format's digits instead of double's.
+  using Long = long double;
+  const auto phase = std::chrono::steady_clock::now();
+  const Eigen::SparseMatrix<Long, Eigen::RowMajor> Jl = J.cast<Long>();
+  const Eigen::SparseMatrix<Long> H = Eigen::SparseMatrix<Long>(Jl.transpose()) * Jl;
+  Eigen::SimplicialLLT<Eigen::SparseMatrix<Long>, Eigen::Lower, Eigen::AMDOrdering<int>> llt(H);
+  if (llt.info() != Eigen::Success) return false;
+  error_.clear();
+  failed_block_ = nullptr;
+  impl.perm = llt.permutationP().indices();
+  impl.col_start.clear();
+  impl.row.clear();
+  impl.z.clear();
+  const int n = static_cast<int>(H.rows());
+  Eigen::Matrix<Long, Eigen::Dynamic, 1> h_diag(n);
+  for (int a = 0; a < n; ++a) h_diag[impl.perm[a]] = H.coeff(a, a);
+  const bool ok = SelectedInverse(llt.matrixL().nestedExpression(), h_diag, variable, impl, phase,
+                                  ExtendedPivotRatio(accepted_pivot_ratio_));
+  if (ok) extended_precision_ = true;
+  else error_ += " (in extended precision too)";
   return ok;
 }
 
@@ -151,9 +193,10 @@ void SparseMarginals::set_accepted_pivot_ratio(double ratio) {
   accepted_pivot_ratio_ = std::max(ratio, kSingular);
 }
 
-bool SparseMarginals::SelectedInverse(const Eigen::SparseMatrix<double>& L, const Eigen::VectorXd& h_diag,
+template <typename Scalar>
+bool SparseMarginals::SelectedInverse(const Eigen::SparseMatrix<Scalar>& L, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& h_diag,
                                       const std::vector<double*>& variable, Impl& impl_ref,
-                                      std::chrono::steady_clock::time_point phase) {
+                                      std::chrono::steady_clock::time_point phase, double accepted_ratio) {
   using Clock = std::chrono::steady_clock;
   auto seconds_since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
   Impl* impl = &impl_ref;
@@ -161,17 +204,18 @@ bool SparseMarginals::SelectedInverse(const Eigen::SparseMatrix<double>& L, cons
   // A pivot that keeps almost none of its variable's information (L_jj^2 against H_jj: 1 - R^2
   // of that unknown on the earlier ones) is a numerically dependent direction.
   impl->col_start.assign(n + 1, 0);
-  std::vector<std::pair<int, double>> column;
-  std::vector<double> values;
+  std::vector<std::pair<int, Scalar>> column;
+  std::vector<Scalar> values;
   min_pivot_ratio_ = INFINITY;
+  ill_conditioned_ = false;
   for (int j = 0; j < n; ++j) {
     column.clear();
-    for (Eigen::SparseMatrix<double>::InnerIterator it(L, j); it; ++it) column.emplace_back(static_cast<int>(it.row()), it.value());
+    for (typename Eigen::SparseMatrix<Scalar>::InnerIterator it(L, j); it; ++it) column.emplace_back(static_cast<int>(it.row()), it.value());
     std::sort(column.begin(), column.end());
     const double ratio = column.empty() || column.front().first != j
                              ? 0.0
-                             : column.front().second * column.front().second / h_diag[j];
-    if (!(ratio > accepted_pivot_ratio_) || !std::isfinite(h_diag[j]) || !(column.front().second > 0.0)) {
+                             : static_cast<double>(column.front().second * column.front().second / h_diag[j]);
+    if (!(ratio > accepted_ratio) || !std::isfinite(static_cast<double>(h_diag[j])) || !(column.front().second > 0)) {
       int a = 0;
       while (a < n && impl->perm[a] != j) ++a;
       for (double* b : variable) {
@@ -179,15 +223,16 @@ bool SparseMarginals::SelectedInverse(const Eigen::SparseMatrix<double>& L, cons
         if (a >= offset && a < offset + size) {
           failed_block_ = b;
           const std::string component = "(component " + std::to_string(a - offset) + ")";
-          if (!std::isfinite(h_diag[j])) {
+          if (!std::isfinite(static_cast<double>(h_diag[j]))) {
             error_ = "the information matrix J^T J overflows at a parameter block " + component;
           } else if (!(ratio > kSingular)) {
             error_ = "the information matrix J^T J is (numerically) singular at a parameter block " + component +
                      ": it has no information independent of the others (unobservable or gauge freedom)";
           } else {
+            ill_conditioned_ = true;
             error_ = "the information matrix J^T J is ill-conditioned at a parameter block " + component +
                      ": pivot ratio " + FormatRatio(ratio) +
-                     " below " + FormatRatio(accepted_pivot_ratio_) +
+                     " below " + FormatRatio(accepted_ratio) +
                      ", the selected inverse could lose more than 4 digits (use a QR on J)";
           }
           break;
@@ -204,22 +249,24 @@ bool SparseMarginals::SelectedInverse(const Eigen::SparseMatrix<double>& L, cons
   }
   timings_.factorization = seconds_since(phase);
   phase = Clock::now();
-  impl->z.assign(values.size(), 0.0);
+  std::vector<Scalar> zs(values.size(), Scalar(0));
   // Per column j: Z_RR (R = the rows below the diagonal) gathered densely, each column r_a of Z
   // merged with R (R's rows from r_a on are a subset of that column's pattern), then one matvec.
-  Eigen::MatrixXd z_rr;
-  Eigen::VectorXd l_r;
+  using Matrix = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
+  using Vector = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
+  Matrix z_rr;
+  Vector l_r;
   const std::vector<int>& rows = impl->row;
   for (int j = n - 1; j >= 0; --j) {
     const int begin = impl->col_start[j], end = impl->col_start[j + 1];
     const int m = end - begin - 1;
-    const double ljj = values[begin];
+    const Scalar ljj = values[begin];
     if (m == 0) {
-      impl->z[begin] = 1.0 / (ljj * ljj);
+      zs[begin] = Scalar(1) / (ljj * ljj);
       continue;
     }
     z_rr.resize(m, m);
-    l_r = Eigen::Map<const Eigen::VectorXd>(&values[begin + 1], m);
+    l_r = Eigen::Map<const Vector>(&values[begin + 1], m);
     for (int a = 0; a < m; ++a) {
       const int ra = rows[begin + 1 + a];
       int p = impl->col_start[ra];
@@ -231,13 +278,14 @@ bool SparseMarginals::SelectedInverse(const Eigen::SparseMatrix<double>& L, cons
           error_ = "internal error: the Cholesky factor's pattern is not chordal";
           return false;
         }
-        z_rr(a, b) = z_rr(b, a) = impl->z[p];
+        z_rr(a, b) = z_rr(b, a) = zs[p];
       }
     }
-    const Eigen::VectorXd z_rj = -(z_rr * l_r) / ljj;
-    Eigen::Map<Eigen::VectorXd>(&impl->z[begin + 1], m) = z_rj;
-    impl->z[begin] = (1.0 / ljj - l_r.dot(z_rj)) / ljj;
+    const Vector z_rj = -(z_rr * l_r) / ljj;
+    Eigen::Map<Vector>(&zs[begin + 1], m) = z_rj;
+    zs[begin] = (Scalar(1) / ljj - l_r.dot(z_rj)) / ljj;
   }
+  impl->z.assign(zs.begin(), zs.end());
   timings_.inversion = seconds_since(phase);
   return true;
 }
@@ -246,6 +294,7 @@ bool SparseMarginals::Compute(ChainSolver& solver) {
   impl_.reset();
   error_.clear();
   failed_block_ = nullptr;
+  extended_precision_ = false;
   timings_ = Timings{};
   min_pivot_ratio_ = 0.0;
   ChainSolver::Impl& s = solver.impl();
@@ -265,7 +314,21 @@ bool SparseMarginals::Compute(ChainSolver& solver) {
   impl->perm = s.llt.permutationP().indices();
   Eigen::VectorXd h_diag(s.n);
   for (int a = 0; a < s.n; ++a) h_diag[impl->perm[a]] = s.values[s.diagonal[a]];
-  const bool ok = SelectedInverse(s.llt.matrixL().nestedExpression(), h_diag, variable, *impl, phase);
+  bool ok = SelectedInverse(s.llt.matrixL().nestedExpression(), h_diag, variable, *impl, phase, accepted_pivot_ratio_);
+  if (!ok && ill_conditioned_) {
+    // The extended pass needs J itself (the solver keeps only J^T J): Ceres evaluates it at the
+    // solution, its columns in the solver's block order.
+    ceres::Problem::EvaluateOptions eval;
+    eval.parameter_blocks = variable;
+    eval.apply_loss_function = true;
+    ceres::CRSMatrix crs;
+    if (s.problem->Evaluate(eval, nullptr, nullptr, nullptr, &crs)) {
+      const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>> J(
+          crs.num_rows, crs.num_cols, static_cast<Eigen::Index>(crs.values.size()), crs.rows.data(), crs.cols.data(),
+          crs.values.data());
+      ok = ComputeExtended(J, variable, *impl);
+    }
+  }
   if (ok) impl_ = std::move(impl);
   return ok;
 }

@@ -1,6 +1,7 @@
 #pragma once
 // Internal: small helpers of the graph module's reports (registration, diagnostics).
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -16,6 +17,14 @@ std::string Format(const char* fmt, Args... args) {
   std::snprintf(out.data(), out.size(), fmt, args...);
   out.resize(static_cast<std::size_t>(size));
   return out;
+}
+
+/// A step's time for messages: "0.068 s" as given, and for clock times (a recording's Unix
+/// time, where %g would print 1.46185921e+09 for every step of a push) to the millisecond with
+/// the time since the first step: "1461859211.061 s, 1.336 s after the first step".
+inline std::string StepTime(double t, double first) {
+  if (std::abs(t) < 1e5) return Format("%.9g s", t);
+  return Format("%.3f s, %.3f s after the first step", t, t - first);
 }
 
 /// The median (upper middle for an even count); 0 for an empty vector.

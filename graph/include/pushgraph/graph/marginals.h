@@ -16,8 +16,10 @@
 //
 // The Jacobian is the one Ceres uses (loss functions applied, as ceres::Covariance does);
 // constant parameter blocks, and blocks no residual uses, are held fixed. Blocks with a manifold
-// are not supported. Forming J^T J squares J's condition: Compute refuses when that could cost
-// more than 4 digits (see min_pivot_ratio), and ceres::Covariance's QR on J is the tool then.
+// are not supported. Forming J^T J squares J's condition: when that could cost more than 4
+// digits in double (see min_pivot_ratio), Compute forms, factorizes and inverts J^T J again in
+// long double (extended_precision()), and refuses only when even that could; ceres::Covariance's
+// QR on J is the tool then.
 #include <ceres/problem.h>
 
 #include <Eigen/Core>
@@ -43,9 +45,11 @@ class SparseMarginals {
   /// Factorizes H at the problem's current parameter values and computes the selected inverse.
   /// Returns false, with error() saying why, when: there is no variable block; a block has a
   /// manifold; a residual block fails to evaluate or gives a non-finite value; H is not positive
-  /// definite, or a pivot keeps less than 1e-9 of its unknown's information (min_pivot_ratio():
-  /// below it the result could lose more than 4 digits, measured against a QR on J; below 1e-14
-  /// the direction is unobservable). failed_block() then names the block when known.
+  /// definite, or a pivot keeps less than 1e-9 of its unknown's information in double
+  /// (min_pivot_ratio(): below it the result could lose more than 4 digits, measured against a QR
+  /// on J) and less than 4.9e-13 in the long double pass that follows (x86's 64-bit significand;
+  /// where long double is double there is no such pass); below 1e-14 the direction is
+  /// unobservable. failed_block() then names the block when known.
   /// Parameter bounds are ignored (as ceres::Covariance does): a variable on its bound gets the
   /// unconstrained Gaussian covariance.
   bool Compute(ceres::Problem& problem);
@@ -66,6 +70,9 @@ class SparseMarginals {
   const std::string& error() const { return error_; }
   /// After a failed Compute: the parameter block whose pivot failed, when one did (else nullptr).
   const double* failed_block() const { return failed_block_; }
+  /// After a successful Compute: whether it took the long double pass (a pivot ratio below the
+  /// accepted one in double; about 10 times the double pass' time).
+  bool extended_precision() const { return extended_precision_; }
   /// Diagnostics: unknowns, nonzeros of the Cholesky factor, and the wall time (s) of the last
   /// Compute's phases: Jacobian evaluation, J^T J, sparse Cholesky, selected inversion.
   int num_unknowns() const;
@@ -78,23 +85,32 @@ class SparseMarginals {
   /// information left after conditioning on the ones eliminated before it (1 for independent
   /// unknowns; small for nearly dependent directions, where J^T J loses digits).
   double min_pivot_ratio() const { return min_pivot_ratio_; }
-  /// The smallest pivot ratio Compute accepts (default 1e-9, about 4 digits kept; at least 1e-14,
-  /// below which a direction has no information of its own). A user that needs fewer digits
+  /// The smallest pivot ratio Compute accepts in double (default 1e-9, about 4 digits kept; at
+  /// least 1e-14, below which a direction has no information of its own); the long double pass
+  /// accepts this times eps(long double) / eps(double), about 4.9e-4 times it on x86. A user that needs fewer digits
   /// (the self-diagnosis' leverages) may accept more ill-conditioned problems.
   void set_accepted_pivot_ratio(double ratio);
 
  private:
   struct Impl;
-  // Checks the pivots of L (factor order; h_diag the diagonal of H in that order) and computes
-  // the selected inverse into impl.
-  bool SelectedInverse(const Eigen::SparseMatrix<double>& L, const Eigen::VectorXd& h_diag,
-                       const std::vector<double*>& variable, Impl& impl, std::chrono::steady_clock::time_point phase);
+  // Checks the pivots of L (factor order; h_diag the diagonal of H in that order) against
+  // accepted_ratio and computes the selected inverse into impl (Scalar: double, or long double
+  // for the extended pass).
+  template <typename Scalar>
+  bool SelectedInverse(const Eigen::SparseMatrix<Scalar>& L, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& h_diag,
+                       const std::vector<double*>& variable, Impl& impl, std::chrono::steady_clock::time_point phase,
+                       double accepted_ratio);
+  // J^T J formed, factorized and inverted again in long double (after an ill-conditioned pivot).
+  bool ComputeExtended(const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>>& J,
+                       const std::vector<double*>& variable, Impl& impl);
   std::unique_ptr<Impl> impl_;
   std::string error_;
   const double* failed_block_ = nullptr;
   Timings timings_;
   double min_pivot_ratio_ = 0.0;
   double accepted_pivot_ratio_ = 1e-9;
+  bool ill_conditioned_ = false;     // the last pivot check failed on the ratio alone
+  bool extended_precision_ = false;  // the last successful Compute needed the extended pass
 };
 
 }  // namespace pushgraph::graph
