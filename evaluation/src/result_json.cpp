@@ -124,6 +124,14 @@ std::string ResultToJson(const graph::EstimationResult& r, int indent) {
     if (a.suggested) {
       Json t = {a.transform.pose.x, a.transform.pose.y, a.transform.pose.theta};
       Json sigma = {a.sigma.x(), a.sigma.y(), a.rotation_observable ? Json(a.sigma.z()) : Json(nullptr)};
+      // Unsettled, the curvature's sigmas cover the chosen placement alone: kept apart from the
+      // transform's sigma, which is then null.
+      shape["placement_settled"] = a.settled;
+      if (!a.settled) {
+        shape["placement_unsettled_by"] = a.unsettled_by;
+        shape["local_transform_sigma"] = sigma;
+        sigma = nullptr;
+      }
       if (a.aligned) {
         parameters["shape_transform"] = t;
         parameters["shape_transform_sigma"] = sigma;

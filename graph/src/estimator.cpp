@@ -157,6 +157,7 @@ EstimationResult EstimateBatch(const push::Trajectory& traj, Model model, const 
   r.solver.evaluation_time_s = summary.evaluation_s;
   r.solver.linear_solve_time_s = summary.linear_solve_s;
   r.solver.factor_flops = summary.factor_flops;
+  r.solver.stalled = summary.stalled;
   if (!summary.converged) {
     // Ceres and the chain solver both say "iteration limit" in their own words: said once.
     const bool at_limit = summary.termination.find("iteration") != std::string::npos;
@@ -217,10 +218,14 @@ std::string TransformText(const ShapeTransform& t) {
 std::string AlignedText(const RegistrationResult& registration, const ShapeAlignment& alignment) {
   RegistrationResult final_transform = registration;
   final_transform.transform = alignment.transform;
-  final_transform.sigma = alignment.sigma;
+  final_transform.sigma = alignment.settled ? alignment.sigma : Eigen::Vector3d::Zero();
   const ShapeTransform& t = alignment.transform;
   const Eigen::Vector3d& sigma = alignment.sigma;
   std::string s = "aligned it: " + final_transform.Describe();
+  // The curvature's sigmas describe the chosen placement alone; where others fit about as well
+  // they read as certainty (the notched block turned by 30 degrees "aligned" by -125 degrees with
+  // "sigma 1.5 deg, 0.8 and 0.4 mm").
+  if (!alignment.settled) s += " (not settled: " + alignment.unsettled_by + ")";
   // Placements the whole graph fits as well: the sigmas above are the curvature at the chosen
   // one and do not show them (rect2 given in millimetres, one sticking push: turned by -88.7
   // degrees "sigma 1.0 deg", with turns of 35 and 63 degrees within 2 in cost; the truth is 0).
@@ -586,6 +591,10 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
   // still moving lost to worse ones (a rect1 recording with its mesh turned by 37 degrees:
   // the right turn 462.6 at the cap, 429.2 converged; the finger 4.3 mm larger, 436.7, won).
   // Each placement's graph cost and its transform refined by the graph (the shape frame).
+  bool last_stalled = false;     // the last framed_cost's solve stalled
+  bool best_stalled = false;     // the winning placement's solve stalled
+  std::vector<std::string> stalled_losers;  // turns (deg) of placements that lost on a stalled solve
+  std::string best_label;
   auto framed_cost = [&](const push::Trajectory& base, const ShapeTransform& t, ShapeTransform* refined,
                          const EstimatorConfig& solve) {
     RegistrationResult r = *registration;
@@ -596,7 +605,9 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
     frame.centroid = geometry::CoreCentroid(framed.object.shape);
     frame.sigma_centroid = options.centroid_prior * geometry::RadiusAbout(framed.object.shape, frame.centroid);
     frame.rotation = registration->rotation_observable;
-    const double cost = EstimateBatch(framed, model, solve, &frame).solver.final_cost;
+    const EstimationResult framed_result = EstimateBatch(framed, model, solve, &frame);
+    const double cost = framed_result.solver.final_cost;
+    last_stalled = framed_result.solver.stalled;
     *refined = t;
     refined->pose = geometry::Compose(frame.frame, t.pose);
     return cost;
@@ -611,6 +622,18 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
     }
     ShapeTransform best, refined;
     double best_cost = framed_cost(judged, registration->transform, &best, quick);
+    best_stalled = last_stalled;
+    best_label = internal::Format("%.1f", registration->transform.pose.theta * 180.0 / M_PI);
+    // A stalled solve ends where a residual jumps, not at a minimum: its cost ranks nothing (the
+    // notched block turned by 30 degrees: the placement near the truth stalled at 1994.8 against
+    // 460.8 for one turned by -131 degrees, and the true shape itself costs 556.8).
+    auto stall_note = [&] {
+      return std::string(last_stalled ? " (its solve stalled at a residual that jumps: no minimum, no comparison)" : "");
+    };
+    if (best_stalled) {
+      alignment.notes.push_back(internal::Format("the best placement by the contacts, turned by %s deg: graph cost %.1f", best_label.c_str(),
+                                                 best_cost) + stall_note());
+    }
     std::vector<std::pair<ShapeTransform, double>> ranked{{best, best_cost}};  // every placement's graph cost
     // The shape as given competes too: the contacts alone can misjudge a push the model does
     // not describe (a finger wedged between two walls under bimodal noise misfired so). As
@@ -635,11 +658,17 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
       ranked.emplace_back(refined, cost);
       std::snprintf(text, sizeof text, "alternative placement turned by %.1f deg, shifted by (%.1f, %.1f) mm: graph cost %.1f "
                     "against %.1f", alt.pose.theta * 180.0 / M_PI, alt.pose.x * 1e3, alt.pose.y * 1e3, cost, best_cost);
-      alignment.notes.push_back(text);
+      alignment.notes.push_back(text + stall_note());
+      const std::string label = internal::Format("%.1f", alt.pose.theta * 180.0 / M_PI);
       if (cost < best_cost) {
+        if (best_stalled && !identity_wins) stalled_losers.push_back(best_label);
         best_cost = cost;
         best = refined;
+        best_stalled = last_stalled;
+        best_label = label;
         identity_wins = false;
+      } else if (last_stalled) {
+        stalled_losers.push_back(label);
       }
     }
     // Wrong units (or a mirror) and nothing else is the likelier mistake: the file's frame at the
@@ -870,6 +899,25 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
     IncrementalEstimator inc(*working, model, config);
     while (!inc.Done()) inc.Update();
     result = inc.Finish();
+  }
+  // Whether the recording settles a placement used or suggested for a misfit, once
+  // the frame check (batch: after the estimate as given) has decided (the units alone and
+  // the shape as given are the file's own frame, not a placement).
+  if (registration && (align || misfit) && !units_win && (!identity_wins || frame_wins)) {
+    std::vector<std::string> open;
+    if (registration->ambiguous) open.push_back("the contacts fit other placements about as well");
+    if (!alignment.ties.empty()) open.push_back("the whole graph fits others about as well");
+    if (!stalled_losers.empty()) {
+      std::string which;
+      for (std::size_t k = 0; k < stalled_losers.size(); ++k)
+        which += (k == 0 ? "" : k + 1 == stalled_losers.size() ? " and " : ", ") + stalled_losers[k];
+      open.push_back(internal::Format("the solve%s of the placement%s turned by %s deg stalled, so the graph's cost does not rank %s",
+                                      stalled_losers.size() > 1 ? "s" : "", stalled_losers.size() > 1 ? "s" : "",
+                                      which.c_str(), stalled_losers.size() > 1 ? "them" : "it"));
+    }
+    if (best_stalled) open.push_back("this placement's own solve stalled");
+    alignment.settled = open.empty();
+    for (std::size_t k = 0; k < open.size(); ++k) alignment.unsettled_by += (k ? "; " : "") + open[k];
   }
   if (alignment.checked && !alignment.check.fits) {
     std::string what = "the object's shape does not fit this recording as given (" + alignment.check.Describe() + ")";

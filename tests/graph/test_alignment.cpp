@@ -105,7 +105,8 @@ TEST(Alignment, MisframedShapesAreAlignedAndEstimatedAsWellAsTheTrueOne) {
                                 {"2 cm, -1.5 cm", {0.02, -0.015, 0}, 1.0},
                                 {"mm, -60 deg, 1 cm", {0.01, 0.004, -M_PI / 3}, 0.001}};
   std::vector<double> outlines, ratios, off_ratios;
-  int cases = 0, flagged = 0, aligned_count = 0, ambiguous_count = 0, weak_count = 0;
+  int cases = 0, flagged = 0, aligned_count = 0, ambiguous_count = 0, weak_count = 0, settled_count = 0;
+  std::vector<double> settled_outlines;
   for (unsigned seed = 2; seed <= 4; ++seed) {
     const push::Trajectory truth = NotchedPush(1.1 * seed, 0.006 * ((seed % 3) - 1.0), seed);
     EstimatorConfig cfg = ApplyMeasurementSigmas({}, *truth.measurement_sigmas);
@@ -149,7 +150,11 @@ TEST(Alignment, MisframedShapesAreAlignedAndEstimatedAsWellAsTheTrueOne) {
         ambiguous_count += ambiguous ? 1 : 0;
         if (ambiguous) {
           EXPECT_TRUE(HasWarning(aligned, "does not settle the placement")) << m.name;
+          // and gives no sigma for the placement, which is only its curvature there.
+          EXPECT_FALSE(a.settled) << m.name;
+          EXPECT_TRUE(HasWarning(aligned, "(not settled: ")) << m.name;
         }
+        settled_count += a.settled ? 1 : 0;
         // And where they leave a direction to the centroid prior, that another size would fit too.
         const bool weak = std::any_of(a.notes.begin(), a.notes.end(), [](const std::string& n) {
           return n.rfind("the contacts do not fix the position along", 0) == 0;
@@ -162,10 +167,12 @@ TEST(Alignment, MisframedShapesAreAlignedAndEstimatedAsWellAsTheTrueOne) {
         const double outline = OutlineDistance(
             geometry::TransformShape(t.object.shape, a.transform.pose, a.transform.scale, a.transform.mirrored), truth.object.shape);
         outlines.push_back(outline);
+        if (a.settled) settled_outlines.push_back(outline);
         ratios.push_back(aligned_rms / rms);
         std::printf(": transform (%6.2f mm, %6.2f mm, %7.2f deg, scale %g) +- (%.2f mm, %.2f mm, %.2f deg); outline error %5.2f mm",
                     a.transform.pose.x * 1e3, a.transform.pose.y * 1e3, a.transform.pose.theta * 180 / M_PI, a.transform.scale,
                     a.sigma.x() * 1e3, a.sigma.y() * 1e3, a.sigma.z() * 180 / M_PI, outline * 1e3);
+        if (!a.settled) std::printf(" (not settled: %s)", a.unsettled_by.c_str());
       }
       off_ratios.push_back(raw.metrics.at("object_position_rms") / rms);
       std::printf("; object RMS %.3f mm (true shape %.3f mm, alignment off %.3f mm%s)\n", aligned_rms * 1e3, rms * 1e3,

@@ -90,6 +90,9 @@ struct SolverStats {
   double mean_update_time_s = 0.0;
   std::string covariance_status = "not computed";
   std::string name = "chain";           ///< which solver ran: "ceres" or "chain" (ChainSolver)
+  /// Batch: the last stage stopped on a stall (a residual that jumps next to the current point;
+  /// the warnings say which), so final_cost is no minimum.
+  bool stalled = false;
   std::vector<double> update_times_s;   ///< incremental: each update's wall time, in order
   /// The chain solver's profile of the batch's final stage: wall time (s) in residual and
   /// Jacobian evaluation with the J^T J accumulation and in factorizations and solves, and the
@@ -117,6 +120,12 @@ struct ShapeAlignment {
   /// turned or shifted by more than 3 degrees or 3 mm): one push often cannot tell them apart,
   /// and `sigma` (the curvature at the chosen one) does not say so.
   std::vector<ShapeTransform> ties;
+  /// False when the recording leaves the placement open (aligned or suggested): the contacts fit
+  /// several placements about as well (a straight stretch of the outline touched), the whole
+  /// graph ties (`ties`), or a competing placement's solve stalled, so its cost is no comparison.
+  /// `sigma` is then the curvature at the chosen placement only, and `unsettled_by` says why.
+  bool settled = true;
+  std::string unsettled_by;
   std::vector<std::string> notes;  ///< registration's notes: symmetry, weak directions, ambiguity
 };
 
