@@ -158,7 +158,9 @@ struct DemoOptions {
 void RunEstimationDemo(const DemoOptions& o) {
   const auto t_start = std::chrono::steady_clock::now();
   push::PushPlan plan;
-  plan.object = {geometry::LoadShapeJson(o.data_dir + "/shapes/notched_block.json"), /*mass=*/0.5, /*mu_surface=*/0.3};
+  plan.object.shape = geometry::LoadShapeJson(o.data_dir + "/shapes/notched_block.json");
+  plan.object.mass = 0.5;
+  plan.object.mu_surface = 0.3;
   plan.finger = {geometry::LoadShapeJson(o.data_dir + "/shapes/disk_finger_5mm.json"), /*mu_contact=*/0.4};
   MakeParentFolder(o.svg_path);
   evaluation::WriteSvgFile(o.svg_path, "");  // an unwritable picture path fails now, not after the solves

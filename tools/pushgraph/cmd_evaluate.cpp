@@ -121,7 +121,9 @@ void RunEvaluate(const EvaluateOptions& o) {
     if (o.object.empty() || o.finger.empty() || !(o.mass > 0.0) || !(o.mu >= 0.0))
       throw CliError("--object, --finger, --mass and --mu go together (they describe every MIT recording)");
     evaluation::ObjectModel m;
-    m.object = {LoadShapeArgument(o.object, "--object"), o.mass, o.mu};
+    m.object.shape = LoadShapeArgument(o.object, "--object");
+    m.object.mass = o.mass;
+    m.object.mu_surface = o.mu;
     m.finger.shape = LoadShapeArgument(o.finger, "--finger");
     options.object_override = m;
   }
@@ -131,7 +133,9 @@ void RunEvaluate(const EvaluateOptions& o) {
   if (o.simulate > 0 || o.simulate_multi > 0) {
     if (!(o.sim_mass > 0.0) || !(o.sim_mu > 0.0) || !(o.sim_mu_contact >= 0.0))
       throw CliError("--sim-mass and --sim-mu must be > 0, --sim-mu-contact >= 0");
-    options.simulation.object = {LoadShapeArgument(o.sim_object, "--sim-object"), o.sim_mass, o.sim_mu};
+    options.simulation.object.shape = LoadShapeArgument(o.sim_object, "--sim-object");
+    options.simulation.object.mass = o.sim_mass;
+    options.simulation.object.mu_surface = o.sim_mu;
     options.simulation.finger = {LoadShapeArgument(o.sim_finger, "--sim-finger"), o.sim_mu_contact};
     options.simulation.name = "sim:" + fs::path(o.sim_object).stem().string();
     options.multi_contact_simulation = options.simulation;

@@ -108,7 +108,9 @@ void Run(const SimulateOptions& o) {
     throw CliError("--outliers must be a probability in [0, 1] (got " + FormatDouble(o.outliers) + ")");
   NonNegative(o.occlusion_scale, "--occlusion-scale");
 
-  plan.object = {LoadShapeArgument(o.object_path, "--object"), o.mass, o.mu_surface};
+  plan.object.shape = LoadShapeArgument(o.object_path, "--object");
+  plan.object.mass = o.mass;
+  plan.object.mu_surface = o.mu_surface;
   plan.finger = {LoadShapeArgument(o.finger_paths.empty() ? o.finger_path : o.finger_paths[0],
                                    o.finger_paths.empty() ? "--finger" : "--fingers"),
                  o.mu_contact};
