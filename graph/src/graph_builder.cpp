@@ -383,8 +383,11 @@ const char* FactorTypeName(FactorType t) {
 }
 
 std::string GraphBuilder::Describe(ceres::ResidualBlockId id) const {
-  const auto it = origin_.find(id);
-  if (it == origin_.end()) return "a marginal prior or unnamed factor";
+  auto it = origin_.find(id);
+  if (it == origin_.end()) {
+    it = warm_origin_.find(id);
+    if (it == warm_origin_.end()) return "a marginal prior or unnamed factor";
+  }
   const auto [type, step] = it->second;
   std::string s = std::string(FactorTypeName(type)) + " factor";
   if (step >= 0 && step < static_cast<int>(steps_.size())) {
@@ -465,7 +468,10 @@ ceres::ResidualBlockId GraphBuilder::Add(ceres::Problem& problem, FactorType typ
     }
   }
   const ceres::ResidualBlockId id = problem.AddResidualBlock(cost, loss, blocks);
-  if (warm_start_) return id;
+  if (warm_start_) {
+    warm_origin_[id] = {type, type == FactorType::kPrior ? -1 : adding_step_};
+    return id;
+  }
   if (tags_ != nullptr) tags_->push_back({type, id});
   origin_[id] = {type, type == FactorType::kPrior ? -1 : adding_step_};
   return id;
@@ -905,6 +911,7 @@ int GraphBuilder::StageSteps(ceres::Problem& problem, int first, int last, int m
       }
     }
     iterations += Solve(warm, max_iterations, function_tolerance, (what + ", kinematics first").c_str()).iterations;
+    warm_origin_.clear();
   }
   for (int i = first; i < last; ++i) AddFactors(problem, i, kAll);
   return iterations;

@@ -436,6 +436,9 @@ class GraphBuilder {
   bool object_moving_seen_ = false;
   std::size_t object_poses_seen_ = 0;
   std::unordered_map<ceres::ResidualBlockId, std::pair<FactorType, int>> origin_;  ///< for Describe
+  /// The same for the staged start's temporary problem (StageSteps' kinematic stage), cleared
+  /// after its solve: its stall named "a marginal prior or unnamed factor".
+  std::unordered_map<ceres::ResidualBlockId, std::pair<FactorType, int>> warm_origin_;
   double frame_sigma_centroid_ = 0.01, frame_sigma_theta_ = 0.2;
 };
 
