@@ -100,9 +100,12 @@ struct FrameSetup {
   std::optional<Eigen::Matrix3d> covariance;  // out
 };
 
+// `warm`: the states to start from (an estimate of the same trajectory), instead of the staged
+// start from the measurements.
 EstimationResult EstimateBatch(const push::Trajectory& traj, Model model, const EstimatorConfig& cfg,
                                FrameSetup* frame = nullptr,
-                               std::shared_ptr<const geometry::ShapePairQuerier> querier = nullptr) {
+                               std::shared_ptr<const geometry::ShapePairQuerier> querier = nullptr,
+                               const EstimationResult* warm = nullptr) {
   internal::GraphBuilder builder(traj, model, cfg, std::move(querier));
   if (frame) builder.EnableShapeFrame(frame->centroid, frame->sigma_centroid, frame->sigma_theta, frame->rotation);
   if (cfg.estimate_c) builder.EnableCEstimation();
@@ -111,9 +114,16 @@ EstimationResult EstimateBatch(const push::Trajectory& traj, Model model, const 
   const auto start = std::chrono::steady_clock::now();
   auto owned = std::make_unique<ceres::Problem>();
   for (int i = 0; i < n; ++i) builder.Initialize(i, INFINITY);
-  builder.CarryObjectThroughGaps();
-  // One builder, one shape querier, the staging the incremental mode uses too.
-  int stage_iterations = builder.StageSteps(*owned, 0, n, cfg.max_iterations, cfg.function_tolerance, "batch solve");
+  int stage_iterations = 0;
+  if (warm != nullptr && static_cast<int>(warm->states.size()) == n) {
+    for (int i = 0; i < n; ++i) builder.SetState(i, warm->states[i]);
+    builder.SetSharedParameters(warm->c, warm->mu);
+    for (int i = 0; i < n; ++i) builder.AddFactors(*owned, i, internal::GraphBuilder::kAll);
+  } else {
+    builder.CarryObjectThroughGaps();
+    // One builder, one shape querier, the staging the incremental mode uses too.
+    stage_iterations = builder.StageSteps(*owned, 0, n, cfg.max_iterations, cfg.function_tolerance, "batch solve");
+  }
   internal::SolveOutcome summary = builder.Solve(*owned, cfg.max_iterations, cfg.function_tolerance, "batch solve");
   // Contact features fixed at the start that the solution no longer touches: the graph again
   // with the features at the solution (GraphBuilder::FeatureChoicesChanged).
@@ -158,6 +168,7 @@ EstimationResult EstimateBatch(const push::Trajectory& traj, Model model, const 
   r.solver.linear_solve_time_s = summary.linear_solve_s;
   r.solver.factor_flops = summary.factor_flops;
   r.solver.stalled = summary.stalled;
+  r.solver.at_iteration_limit = !summary.converged && !summary.stalled;
   if (!summary.converged) {
     // Ceres and the chain solver both say "iteration limit" in their own words: said once.
     const bool at_limit = summary.termination.find("iteration") != std::string::npos;
@@ -560,6 +571,10 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
   // ellip1: at most 11.5, 0.0138 a step at worst, and 0.0056 on the other 2055-step push). A 40 mm
   // shift of rect1's mesh gained 0.23 a step. So the margin is also 0.02 a step.
   constexpr double kFrameMarginPerStep = 0.02;
+  // The frame check's solve, warm from the estimate as given, stops here: it only has to tell
+  // whether freeing the frame gains the margin (on the 2061-step ellip1 recording it crept from
+  // 79.1 to 51.0 over 300 iterations, 5.1 s, against a margin of 41).
+  constexpr int kFrameCheckIterations = 60;
   // Within the gap tolerance, but one placement (not several alike) fits the contacts clearly
   // better: the whole graph decides that too, the shape as given winning ties. (A rect1
   // recording with its mesh turned by 37 degrees was only suspected: 1.73 mm against 1.09 mm
@@ -592,11 +607,12 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
   // the right turn 462.6 at the cap, 429.2 converged; the finger 4.3 mm larger, 436.7, won).
   // Each placement's graph cost and its transform refined by the graph (the shape frame).
   bool last_stalled = false;     // the last framed_cost's solve stalled
+  bool last_capped = false;      // or stopped at its iteration limit
   bool best_stalled = false;     // the winning placement's solve stalled
   std::vector<std::string> stalled_losers;  // turns (deg) of placements that lost on a stalled solve
   std::string best_label;
   auto framed_cost = [&](const push::Trajectory& base, const ShapeTransform& t, ShapeTransform* refined,
-                         const EstimatorConfig& solve) {
+                         const EstimatorConfig& solve, const EstimationResult* start = nullptr) {
     RegistrationResult r = *registration;
     r.transform = t;
     push::Trajectory framed = base;
@@ -605,9 +621,10 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
     frame.centroid = geometry::CoreCentroid(framed.object.shape);
     frame.sigma_centroid = options.centroid_prior * geometry::RadiusAbout(framed.object.shape, frame.centroid);
     frame.rotation = registration->rotation_observable;
-    const EstimationResult framed_result = EstimateBatch(framed, model, solve, &frame);
+    const EstimationResult framed_result = EstimateBatch(framed, model, solve, &frame, nullptr, start);
     const double cost = framed_result.solver.final_cost;
     last_stalled = framed_result.solver.stalled;
+    last_capped = framed_result.solver.at_iteration_limit;
     *refined = t;
     refined->pose = geometry::Compose(frame.frame, t.pose);
     return cost;
@@ -780,31 +797,38 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
                            registration->fits_as_given && !misfit && !suspect && !registration->weak_directions.empty();
   double frame_given_cost = 0.0, frame_cost = 0.0, frame_moved = 0.0;
   ShapeTransform frame_refined;
-  if (frame_check) {
+  // Decides the frame check from the estimate as given: the frame is freed there (a warm start:
+  // its cost can only fall, where a solve from the measurements with the frame free ended worse
+  // than the one with it fixed, 403.4 against 386.4, and took as long as the estimate itself);
+  // true when the frame wins.
+  auto decide_frame = [&](const EstimationResult& given) {
     try {
-      frame_cost = framed_cost(trajectory, ShapeTransform{}, &frame_refined, quick);
+      EstimatorConfig frame_solve = quick;
+      frame_solve.max_iterations = std::min(quick.max_iterations, kFrameCheckIterations);
+      frame_cost = framed_cost(trajectory, ShapeTransform{}, &frame_refined, frame_solve, &given);
       frame_moved = internal::registration::OutlineDisplacement(trajectory.object.shape, frame_refined);
     } catch (const std::exception& e) {
       // A check, not the estimate: a solve with the frame free that fails leaves the shape as given.
       alignment.notes.push_back(std::string("frame check skipped: ") + e.what());
       frame_check = false;
+      return false;
     }
-  }
-  // Decides the frame check once the cost as given is known; true when the frame wins.
-  auto decide_frame = [&](double given_cost, std::size_t steps) {
+    const double given_cost = given.solver.final_cost;
+    const std::size_t steps = given.states.size();
     frame_given_cost = given_cost;
     const double margin = std::max(kFrameMargin, kFrameMarginPerStep * static_cast<double>(steps));
     alignment.notes.push_back(internal::Format(
-        "frame check: graph cost %.1f as given, %.1f with the frame free (it moves the outline by %.1f mm; "
+        "frame check: graph cost %.1f as given, %.1f with the frame free%s (it moves the outline by %.1f mm; "
         "it is used when it gains more than %.1f, on %zu steps, and moves the outline by more than %.1f mm)",
-        frame_given_cost, frame_cost, frame_moved * 1e3, margin, steps, registration->check.tolerance * 1e3));
+        frame_given_cost, frame_cost, last_capped ? internal::Format(" after %d iterations from there", kFrameCheckIterations).c_str() : "",
+        frame_moved * 1e3, margin, steps, registration->check.tolerance * 1e3));
     frame_wins = frame_cost < frame_given_cost - margin && frame_moved > registration->check.tolerance;
     if (frame_wins) registration->transform = CanonicalTransform(frame_refined, trajectory.object.shape, registration->symmetry_order);
     return frame_wins;
   };
   if (frame_check && mode != Mode::kBatch) {
     const EstimationResult given = EstimateBatch(trajectory, model, quick);
-    decide_frame(given.solver.final_cost, given.states.size());
+    decide_frame(given);
   }
   bool align = registration && (config.align_shape == Align::kOn ||
                                 (config.align_shape == Align::kAuto && placeable && !size_wins && !identity_wins) ||
@@ -862,7 +886,7 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
   if (mode == Mode::kBatch) querier = internal::GraphBuilder::MakeQuerier(*working, config);
   if (mode == Mode::kBatch && frame_check) {
     result = EstimateBatch(*working, model, config, nullptr, querier);
-    if (decide_frame(result.solver.final_cost, result.states.size())) {
+    if (decide_frame(result)) {
       align = true;
       use_alignment();
       querier = internal::GraphBuilder::MakeQuerier(*working, config);

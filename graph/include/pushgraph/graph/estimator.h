@@ -93,6 +93,8 @@ struct SolverStats {
   /// Batch: the last stage stopped on a stall (a residual that jumps next to the current point;
   /// the warnings say which), so final_cost is no minimum.
   bool stalled = false;
+  /// Batch: the last stage stopped at its iteration limit (max_iterations) before converging.
+  bool at_iteration_limit = false;
   std::vector<double> update_times_s;   ///< incremental: each update's wall time, in order
   /// The chain solver's profile of the batch's final stage: wall time (s) in residual and
   /// Jacobian evaluation with the J^T J accumulation and in factorizations and solves, and the
