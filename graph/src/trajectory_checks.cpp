@@ -233,6 +233,24 @@ void ValidateTrajectory(const push::Trajectory& traj) {
   if (traj.object.shape.empty()) throw GraphError("trajectory: object.shape is missing or empty");
   if (traj.finger.shape.empty()) throw GraphError("trajectory: finger.shape is missing or empty");
   ValidateFingers(traj);
+  // The object's and fingers' parameters as the file format bounds them (a trajectory built in
+  // code or from a Python dict skips the file reader: mass -1 or NaN and mu_surface NaN were
+  // estimated as if valid, mu_surface 50 gave forces of 107 N); a mass or mu_surface of 0 is
+  // "unknown" there (QS then leaves out the load factor and says so).
+  auto in_range = [](double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; };
+  if (!in_range(traj.object.mass, 0.0, 1e6))
+    throw GraphError("trajectory: object.mass must be in (0, 1e6] kg (0: unknown), got " + Format("%.9g", traj.object.mass));
+  if (!in_range(traj.object.mu_surface, 0.0, 10.0))
+    throw GraphError("trajectory: object.mu_surface must be in [0, 10] (0: unknown), got " + Format("%.9g", traj.object.mu_surface));
+  if (!(std::isfinite(traj.object.gravity) && traj.object.gravity > 0.0))
+    throw GraphError("trajectory: object.gravity must be > 0 m/s^2, got " + Format("%.9g", traj.object.gravity));
+  if (!in_range(traj.finger.mu_contact, 0.0, 10.0))
+    throw GraphError("trajectory: finger.mu_contact must be in [0, 10], got " + Format("%.9g", traj.finger.mu_contact));
+  for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k) {
+    if (!in_range(traj.extra_fingers[k].finger.mu_contact, 0.0, 10.0))
+      throw GraphError("trajectory: fingers[" + std::to_string(k + 1) + "].mu_contact must be in [0, 10], got " +
+                       Format("%.9g", traj.extra_fingers[k].finger.mu_contact));
+  }
   const auto& m = traj.measured;
   for (std::size_t i = 0; i < m.object_pose.size(); ++i) {
     CheckFinite(std::isfinite(m.object_pose[i].t) && m.object_pose[i].pose.vector().allFinite(), "object_pose", i);

@@ -409,6 +409,14 @@ std::string TrajectoryToJson(const Trajectory& t, int indent) {
     throw IoError("trajectory JSON: object.pressure must be uniform (the format has no other)");
   if (t.object.gravity != limit_surface::kStandardGravity)
     throw IoError("trajectory JSON: object.gravity must be the standard 9.80665 m/s^2 (the format has no field for it)");
+  // What the reader requires, refused here rather than written into a file it then refuses.
+  auto friction_ok = [](double mu) { return std::isfinite(mu) && mu >= 0.0 && mu <= 10.0; };
+  if (!(std::isfinite(t.object.mass) && t.object.mass > 0.0))
+    throw IoError("trajectory JSON: object.mass must be > 0 kg (the format has no unknown mass), got " + std::to_string(t.object.mass));
+  if (!friction_ok(t.object.mu_surface))
+    throw IoError("trajectory JSON: object.mu_surface must be in [0, 10], got " + std::to_string(t.object.mu_surface));
+  if (!friction_ok(t.finger.mu_contact))
+    throw IoError("trajectory JSON: finger.mu_contact must be in [0, 10], got " + std::to_string(t.finger.mu_contact));
   json object = {{"shape", ShapeJson(t.object.shape)},
                  {"mass", t.object.mass},
                  {"mu_surface", t.object.mu_surface},

@@ -654,6 +654,24 @@ TEST(Estimator, BadTrajectoriesGetClearErrors) {
   auto no_shape = t;
   no_shape.finger.shape = geometry::Shape();
   EXPECT_NE(message(no_shape).find("finger.shape"), std::string::npos);
+  // Object and finger parameters out of the file format's bounds (a trajectory built in code or
+  // from a Python dict skips the file reader; these were estimated as if valid): named.
+  for (const double mass : {-1.0, double(NAN), 1e9}) {
+    auto bad = t;
+    bad.object.mass = mass;
+    EXPECT_NE(message(bad).find("object.mass must be"), std::string::npos) << mass;
+  }
+  for (const double mu : {-0.3, double(NAN), 50.0}) {
+    auto bad = t;
+    bad.object.mu_surface = mu;
+    EXPECT_NE(message(bad).find("object.mu_surface must be in [0, 10]"), std::string::npos) << mu;
+    bad = t;
+    bad.finger.mu_contact = mu;
+    EXPECT_NE(message(bad).find("finger.mu_contact must be in [0, 10]"), std::string::npos) << mu;
+  }
+  auto unknown_mass = t;  // 0: unknown (QS leaves out the load factor and says so)
+  unknown_mass.object.mass = 0.0;
+  EXPECT_EQ(message(unknown_mass), "no error");
   // A probe file in millimetres (radius 5 read as 5 m) would hold the object at every sample; the
   // right radius (5 mm) passes, and so does a wrong one within the push's reach (0.1 m: the check
   // is for units; the shape check and the self-diagnosis judge sizes).

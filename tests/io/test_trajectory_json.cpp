@@ -40,6 +40,15 @@ TEST(TrajectoryJson, RoundTripIsExact) {
     EXPECT_EQ(u.measured.object_pose[1].pose.x, t.measured.object_pose[1].pose.x);
     EXPECT_EQ(u.object.mass, 0.8374);
   }
+  // The writer refuses what the reader would (a mass of -1 was written, then refused on reading).
+  for (const double mass : {-1.0, 0.0, double(NAN)}) {
+    auto bad = t;
+    bad.object.mass = mass;
+    EXPECT_THROW(TrajectoryToJson(bad, -1), IoError) << mass;
+  }
+  auto bad_mu = t;
+  bad_mu.object.mu_surface = 50.0;
+  EXPECT_THROW(TrajectoryToJson(bad_mu, -1), IoError);
 }
 
 TEST(TrajectoryJson, MissingStreamsAreEmptyAndOutOfOrderSamplesAreSorted) {
