@@ -445,6 +445,31 @@ static std::optional<std::string> ToleranceNote(const EstimatorConfig& c) {
                           c.function_tolerance, c.function_tolerance / d.function_tolerance, d.function_tolerance);
 }
 
+// Whether every stream of the ground truth equals the measured one sample for sample.
+static bool GroundTruthIsTheMeasurements(const push::Trajectory& t) {
+  if (!t.ground_truth) return false;
+  auto same_poses = [](const std::vector<push::PoseSample>& a, const std::vector<push::PoseSample>& b) {
+    return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](const push::PoseSample& x, const push::PoseSample& y) {
+      return x.t == y.t && x.pose.x == y.pose.x && x.pose.y == y.pose.y && x.pose.theta == y.pose.theta;
+    });
+  };
+  auto same_points = [](const auto& a, const auto& b, auto value) {
+    return std::equal(a.begin(), a.end(), b.begin(), b.end(),
+                      [&](const auto& x, const auto& y) { return x.t == y.t && value(x) == value(y); });
+  };
+  auto point = [](const push::PointSample& s) { return s.point; };
+  auto force = [](const push::ForceSample& s) { return s.force; };
+  const push::Streams &m = t.measured, &g = *t.ground_truth;
+  bool same = same_poses(m.object_pose, g.object_pose) && same_poses(m.finger_pose, g.finger_pose) &&
+              same_points(m.contact_point, g.contact_point, point) && same_points(m.force, g.force, force);
+  for (const auto& e : t.extra_fingers) {
+    same = same && e.ground_truth && same_poses(e.measured.finger_pose, e.ground_truth->finger_pose) &&
+           same_points(e.measured.contact_point, e.ground_truth->contact_point, point) &&
+           same_points(e.measured.force, e.ground_truth->force, force);
+  }
+  return same;
+}
+
 EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode mode,
                           const EstimatorConfig& config) {
   ValidateConfig(config);
@@ -456,15 +481,29 @@ EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode 
   const push::Trajectory& input = cleaned ? *cleaned : *before_glitches;
   const std::optional<std::string> time_unit = internal::TimeUnitNote(trajectory);
   const std::optional<std::string> length_unit = internal::ShapeSizeNote(trajectory);
-  const char* unit_doubt = time_unit     ? "time stamps that read as milliseconds"
-                           : length_unit ? "lengths that read as centimetres or millimetres"
-                                         : nullptr;
+  // A step of the object's tracker is no placement evidence either: a hostile user's rect1 with a
+  // 50 mm step had its true mesh "aligned" by a turn of 18.4 degrees to explain it.
+  const std::optional<std::string> tracker_step = internal::TrackerStepNote(trajectory);
+  const char* unit_doubt = time_unit      ? "time stamps that read as milliseconds"
+                           : length_unit  ? "lengths that read as centimetres or millimetres"
+                           : tracker_step ? "a step of the object's tracker"
+                                          : nullptr;
   EstimationResult r = EstimateValidated(input, model, mode, config, unit_doubt);
   // A covariance failure was only in RESULT.json's solver.covariance (NEES NaN, nothing said).
   if (config.covariance && r.solver.covariance_status.find("failed") != std::string::npos)
     r.warnings.push_back("covariances not computed: " + r.solver.covariance_status +
                          "; the states are estimated, their sigmas and NEES are not (a noise model far from the data's, "
                          "such as sigmas or accelerations near zero, makes the information matrix numerically singular)");
+  if (!r.metrics.empty() && GroundTruthIsTheMeasurements(trajectory)) {
+    // A recording's "ground truth" that is its own measurements (mit-import, an MIT file read
+    // directly) scored the estimate against the raw data: measured_*_rms 0 and the estimate
+    // "0.7 mm off". Nothing to score against.
+    r.metrics.clear();
+    r.warnings.push_back("no metrics: the input's ground_truth is its own measurements (a recording, such as an MIT file "
+                         "or its mit-import), so there is nothing to score the estimate against; the paper's protocol "
+                         "adds noise to the recording and scores against it (pushgraph estimate --add-noise, pushgraph "
+                         "evaluate)");
+  }
   if (cleaned && !r.metrics.empty()) {
     // The raw tracker's errors are the stream as recorded, glitches included.
     for (const auto& [key, value] : ComputeMetrics(*before_glitches, r.states))
@@ -479,6 +518,7 @@ EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode 
   add(time_unit);
   add(internal::StreamOverlapNote(trajectory));
   add(internal::YawUnitNote(trajectory));
+  add(tracker_step);
   add(length_unit);
   if (!note.empty()) front.push_back(note);
   if (!glitch_note.empty()) front.push_back(glitch_note);
@@ -967,7 +1007,7 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
       }
       warnings.push_back(what + "; " + AlignedText(*registration, alignment) + also);
     } else if (misfit && unit_gate) {
-      warnings.push_back(what + "; not aligned on " + unit_doubt + " (the first warning): fix the units, then estimate "
+      warnings.push_back(what + "; not aligned on " + unit_doubt + " (the first warning): fix that, then estimate "
                                 "again (estimates may be worse than the raw measurements)");
     } else if (misfit && too_little) {
       warnings.push_back(what + internal::Format("; too little contact to place it by (%.2f s): not aligned, check the shape "

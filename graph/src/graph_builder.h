@@ -495,6 +495,8 @@ std::optional<push::Trajectory> DropObjectPoseGlitches(const push::Trajectory& t
 /// A warning when the object's yaw scatters by more than 0.2 rad about its centred running median
 /// or turns at a median 8 rad/s or more: a yaw in degrees.
 std::optional<std::string> YawUnitNote(const push::Trajectory& trajectory);
+/// A step of the object pose stream that stays (samples on each side agree): said, not repaired.
+std::optional<std::string> TrackerStepNote(const push::Trajectory& trajectory);
 /// A warning when the object's shape reaches more than 1 m from its centroid: a file in
 /// centimetres or millimetres throughout (shapes and positions agree, so nothing else sees it).
 std::optional<std::string> ShapeSizeNote(const push::Trajectory& trajectory);

@@ -22,9 +22,9 @@ std::string Format(const char* fmt, Args... args) {
 /// A step's time for messages: "0.068 s" as given, and for clock times (a recording's Unix
 /// time, where %g would print 1.46185921e+09 for every step of a push) to the millisecond with
 /// the time since the first step: "1461859211.061 s, 1.336 s after the first step".
-inline std::string StepTime(double t, double first) {
+inline std::string StepTime(double t, double first, const char* first_is = "the first step") {
   if (std::abs(t) < 1e5) return Format("%.9g s", t);
-  return Format("%.3f s, %.3f s after the first step", t, t - first);
+  return Format("%.3f s, %.3f s after %s", t, t - first, first_is);
 }
 
 /// The median (upper middle for an even count); 0 for an empty vector.

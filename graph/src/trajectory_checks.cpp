@@ -589,6 +589,60 @@ std::optional<push::Trajectory> DropObjectPoseGlitches(const push::Trajectory& t
   return out;
 }
 
+std::optional<std::string> TrackerStepNote(const push::Trajectory& traj) {
+  // A step of the object's tracker that stays (a re-initialization, a marker swap): the samples
+  // on each side agree among themselves, so the glitch test, which compares a sample with its
+  // neighbours, keeps them all; the estimate then follows the step and the shape check "aligned"
+  // the shape by 18 degrees to explain it (rect1 with its poses 50 mm off from the 100th on).
+  // A step: between two samples the position moves by most of the difference of the medians of
+  // the five samples on either side, and that difference exceeds 1 cm, ten times the tracker's
+  // scatter and twice the finger's motion over those ten samples (without a finger stream, the
+  // stream's own fastest motion).
+  const auto& s = traj.measured.object_pose;
+  const std::size_t n = s.size();
+  if (n < 12) return std::nullopt;
+  const CentredGaps gaps = CentredMedianGaps(s);
+  const double scatter = gaps.Scatter(gaps.position);
+  std::vector<double> speeds;
+  for (std::size_t i = 0, j = 0; i < n; ++i) {
+    while (j + 1 < n && s[j].t - s[i].t < 2.0 * gaps.half) ++j;
+    if (s[j].t - s[i].t >= gaps.half) speeds.push_back((s[j].pose.translation() - s[i].pose.translation()).norm() / (s[j].t - s[i].t));
+  }
+  const double fast = speeds.empty() ? 0.0 : Percentile95(speeds);
+  // The finger's motion over a time span (the median of up to five samples at each end): the
+  // object moves with it while pushed, and a step of the object's tracker is not in it.
+  const auto& fingers = traj.measured.finger_pose;
+  auto finger_at = [&](double t) {
+    const auto it = std::lower_bound(fingers.begin(), fingers.end(), t, [](const push::PoseSample& a, double v) { return a.t < v; });
+    const std::size_t k = static_cast<std::size_t>(it - fingers.begin());
+    std::vector<double> xs, ys;
+    for (std::size_t j = k >= 2 ? k - 2 : 0; j < fingers.size() && j < k + 3; ++j) xs.push_back(fingers[j].pose.x), ys.push_back(fingers[j].pose.y);
+    return Vec2(Median(xs), Median(ys));
+  };
+  double worst = 0.0;
+  std::size_t at = 0;
+  for (std::size_t i = 5; i + 5 <= n; ++i) {
+    std::vector<double> bx, by, ax, ay;
+    for (std::size_t k = 1; k <= 5; ++k) bx.push_back(s[i - k].pose.x), by.push_back(s[i - k].pose.y);
+    for (std::size_t k = 0; k < 5; ++k) ax.push_back(s[i + k].pose.x), ay.push_back(s[i + k].pose.y);
+    const double jump = std::hypot(Median(ax) - Median(bx), Median(ay) - Median(by));
+    const double span = s[i + 4].t - s[i - 5].t;
+    const double motion = fingers.size() >= 5 ? (finger_at(s[i + 4].t) - finger_at(s[i - 5].t)).norm() : fast * span;
+    const double allowed = std::max({0.01, 10.0 * scatter, 2.0 * motion});
+    const double single = (s[i].pose.translation() - s[i - 1].pose.translation()).norm();
+    if (jump > allowed && single > 0.7 * jump && jump > worst) worst = jump, at = i;
+  }
+  if (worst == 0.0) return std::nullopt;
+  const double dt = s[at].t - s[at - 1].t;
+  return Format("object_pose: the tracker steps by %.1f mm between samples %zu and %zu (t = %s -> %s, %.3g m/s) and "
+                "stays there: a re-initialized tracker or a swapped marker, not a motion of a pushed object. The estimate "
+                "follows both sides (and a shape check may turn or shift the shape to explain the step): cut the "
+                "recording there, or correct one side",
+                worst * 1e3, at - 1, at, StepTime(s[at - 1].t, s.front().t, "the stream's first").c_str(),
+                StepTime(s[at].t, s.front().t, "its first").c_str(),
+                dt > 0.0 ? worst / dt : INFINITY);
+}
+
 std::optional<std::string> YawUnitNote(const push::Trajectory& traj) {
   const auto& s = traj.measured.object_pose;
   if (s.size() < 7) return std::nullopt;

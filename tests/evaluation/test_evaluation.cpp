@@ -95,6 +95,7 @@ TEST_F(Evaluation, InputKindIsDecidedByContent) {
   push::Trajectory t;
   t.object.shape = geometry::Shape::Disk(0.05);
   t.finger.shape = geometry::Shape::Disk(0.005);
+  t.object.mass = 0.5;
   io::SaveTrajectoryJson(t, (dir_ / "traj.json").string());
   EXPECT_EQ(DetectInputKind((dir_ / "traj.json").string()), InputKind::kTrajectory);
   for (const std::string& bad : {Write("other.json", R"({"format": "something-else"})"), Write("list.json", "[1, 2]"),

@@ -314,14 +314,18 @@ TEST_F(EstimateCli, MeshFilesAreReadDirectly) {
   ASSERT_EQ(converted.status, 0) << converted.err;
   const nlohmann::json a = Load(dir() + "/direct.json"), b = Load(dir() + "/converted.json");
   // The same estimate up to the disk's radius from the mesh's rounded vertices (4.7 mm +- 1 um).
-  int compared = 0;
-  for (const char* key : {"object_position_rms", "finger_position_rms", "contact_rms"}) {
-    if (!b["metrics"].contains(key)) continue;
-    ++compared;
-    EXPECT_NEAR(a["metrics"][key].get<double>(), b["metrics"][key].get<double>(), 1e-3 * b["metrics"][key].get<double>()) << key;
+  // (A recording has no ground truth: the states are compared, not metrics.)
+  ASSERT_EQ(a["states"].size(), b["states"].size());
+  double largest = 0.0;
+  for (std::size_t i = 0; i < a["states"].size(); ++i) {
+    for (int k = 0; k < 2; ++k) {
+      largest = std::max(largest, std::abs(a["states"][i]["object_pose"][k].get<double>() -
+                                           b["states"][i]["object_pose"][k].get<double>()));
+      largest = std::max(largest, std::abs(a["states"][i]["finger_pose"][k].get<double>() -
+                                           b["states"][i]["finger_pose"][k].get<double>()));
+    }
   }
-  EXPECT_GE(compared, 2) << b["metrics"].dump();
-  EXPECT_EQ(a["states"].size(), b["states"].size());
+  EXPECT_LT(largest, 2e-5);
   std::ofstream(dir() + "/probe.stl") << "solid probe\nendsolid probe\n";
   const pushgraph::testing::ToolRun stl =
       Tool("estimate '" + h5 + "' --object " + dir() + "/probe.stl --finger " + dir() + "/tip.json" + mass + "-o " + dir() + "/x.json");
@@ -572,11 +576,15 @@ TEST_F(EstimateCli, MitRecordingWithAddedNoise) {
   EXPECT_NEAR(m["measured_object_rotation_rms"].get<double>(), 0.05, 0.015);
   EXPECT_LT(m["object_position_rms"].get<double>(), m["measured_object_position_rms"].get<double>());
   EXPECT_TRUE(std::ifstream(svg).good());
-  // Another seed, other noise; without --add-noise the clean recording is its own ground truth.
+  // Another seed, other noise; without --add-noise a recording has nothing to be scored against
+  // (its "ground truth" would be the measurements themselves: measured_*_rms 0, the estimate
+  // "0.7 mm off"): no metrics, and said why.
   ASSERT_EQ(Tool(common + " --add-noise bimodal --seed 5 -o " + out).status, 0);
   EXPECT_NE(Load(out)["metrics"]["measured_object_position_rms"].get<double>(), m["measured_object_position_rms"].get<double>());
-  ASSERT_EQ(Tool(common + " -o " + out).status, 0);
-  EXPECT_EQ(Load(out)["metrics"]["measured_object_position_rms"].get<double>(), 0.0);
+  const pushgraph::testing::ToolRun plain = Tool(common + " -o " + out);
+  ASSERT_EQ(plain.status, 0) << plain.err;
+  EXPECT_FALSE(Load(out).contains("metrics")) << Load(out)["metrics"].dump();
+  EXPECT_NE(plain.err.find("no metrics: the input's ground_truth is its own measurements"), std::string::npos) << plain.err;
   // MIT input needs the object's description; unknown content is named.
   pushgraph::testing::ToolRun bad = Tool("estimate '" + h5 + "' -o " + out);
   EXPECT_EQ(bad.status, 1);

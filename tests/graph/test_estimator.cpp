@@ -367,6 +367,15 @@ TEST(Estimator, ObjectTrackerGlitchesAreLeftOut) {
   const EstimationResult quick = Estimate(GeneratePush(fast), Model::kCp, Mode::kBatch);
   EXPECT_FALSE(HasWarning(quick, "tracker glitches")) << quick.warnings[0];
   EXPECT_FALSE(HasWarning(quick, "is it in degrees"));
+  EXPECT_FALSE(HasWarning(quick, "the tracker steps"));
+  EXPECT_FALSE(HasWarning(base, "the tracker steps"));
+  // A step that stays (a re-initialized tracker: every pose from the 12th on 50 mm off): its
+  // samples agree among themselves, so no glitch; the estimate followed it without a word.
+  push::Trajectory stepped = clean;
+  for (std::size_t i = 12; i < stepped.measured.object_pose.size(); ++i) stepped.measured.object_pose[i].pose.x += 0.05;
+  const EstimationResult st = Estimate(stepped, Model::kCp, Mode::kBatch);
+  EXPECT_TRUE(HasWarning(st, "object_pose: the tracker steps by 5")) << (st.warnings.empty() ? "" : st.warnings[0]);
+  EXPECT_TRUE(HasWarning(st, "between samples 11 and 12"));
 }
 
 // A yaw in degrees (read as radians it turns 57 times faster and scatters 57 times more) is named.
