@@ -421,8 +421,9 @@ normal (N, 2); with jacobians J_sd_object_pose, J_sd_finger_pose (N, 1, 3) and t
 J_object_point_object_pose ... J_finger_point_finger_pose (N, 2, 3).)doc");
 
   py::class_<geometry::DistanceField>(m, "DistanceField", R"doc(
-A sampled signed distance field of a shape (bilinear), checked against the exact queries at
-build time (max_error).
+A sampled signed distance field of a shape (bicubic), checked against the exact queries at
+build time (max_error: the largest error seen at the check's points, an estimate, not a bound;
+NaN with error_samples_per_cell=0).
 
     field = pushgraph.DistanceField(shape, resolution=1e-3)
     d, grad = field.evaluate(points, gradient=True)
@@ -463,7 +464,9 @@ build time (max_error).
           },
           "points"_a, "gradient"_a = false)
       .def_property_readonly("max_error", &geometry::DistanceField::max_error,
-                             "Largest |interpolated - exact| of the build-time check (inside the grid).")
+                             "Largest |interpolated - exact| seen at the build-time check's points (inside the grid): an "
+                             "estimate, not a bound (between those points up to 1.35 times it was measured); NaN when "
+                             "the check is off.")
       .def_property_readonly(
           "bounds",
           [](const geometry::DistanceField& f) { return BoxArray(f.grid_bounds()); },

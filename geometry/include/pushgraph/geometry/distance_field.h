@@ -36,7 +36,10 @@ class DistanceField {
   /// from the nearest grid point plus the distance to it (a conservative continuation).
   double Evaluate(const Vec2& point, Vec2* gradient = nullptr) const;
 
-  /// Largest |interpolated - exact| seen in the build-time check, and where it occurred.
+  /// Largest |interpolated - exact| seen in the build-time check, and where it occurred: an
+  /// estimate from the check's points, not a bound (between them the error can be larger: up
+  /// to 1.35 times it on a rounded box at resolution 0.03 in a sweep of 100000 points, 1.2
+  /// times on a notch at 0.01); NaN when the check is off (error_samples_per_cell 0).
   double max_error() const;
   Vec2 max_error_location() const;
   /// Grid size in samples.
