@@ -87,6 +87,7 @@ std::string ResultToJson(const graph::EstimationResult& r, int indent) {
   j["states"] = std::move(states);
   j["solver"] = {{"iterations", r.solver.iterations},
                  {"time_s", r.solver.time_s},
+                 {"total_time_s", r.solver.total_time_s},
                  {"final_cost", r.solver.final_cost},
                  {"updates", r.solver.updates},
                  {"max_update_time_s", r.solver.max_update_time_s},

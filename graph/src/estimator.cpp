@@ -472,6 +472,7 @@ static bool GroundTruthIsTheMeasurements(const push::Trajectory& t) {
 
 EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode mode,
                           const EstimatorConfig& config) {
+  const auto call_start = std::chrono::steady_clock::now();
   ValidateConfig(config);
   internal::ValidateTrajectory(trajectory);
   std::string note, glitch_note;
@@ -551,6 +552,7 @@ EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode 
                          ": the finger's path between them rests on the contacts and the motion prior, and the "
                          "diagnostics' other findings may come from that");
   }
+  r.solver.total_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - call_start).count();
   return r;
 }
 

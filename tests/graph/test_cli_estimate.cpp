@@ -86,6 +86,8 @@ TEST_F(EstimateCli, WritesTheResultFormatForEveryModelAndMode) {
       EXPECT_EQ(s.contains("force_cov"), forces);
       EXPECT_GT(j["solver"]["iterations"].get<int>(), 0);
       EXPECT_GE(j["solver"]["time_s"].get<double>(), 0.0);
+      // The whole call (shape check, estimate, diagnostics) includes the estimate.
+      EXPECT_GE(j["solver"]["total_time_s"].get<double>(), j["solver"]["time_s"].get<double>());
       EXPECT_GE(j["solver"]["final_cost"].get<double>(), 0.0);
       EXPECT_LT(j["metrics"]["object_position_rms"].get<double>(), j["metrics"]["measured_object_position_rms"].get<double>());
     }

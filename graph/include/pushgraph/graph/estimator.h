@@ -84,6 +84,10 @@ struct StateEstimate {
 struct SolverStats {
   int iterations = 0;      ///< LM iterations (summed over updates when incremental)
   double time_s = 0.0;     ///< wall time of solving and covariance estimation
+  /// Wall time of the whole Estimate call: the input checks, the shape check and registration
+  /// (and the placements it compares), the estimate and its self-diagnosis. Under align_shape
+  /// "auto" the shape check can take longer than the estimate itself (time_s leaves it out).
+  double total_time_s = 0.0;
   double final_cost = 0.0; ///< batch: final cost; incremental: cost of the last window
   int updates = 0;         ///< incremental updates (1 for batch)
   double max_update_time_s = 0.0;
