@@ -696,6 +696,12 @@ struct OnlineEstimator::Impl {
                        "arguments in Python): it decides contact gating and the load factor");
     }
     if (!std::isfinite(t) || !finite) throw GraphError(where() + " is not finite");
+    // The trajectory's bound (|t| <= 1e11 s: epoch seconds): one wild first time stamp (-1e300)
+    // was accepted and every later sample then refused as a clock jump.
+    if (std::abs(t) > push::kMaxTimeStamp) {
+      throw GraphError(where() + " is out of the supported range (|t| <= " + Precise(push::kMaxTimeStamp) +
+                       " s, epoch seconds): milliseconds or a corrupt time stamp?");
+    }
     // A second contact point of a finger at the same time is its second contact (a finger wedged
     // in a notch, a flat face along the object's).
     const bool contact = stream >= 1 && (stream - 1) % 3 == 1;

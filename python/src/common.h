@@ -77,18 +77,19 @@ inline py::array_t<double> NewArray(std::vector<py::ssize_t> shape) { return py:
 /// (x, y, theta) from a row.
 inline geometry::Pose2 PoseRow(const double* r) { return {r[0], r[1], r[2]}; }
 
-/// One pose from a sequence of three numbers (ValueError otherwise).
-inline geometry::Pose2 ToPose(const py::handle& object, const char* what) {
+/// One pose from a sequence of three numbers (ValueError otherwise; `finite`: non-finite values
+/// too, where the callee names the stream and time of one, as OnlineEstimator does).
+inline geometry::Pose2 ToPose(const py::handle& object, const char* what, bool finite = true) {
   const Array a = Rows(object, 3, what);
   if (a.shape(0) != 1) throw py::value_error(std::string(what) + ": expected one pose (x, y, theta)");
-  CheckFinite(a, what);
+  if (finite) CheckFinite(a, what);
   return PoseRow(a.data());
 }
 
-inline geometry::Vec2 ToVec2(const py::handle& object, const char* what) {
+inline geometry::Vec2 ToVec2(const py::handle& object, const char* what, bool finite = true) {
   const Array a = Rows(object, 2, what);
   if (a.shape(0) != 1) throw py::value_error(std::string(what) + ": expected one point (x, y)");
-  CheckFinite(a, what);
+  if (finite) CheckFinite(a, what);
   return {a.data()[0], a.data()[1]};
 }
 

@@ -214,17 +214,17 @@ void RegisterEstimation(py::module_& m) {
            }),
            "setup"_a, "model"_a, "config_json"_a, "contact_point"_a, "force"_a, "max_latency"_a)
       .def("add_object_pose",
-           [](Online& o, double t, const py::handle& pose) { return o.estimator->AddObjectPose(t, ToPose(pose, "pose")); })
+           [](Online& o, double t, const py::handle& pose) { return o.estimator->AddObjectPose(t, ToPose(pose, "pose", false)); })
       .def("add_finger_pose",
            [](Online& o, double t, const py::handle& pose, int finger) {
-             return o.estimator->AddFingerPose(t, finger, ToPose(pose, "pose"));
+             return o.estimator->AddFingerPose(t, finger, ToPose(pose, "pose", false));
            })
       .def("add_contact_point",
            [](Online& o, double t, const py::handle& p, int finger) {
-             return o.estimator->AddContactPoint(t, finger, ToVec2(p, "point"));
+             return o.estimator->AddContactPoint(t, finger, ToVec2(p, "point", false));
            })
       .def("add_force", [](Online& o, double t, const py::handle& f, int finger) {
-        return o.estimator->AddForce(t, finger, ToVec2(f, "force"));
+        return o.estimator->AddForce(t, finger, ToVec2(f, "force", false));
       })
       .def("update_due", [](const Online& o) { return o.estimator->UpdateDue(); })
       .def("update",

@@ -235,6 +235,14 @@ TEST(Online, RefusesBadAndLateSamples) {
   EXPECT_THROW(online.AddObjectPose(NAN, pose), GraphError);
   EXPECT_THROW(online.AddObjectPose(0.0, geometry::Pose2{NAN, 0.0, 0.0}), GraphError);
   EXPECT_THROW(online.AddForce(0.0, geometry::Vec2(INFINITY, 0.0)), GraphError);
+  // A wild first time stamp is refused (it was accepted, and every later sample then refused as
+  // a clock jump from it).
+  try {
+    online.AddObjectPose(-1e300, pose);
+    ADD_FAILURE() << "a time stamp of -1e300 s was accepted";
+  } catch (const GraphError& e) {
+    EXPECT_NE(std::string(e.what()).find("out of the supported range"), std::string::npos) << e.what();
+  }
   online.AddFingerPose(0.0, finger);
   EXPECT_THROW(online.Update(), GraphError);  // no object pose yet: nothing anchors the object
   online.AddObjectPose(0.0, pose);

@@ -101,6 +101,9 @@ def test_online_estimator_fed_from_python(push):
             assert len(state["object_pose"]) == 3
     with pytest.raises(pg.GraphError, match="not after the previous"):
         online.add_force(0.0, (1.0, 0.0))
+    # A non-finite value is a GraphError naming the stream and time (it was a bare ValueError).
+    with pytest.raises(pg.GraphError, match=r"streams\.finger_pose\[\d+\] at t = .* is not finite"):
+        online.add_finger_pose(1e3, (np.nan, 0.0, 0.0))
     result = online.finish()
     assert updates > 3 and len(result["t"]) > 100
     assert np.all(np.isfinite(result["object_pose"]))
