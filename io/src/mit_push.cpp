@@ -254,6 +254,17 @@ void Clean(std::vector<Row>* rows, const std::string& path, const char* name, Mi
   for (std::size_t i = 1; i < rows->size(); ++i) reordered += (*rows)[i][0] < (*rows)[i - 1][0];
   std::stable_sort(rows->begin(), rows->end(), [](const Row& a, const Row& b) { return a[0] < b[0]; });
   const std::size_t before = rows->size();
+  // A repeated time stamp keeps its first row; a repeat with other values is counted apart, with
+  // the largest difference (it was called a duplicate: a row 3 mm away was dropped as one).
+  int conflicting = 0;
+  double largest = 0.0;
+  for (std::size_t i = 1; i < rows->size(); ++i) {
+    const Row& a = (*rows)[i - 1];
+    const Row& b = (*rows)[i];
+    if (a[0] != b[0] || (a[1] == b[1] && a[2] == b[2] && a[3] == b[3])) continue;
+    ++conflicting;
+    largest = std::max({largest, std::abs(a[1] - b[1]), std::abs(a[2] - b[2]), std::abs(a[3] - b[3])});
+  }
   rows->erase(std::unique(rows->begin(), rows->end(), [](const Row& a, const Row& b) { return a[0] == b[0]; }), rows->end());
   const int dropped = static_cast<int>(before - rows->size());
   rec->samples_reordered += reordered;
@@ -282,7 +293,15 @@ void Clean(std::vector<Row>* rows, const std::string& path, const char* name, Mi
     }
   }
   if (reordered > 0) rec->notes.push_back(std::string(name) + ": sorted " + std::to_string(reordered) + " out-of-order samples");
-  if (dropped > 0) rec->notes.push_back(std::string(name) + ": dropped " + std::to_string(dropped) + " duplicate time stamps");
+  if (dropped > conflicting)
+    rec->notes.push_back(std::string(name) + ": dropped " + std::to_string(dropped - conflicting) + " duplicate samples");
+  if (conflicting > 0) {
+    std::ostringstream text;
+    text << name << ": dropped " << conflicting << " sample" << (conflicting == 1 ? "" : "s")
+         << " whose time stamp repeats with other values (the first row of each time kept; the largest difference "
+         << largest << " in a column)";
+    rec->notes.push_back(text.str());
+  }
 }
 
 double Wrap(double a) { return std::remainder(a, 2.0 * M_PI); }

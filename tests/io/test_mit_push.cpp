@@ -106,13 +106,24 @@ TEST_F(MitPush, SyntheticFaultsAreRepaired) {
   auto& obj = sets[1].second;
   std::swap(obj[10], obj[11]);                  // out of order
   obj.insert(obj.begin() + 20, obj[20]);        // duplicate time stamp
+  auto repeat = obj[40];                         // a repeated time with other values: 3 mm off
+  repeat[1] += 0.003;
+  obj.insert(obj.begin() + 41, repeat);
   for (std::size_t i = 120; i < obj.size(); ++i) obj[i][3] += M_PI / 2;    // tracker flip by pi/2
   for (std::size_t i = 160; i < obj.size(); ++i) obj[i][3] -= 2 * M_PI;   // and a wrap
   const std::string path = (dir_ / "faults.h5").string();
   WriteH5(path, sets);
   const io::MitRecording rec = io::ReadMitPush(path);
   EXPECT_EQ(rec.samples_reordered, 1);
-  EXPECT_EQ(rec.duplicates_dropped, 1);
+  EXPECT_EQ(rec.duplicates_dropped, 2);
+  // Named apart from the exact duplicate, with its difference (it was "1 duplicate time stamps").
+  EXPECT_TRUE(std::any_of(rec.notes.begin(), rec.notes.end(), [](const std::string& n) {
+    return n.find("object_pose: dropped 1 duplicate sample") != std::string::npos;
+  }));
+  EXPECT_TRUE(std::any_of(rec.notes.begin(), rec.notes.end(), [](const std::string& n) {
+    return n.find("dropped 1 sample whose time stamp repeats with other values") != std::string::npos &&
+           n.find("largest difference 0.003") != std::string::npos;
+  }));
   EXPECT_EQ(rec.yaw_jumps_repaired, 1);
   for (const auto& s : rec.streams.object_pose) EXPECT_NEAR(s.pose.theta, 0.01, 1e-12) << "at t = " << s.t;
   for (const auto& s : rec.streams.finger_pose) EXPECT_EQ(s.pose.theta, 0.0);
