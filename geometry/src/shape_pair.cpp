@@ -20,8 +20,6 @@
 #include <Eigen/LU>
 
 #include <algorithm>
-#include <cstdio>
-#include <cstdlib>
 #include <cmath>
 #include <deque>
 #include <limits>
@@ -197,6 +195,12 @@ FeatureMotion ShapePairQuerier::Impl::MotionAt(const Vec2& c_contact, double phi
   std::vector<Pair> pairs;
   const Shape::Impl& oi = object.impl();
   const Shape::Impl& fi = finger.impl();
+  // The object's vertex index of an edge's first vertex (its ring's first plus the edge's index).
+  auto vertex_of = [&oi](const EdgeId& e) {
+    for (const RingInfo& ring : oi.rings)
+      if (ring.polygon == e.polygon && ring.ring == e.ring) return ring.first + e.index;
+    return oi.rings[0].first;
+  };
   for (const Vec2& f : fi.vertices) {
     const PointQuery q = QueryPoint(object, c_contact + R * f);
     if (std::abs(q.signed_distance + ro) > tol) continue;
@@ -204,9 +208,7 @@ FeatureMotion ShapePairQuerier::Impl::MotionAt(const Vec2& c_contact, double phi
     p.f = f;
     if (q.feature.kind == BoundaryFeature::Kind::kVertex) {
       p.vertex_vertex = true;
-      p.o = oi.vertices[oi.rings[0].first];  // replaced below by the exact vertex
-      for (const RingInfo& ring : oi.rings)
-        if (ring.polygon == q.feature.edge.polygon && ring.ring == q.feature.edge.ring) p.o = oi.vertices[ring.first + q.feature.edge.index];
+      p.o = oi.vertices[vertex_of(q.feature.edge)];
     } else {
       p.n = q.normal;
       p.dh = -p.n.dot(dR * f);
@@ -214,17 +216,14 @@ FeatureMotion ShapePairQuerier::Impl::MotionAt(const Vec2& c_contact, double phi
       // can land on one of o's edges just short of it: that pair is vertex-vertex too (else a C
       // vertex found no vertex pair, and d sd / d phi came out 0: a box finger's corner at a
       // square's, 9 of 3000 random poses).
-      for (const RingInfo& ring : oi.rings) {
-        if (ring.polygon != q.feature.edge.polygon || ring.ring != q.feature.edge.ring) continue;
-        const int a = ring.first + q.feature.edge.index;
-        for (const int end : {a, oi.next[a]}) {
-          if ((c_contact + R * f - oi.vertices[end]).norm() > tol) continue;
-          Pair v;
-          v.vertex_vertex = true;
-          v.f = f;
-          v.o = oi.vertices[end];
-          pairs.push_back(v);
-        }
+      const int a = vertex_of(q.feature.edge);
+      for (const int end : {a, oi.next[a]}) {
+        if ((c_contact + R * f - oi.vertices[end]).norm() > tol) continue;
+        Pair v;
+        v.vertex_vertex = true;
+        v.f = f;
+        v.o = oi.vertices[end];
+        pairs.push_back(v);
       }
     }
     pairs.push_back(p);

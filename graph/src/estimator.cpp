@@ -648,11 +648,10 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
   // still moving lost to worse ones (a rect1 recording with its mesh turned by 37 degrees:
   // the right turn 462.6 at the cap, 429.2 converged; the finger 4.3 mm larger, 436.7, won).
   // Each placement's graph cost and its transform refined by the graph (the shape frame).
-  bool last_stalled = false;     // the last framed_cost's solve stalled
-  bool last_capped = false;      // or stopped at its iteration limit
   bool best_stalled = false;     // the winning placement's solve stalled
   std::vector<std::string> stalled_losers;  // turns (deg) of placements that lost on a stalled solve
   std::string best_label;
+  // Returns the solve's statistics: its final cost, and whether it stalled or stopped at its limit.
   auto framed_cost = [&](const push::Trajectory& base, const ShapeTransform& t, ShapeTransform* refined,
                          const EstimatorConfig& solve, const EstimationResult* start = nullptr) {
     RegistrationResult r = *registration;
@@ -663,13 +662,10 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
     frame.centroid = geometry::CoreCentroid(framed.object.shape);
     frame.sigma_centroid = options.centroid_prior * geometry::RadiusAbout(framed.object.shape, frame.centroid);
     frame.rotation = registration->rotation_observable;
-    const EstimationResult framed_result = EstimateBatch(framed, model, solve, &frame, nullptr, start);
-    const double cost = framed_result.solver.final_cost;
-    last_stalled = framed_result.solver.stalled;
-    last_capped = framed_result.solver.at_iteration_limit;
+    const SolverStats stats = EstimateBatch(framed, model, solve, &frame, nullptr, start).solver;
     *refined = t;
     refined->pose = geometry::Compose(frame.frame, t.pose);
-    return cost;
+    return stats;
   };
   if (registration && (placeable || config.align_shape == Align::kOn) &&
       (size_candidate || !registration->alternatives.empty() || will_align)) {
@@ -680,18 +676,17 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
                                                  judged.measured.object_pose.back().t));
     }
     ShapeTransform best, refined;
-    double best_cost = framed_cost(judged, registration->transform, &best, quick);
-    best_stalled = last_stalled;
+    const SolverStats first = framed_cost(judged, registration->transform, &best, quick);
+    double best_cost = first.final_cost;
+    best_stalled = first.stalled;
     best_label = internal::Format("%.1f", registration->transform.pose.theta * 180.0 / M_PI);
     // A stalled solve ends where a residual jumps, not at a minimum: its cost ranks nothing (the
     // notched block turned by 30 degrees: the placement near the truth stalled at 1994.8 against
     // 460.8 for one turned by -131 degrees, and the true shape itself costs 556.8).
-    auto stall_note = [&] {
-      return std::string(last_stalled ? " (its solve stalled at a residual that jumps: no minimum, no comparison)" : "");
-    };
+    const std::string stall_note = " (its solve stalled at a residual that jumps: no minimum, no comparison)";
     if (best_stalled) {
       alignment.notes.push_back(internal::Format("the best placement by the contacts, turned by %s deg: graph cost %.1f", best_label.c_str(),
-                                                 best_cost) + stall_note());
+                                                 best_cost) + stall_note);
     }
     std::vector<std::pair<ShapeTransform, double>> ranked{{best, best_cost}};  // every placement's graph cost
     // The shape as given competes too: the contacts alone can misjudge a push the model does
@@ -713,20 +708,21 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
     }
     char text[240];
     for (const ShapeTransform& alt : registration->alternatives) {
-      const double cost = framed_cost(judged, alt, &refined, quick);
+      const SolverStats solve = framed_cost(judged, alt, &refined, quick);
+      const double cost = solve.final_cost;
       ranked.emplace_back(refined, cost);
       std::snprintf(text, sizeof text, "alternative placement turned by %.1f deg, shifted by (%.1f, %.1f) mm: graph cost %.1f "
                     "against %.1f", alt.pose.theta * 180.0 / M_PI, alt.pose.x * 1e3, alt.pose.y * 1e3, cost, best_cost);
-      alignment.notes.push_back(text + stall_note());
+      alignment.notes.push_back(text + (solve.stalled ? stall_note : std::string()));
       const std::string label = internal::Format("%.1f", alt.pose.theta * 180.0 / M_PI);
       if (cost < best_cost) {
         if (best_stalled && !identity_wins) stalled_losers.push_back(best_label);
         best_cost = cost;
         best = refined;
-        best_stalled = last_stalled;
+        best_stalled = solve.stalled;
         best_label = label;
         identity_wins = false;
-      } else if (last_stalled) {
+      } else if (solve.stalled) {
         stalled_losers.push_back(label);
       }
     }
@@ -844,10 +840,13 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
   // than the one with it fixed, 403.4 against 386.4, and took as long as the estimate itself);
   // true when the frame wins.
   auto decide_frame = [&](const EstimationResult& given) {
+    bool capped = false;
     try {
       EstimatorConfig frame_solve = quick;
       frame_solve.max_iterations = std::min(quick.max_iterations, kFrameCheckIterations);
-      frame_cost = framed_cost(trajectory, ShapeTransform{}, &frame_refined, frame_solve, &given);
+      const SolverStats solve = framed_cost(trajectory, ShapeTransform{}, &frame_refined, frame_solve, &given);
+      frame_cost = solve.final_cost;
+      capped = solve.at_iteration_limit;
       frame_moved = internal::registration::OutlineDisplacement(trajectory.object.shape, frame_refined);
     } catch (const std::exception& e) {
       // A check, not the estimate: a solve with the frame free that fails leaves the shape as given.
@@ -858,11 +857,12 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
     const double given_cost = given.solver.final_cost;
     const std::size_t steps = given.states.size();
     frame_given_cost = given_cost;
+    const std::string from_there = capped ? internal::Format(" after %d iterations from there", kFrameCheckIterations) : "";
     const double margin = std::max(kFrameMargin, kFrameMarginPerStep * static_cast<double>(steps));
     alignment.notes.push_back(internal::Format(
         "frame check: graph cost %.1f as given, %.1f with the frame free%s (it moves the outline by %.1f mm; "
         "it is used when it gains more than %.1f, on %zu steps, and moves the outline by more than %.1f mm)",
-        frame_given_cost, frame_cost, last_capped ? internal::Format(" after %d iterations from there", kFrameCheckIterations).c_str() : "",
+        frame_given_cost, frame_cost, from_there.c_str(),
         frame_moved * 1e3, margin, steps, registration->check.tolerance * 1e3));
     frame_wins = frame_cost < frame_given_cost - margin && frame_moved > registration->check.tolerance;
     if (frame_wins) registration->transform = CanonicalTransform(frame_refined, trajectory.object.shape, registration->symmetry_order);

@@ -237,17 +237,19 @@ void ValidateTrajectory(const push::Trajectory& traj) {
   // code or from a Python dict skips the file reader: mass -1 or NaN and mu_surface NaN were
   // estimated as if valid, mu_surface 50 gave forces of 107 N); a mass or mu_surface of 0 is
   // "unknown" there (QS then leaves out the load factor and says so).
+  // The bounds are the limit-surface module's supported ranges (support.h).
+  using limit_surface::kMaxFriction, limit_surface::kMaxGravity, limit_surface::kMaxMass;
   auto in_range = [](double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; };
-  if (!in_range(traj.object.mass, 0.0, 1e6))
+  if (!in_range(traj.object.mass, 0.0, kMaxMass))
     throw GraphError("trajectory: object.mass must be in (0, 1e6] kg (0: unknown), got " + Format("%.9g", traj.object.mass));
-  if (!in_range(traj.object.mu_surface, 0.0, 10.0))
+  if (!in_range(traj.object.mu_surface, 0.0, kMaxFriction))
     throw GraphError("trajectory: object.mu_surface must be in [0, 10] (0: unknown), got " + Format("%.9g", traj.object.mu_surface));
-  if (!(std::isfinite(traj.object.gravity) && traj.object.gravity > 0.0))
-    throw GraphError("trajectory: object.gravity must be > 0 m/s^2, got " + Format("%.9g", traj.object.gravity));
-  if (!in_range(traj.finger.mu_contact, 0.0, 10.0))
+  if (!(in_range(traj.object.gravity, 0.0, kMaxGravity) && traj.object.gravity > 0.0))
+    throw GraphError("trajectory: object.gravity must be in (0, 1e3] m/s^2, got " + Format("%.9g", traj.object.gravity));
+  if (!in_range(traj.finger.mu_contact, 0.0, kMaxFriction))
     throw GraphError("trajectory: finger.mu_contact must be in [0, 10], got " + Format("%.9g", traj.finger.mu_contact));
   for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k) {
-    if (!in_range(traj.extra_fingers[k].finger.mu_contact, 0.0, 10.0))
+    if (!in_range(traj.extra_fingers[k].finger.mu_contact, 0.0, kMaxFriction))
       throw GraphError("trajectory: fingers[" + std::to_string(k + 1) + "].mu_contact must be in [0, 10], got " +
                        Format("%.9g", traj.extra_fingers[k].finger.mu_contact));
   }
@@ -504,6 +506,16 @@ namespace {
 
 // One pose stream's glitches (DropObjectPoseGlitches), `floor` the least position bound (m); an
 // empty note when it has none or more than a tenth.
+// The 95th percentile of a pose stream's speed over windows of `half` to 2 `half` (0 with none).
+double FastSpeed(const std::vector<push::PoseSample>& s, double half) {
+  std::vector<double> speeds;
+  for (std::size_t i = 0, j = 0; i < s.size(); ++i) {
+    while (j + 1 < s.size() && s[j].t - s[i].t < 2.0 * half) ++j;
+    if (s[j].t - s[i].t >= half) speeds.push_back((s[j].pose.translation() - s[i].pose.translation()).norm() / (s[j].t - s[i].t));
+  }
+  return speeds.empty() ? 0.0 : Percentile95(speeds);
+}
+
 std::vector<bool> PoseGlitches(const std::vector<push::PoseSample>& s, const char* stream, double floor, std::string* note) {
   const std::size_t n = s.size();
   if (n < 7) return {};
@@ -514,12 +526,7 @@ std::vector<bool> PoseGlitches(const std::vector<push::PoseSample>& s, const cha
   // A centred median cuts a sharp turn of the path by up to about v h / 2 (a finger's U-turn at
   // 0.5 m/s: 22 mm, three true samples dropped), so the floor grows with the stream's fast
   // motion: v the 95th percentile of its speed over the window's width.
-  std::vector<double> speeds;
-  for (std::size_t i = 0, j = 0; i < n; ++i) {
-    while (j + 1 < n && s[j].t - s[i].t < 2.0 * gaps.half) ++j;
-    if (s[j].t - s[i].t >= gaps.half) speeds.push_back((s[j].pose.translation() - s[i].pose.translation()).norm() / (s[j].t - s[i].t));
-  }
-  const double fast = speeds.empty() ? 0.0 : Percentile95(speeds);
+  const double fast = FastSpeed(s, gaps.half);
   const double bound_p = std::max({floor, fast * gaps.half, 10.0 * gaps.Scatter(position_gap)});
   const double bound_a = std::max(0.3, 10.0 * gaps.Scatter(angle_gap));
   std::vector<bool> glitch(n);
@@ -603,15 +610,11 @@ std::optional<std::string> TrackerStepNote(const push::Trajectory& traj) {
   if (n < 12) return std::nullopt;
   const CentredGaps gaps = CentredMedianGaps(s);
   const double scatter = gaps.Scatter(gaps.position);
-  std::vector<double> speeds;
-  for (std::size_t i = 0, j = 0; i < n; ++i) {
-    while (j + 1 < n && s[j].t - s[i].t < 2.0 * gaps.half) ++j;
-    if (s[j].t - s[i].t >= gaps.half) speeds.push_back((s[j].pose.translation() - s[i].pose.translation()).norm() / (s[j].t - s[i].t));
-  }
-  const double fast = speeds.empty() ? 0.0 : Percentile95(speeds);
   // The finger's motion over a time span (the median of up to five samples at each end): the
-  // object moves with it while pushed, and a step of the object's tracker is not in it.
+  // object moves with it while pushed, and a step of the object's tracker is not in it. Without
+  // a finger stream, the object stream's own fast motion.
   const auto& fingers = traj.measured.finger_pose;
+  const double fast = fingers.size() >= 5 ? 0.0 : FastSpeed(s, gaps.half);
   auto finger_at = [&](double t) {
     const auto it = std::lower_bound(fingers.begin(), fingers.end(), t, [](const push::PoseSample& a, double v) { return a.t < v; });
     const std::size_t k = static_cast<std::size_t>(it - fingers.begin());

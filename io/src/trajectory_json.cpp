@@ -2,6 +2,7 @@
 // file name and the JSON path of the offending value.
 #include <pushgraph/geometry/file_output.h>
 #include <pushgraph/io/trajectory_json.h>
+#include <pushgraph/limit_surface/support.h>
 
 #include <pushgraph/geometry/json_check.h>
 
@@ -410,7 +411,7 @@ std::string TrajectoryToJson(const Trajectory& t, int indent) {
   if (t.object.gravity != limit_surface::kStandardGravity)
     throw IoError("trajectory JSON: object.gravity must be the standard 9.80665 m/s^2 (the format has no field for it)");
   // What the reader requires, refused here rather than written into a file it then refuses.
-  auto friction_ok = [](double mu) { return std::isfinite(mu) && mu >= 0.0 && mu <= 10.0; };
+  auto friction_ok = [](double mu) { return std::isfinite(mu) && mu >= 0.0 && mu <= limit_surface::kMaxFriction; };
   if (!(std::isfinite(t.object.mass) && t.object.mass > 0.0))
     throw IoError("trajectory JSON: object.mass must be > 0 kg (the format has no unknown mass), got " + std::to_string(t.object.mass));
   if (!friction_ok(t.object.mu_surface))
