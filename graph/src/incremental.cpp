@@ -470,6 +470,9 @@ struct FixedLagSmoother {
     for (double u : stats.update_times_s) update_sum += u;
     r.solver.mean_update_time_s = stats.updates > 0 ? update_sum / stats.updates : 0.0;
     builder.DropUnobservableForces(r);
+    // The model's shared parameters, as batch reports them (never estimated incrementally).
+    if (ModelHasForce(r.model)) r.c = builder.c();
+    if (r.model == Model::kQs && builder.uses_load_factor()) r.mu = builder.mu();
     r.metrics = ComputeMetrics(traj, r.states);
     if (window_stalled) {
       r.warnings.push_back("incremental: the last window's solve " + window_termination +

@@ -468,6 +468,11 @@ std::optional<std::string> ForceScaleNote(const push::Trajectory& traj, double f
   std::vector<double> top = magnitude;
   std::nth_element(top.begin(), top.begin() + 4, top.end(), std::greater<double>());
   const double high = top[4];
+  if (travel > 0.01 && high == 0.0) {
+    return Format("force: the object moves %.0f mm but every measured force is exactly 0 N: is the force stream "
+                  "recorded (a sensor not switched on, or the wrong columns)? Leave it out if it carries nothing",
+                  1e3 * travel);
+  }
   if (travel > 0.01 && high < load / kFactor) {
     return Format("force: the object moves %.0f mm but the measured forces (at most %.3g N, the fifth largest) are 1/%.0f "
                   "of its friction load mu_surface m g = %.3g N, about what a quasi-static push needs: is the force in "

@@ -281,8 +281,13 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
   for (const tinyobj::shape_t& s : reader.GetShapes()) rep.objects.push_back(s.name);
   if (!options.object.empty() && std::find(rep.objects.begin(), rep.objects.end(), options.object) == rep.objects.end()) {
     std::string names;
-    for (const std::string& n : rep.objects) names += (names.empty() ? "" : ", ") + n;
-    throw IoError(path + ": no object named '" + options.object + "' (the file has: " + names + ")");
+    for (const std::string& n : rep.objects) {
+      if (!n.empty()) names += (names.empty() ? "" : ", ") + n;
+    }
+    throw IoError(path + ": no object named '" + options.object + "' (" +
+                  (names.empty() ? std::string("the file has no named objects or groups ('o' or 'g' lines)")
+                                 : "the file has: " + names) +
+                  ")");
   }
   const int nv = static_cast<int>(attrib.vertices.size() / 3);
   ObjLineFindings found;
@@ -356,6 +361,7 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
       rep.faces_used += used;
     }
   }
+  int flat_axis = -1;  // the axis across which every used vertex lies in one plane, if any
   {
     std::vector<std::string> with_faces;
     std::vector<char> used(nv, 0);
@@ -387,7 +393,12 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
       }
     }
     const double tolerance = 1e-9 * std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 0.0});
-    for (int a = 0; a < 3; ++a) {
+    // A flat mesh (an outline drawn in one plane) is no prism along any axis: its four corners
+    // lie on two planes across each in-plane axis.
+    for (int a = 0; a < 3 && flat_axis < 0; ++a) {
+      if (hi[a] - lo[a] <= tolerance && hi[a] >= lo[a]) flat_axis = a;
+    }
+    for (int a = 0; a < 3 && flat_axis < 0; ++a) {
       bool on_ends = hi[a] > lo[a];
       int at_lo = 0, at_hi = 0;  // an end face needs three vertices (a lone triangle is no prism)
       for (int v = 0; v < nv && on_ends; ++v) {
@@ -410,7 +421,15 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
     }
   }
   if (rep.faces == 0) throw IoError(path + ": the mesh has no faces");
-  if (projected.empty()) throw IoError(path + ": every face has zero area seen along the up axis (wrong --up?)");
+  if (projected.empty()) {
+    const char* axis_names[3] = {"x", "y", "z"};
+    const int up = options.up == UpAxis::kX ? 0 : options.up == UpAxis::kY ? 1 : 2;
+    if (flat_axis >= 0 && flat_axis != up) {
+      throw IoError(path + ": the mesh is flat, drawn in a plane across " + axis_names[flat_axis] +
+                    ", so seen along the up axis every face has zero area; --up " + axis_names[flat_axis] + " reads it");
+    }
+    throw IoError(path + ": every face has zero area seen along the up axis (wrong --up?)");
+  }
   CGAL::Polygon_set_2<K> set;
   set.join(projected.begin(), projected.end());
   std::vector<PolygonWithHoles> parts;

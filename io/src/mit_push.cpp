@@ -71,6 +71,10 @@ Raw ReadH5(const std::string& path) {
     for (int k = 0; k < 3; ++k) {
       stage = std::string("dataset '") + kDatasets[k] + "'";
       if (!file.nameExists(kDatasets[k])) throw IoError(path + ": missing dataset '" + std::string(kDatasets[k]) + "'");
+      if (file.childObjType(kDatasets[k]) != H5O_TYPE_DATASET)
+        throw IoError(path + ": '" + kDatasets[k] + "' is a " +
+                      (file.childObjType(kDatasets[k]) == H5O_TYPE_GROUP ? "group" : "named type") +
+                      ", not an N x 4 dataset of [t, x, y, yaw] (or [t, fx, fy, fz]) rows");
       H5::DataSet ds = file.openDataSet(kDatasets[k]);
       H5::DataSpace space = ds.getSpace();
       hsize_t dims[2] = {0, 0};
@@ -107,6 +111,20 @@ Raw ReadH5(const std::string& path) {
       std::vector<Row>& rows = Slot(raw, k);
       rows.resize(dims[0]);
       if (dims[0] > 0) ds.read(rows.data(), H5::PredType::NATIVE_DOUBLE);
+      // Unix times (1.46e9 s in the dataset) kept in 32-bit floats are 128 s apart: every
+      // sample of a push gets one or two time stamps, which no repair can give back.
+      if (ds.getTypeClass() == H5T_FLOAT && element_bytes == 4) {
+        double largest = 0.0;
+        for (const Row& r : rows) largest = std::max(largest, std::abs(r[0]));
+        const float f = static_cast<float>(largest);
+        const double resolution = static_cast<double>(std::nextafter(f, INFINITY)) - static_cast<double>(f);
+        if (resolution > 1e-3) {
+          std::ostringstream o;
+          o << path << ": dataset '" << kDatasets[k] << "' is stored as 32-bit floats, whose time stamps near "
+            << largest << " s are " << resolution << " s apart: the sample times are lost (store them as 64-bit floats)";
+          throw IoError(o.str());
+        }
+      }
     }
   } catch (const H5::Exception& e) {
     if (stage == "open") throw IoError(path + ": cannot open: " + DescribeUnopenableH5(path));
@@ -374,19 +392,39 @@ MitRecording ReadMitPush(const std::string& path, const MitReadOptions& o) {
 
   for (const Row& r : raw.tip) rec.streams.finger_pose.push_back({r[0], {r[1], r[2], 0.0}});
   double unwrapped = raw.object.front()[3];
+  double largest_yaw = 0.0;
   for (std::size_t i = 0; i < raw.object.size(); ++i) {
+    largest_yaw = std::max(largest_yaw, std::abs(raw.object[i][3]));
     if (i > 0) {
       double step = Wrap(raw.object[i][3] - raw.object[i - 1][3]);
       if (std::abs(step) > o.max_yaw_step) {
         const double quarters = std::round(step / (0.5 * M_PI));
-        ++rec.yaw_jumps_repaired;
-        rec.notes.push_back("object yaw: removed a tracker jump of " + std::to_string(static_cast<int>(quarters)) +
-                            " x pi/2 at t = " + std::to_string(raw.object[i][0]));
+        std::ostringstream note;
+        note.precision(16);
+        if (quarters != 0.0) {
+          ++rec.yaw_jumps_repaired;
+          note << "object yaw: removed a tracker jump of " << static_cast<int>(quarters) << " x pi/2 at t = " << raw.object[i][0];
+        } else {
+          note.precision(3);
+          note << "object yaw: a step of " << step << " rad (more than max_yaw_step " << o.max_yaw_step
+               << ", and no quarter turn) kept at t = ";
+          note.precision(16);
+          note << raw.object[i][0];
+        }
+        rec.notes.push_back(note.str());
         step -= quarters * 0.5 * M_PI;
       }
       unwrapped += step;
     }
     rec.streams.object_pose.push_back({raw.object[i][0], {raw.object[i][1], raw.object[i][2], unwrapped}});
+  }
+  // The dataset's tracker reports yaw in (-pi, pi]; beyond a turn it is most likely in degrees.
+  if (largest_yaw > 2.0 * M_PI) {
+    std::ostringstream note;
+    note.precision(4);
+    note << "object yaw reaches " << largest_yaw << ", more than a turn in radians (the dataset's yaw lies in -pi to pi): "
+         << "is it in degrees? (read as radians)";
+    rec.notes.push_back(note.str());
   }
 
   // A frozen sensor repeats a handful of values (the rect1 recordings: 2 to 4, with spikes).

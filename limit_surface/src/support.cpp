@@ -30,6 +30,9 @@ void CheckScalars(const SupportSpec& spec) {
   if (spec.mass > kMaxMass) Fail("mass " + Number(spec.mass) + " kg is above the supported " + Number(kMaxMass) + " kg");
   if (spec.mu > kMaxFriction) Fail("mu " + Number(spec.mu) + " is above the supported " + Number(kMaxFriction));
   if (spec.gravity > kMaxGravity) Fail("gravity " + Number(spec.gravity) + " is above the supported " + Number(kMaxGravity));
+  if (!(spec.mu * spec.mass * spec.gravity >= kMinFrictionLoad))
+    Fail("the friction load mu m g = " + Number(spec.mu * spec.mass * spec.gravity) + " N (mu " + Number(spec.mu) + ", mass " +
+         Number(spec.mass) + " kg) is below the supported " + Number(kMinFrictionLoad) + " N");
   if (!(spec.relative_tolerance >= 1e-15 && spec.relative_tolerance <= 1e-2))
     Fail("relative_tolerance must lie in [1e-15, 1e-2]");
   if (spec.region.empty()) Fail("the region is an empty shape");

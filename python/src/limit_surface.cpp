@@ -48,7 +48,8 @@ void RegisterLimitSurface(py::module_& m) {
   py::class_<PyLimitSurface>(m, "LimitSurface", R"doc(
 The limit surface of an object of `mass` kg sliding with table friction `mu` on the support
 region `shape` (uniform pressure), or on weighted support points (an (N, 3) array of x, y,
-weight in newtons). Loads are (fx, fy, tau) about the centre of pressure, twists (vx, vy, omega)
+relative weight: the weights are scaled to carry the normal force mass * gravity, so only their
+ratios matter). Loads are (fx, fy, tau) about the centre of pressure, twists (vx, vy, omega)
 of the centre of pressure.
 
     ls = pushgraph.LimitSurface(pushgraph.Shape.box(0.09, 0.09), mass=0.8, mu=0.3)

@@ -238,14 +238,40 @@ Trajectory TrajectoryFromDict(const py::handle& object) {
     if (!py::isinstance<py::dict>(d["measurement_sigmas"])) throw py::type_error("trajectory['measurement_sigmas']: expected a dict");
     const py::dict m = d["measurement_sigmas"];
     const std::string at = "trajectory['measurement_sigmas']";
-    CheckKeys(m, {"object_trans", "object_rot", "finger_trans", "finger_rot", "contact", "force"}, at);
     MeasurementSigmas s;
-    s.object_trans = Number(m, "object_trans", at, 0.0);
-    s.object_rot = Number(m, "object_rot", at, 0.0);
-    s.finger_trans = Number(m, "finger_trans", at, 0.0);
-    s.finger_rot = Number(m, "finger_rot", at, 0.0);
-    s.contact = Number(m, "contact", at, 0.0);
-    s.force = Number(m, "force", at, 0.0);
+    // The dict's own keys, or the trajectory file's ({"object_pose": [trans, rot], "finger_pose":
+    // [trans, rot], "contact_point": s, "force": s}, docs/formats.md), not mixed.
+    const bool file_keys = m.contains("object_pose") || m.contains("finger_pose") || m.contains("contact_point");
+    if (file_keys) {
+      CheckKeys(m, {"object_pose", "finger_pose", "contact_point", "force"},
+                at + " (the trajectory file's keys; the dict's own are object_trans, object_rot, finger_trans, "
+                     "finger_rot, contact, force)");
+      auto pair = [&](const char* key, double* trans, double* rot) {
+        if (!m.contains(key) || m[key].is_none()) return;
+        std::vector<double> v;
+        try {
+          v = m[key].cast<std::vector<double>>();
+        } catch (const py::cast_error&) {
+          throw py::type_error(at + "['" + key + "']: expected [sigma_trans, sigma_rot]");
+        }
+        if (v.size() != 2) throw py::value_error(at + "['" + key + "']: expected [sigma_trans, sigma_rot], got " +
+                                                 std::to_string(v.size()) + " numbers");
+        *trans = v[0];
+        *rot = v[1];
+      };
+      pair("object_pose", &s.object_trans, &s.object_rot);
+      pair("finger_pose", &s.finger_trans, &s.finger_rot);
+      s.contact = Number(m, "contact_point", at, 0.0);
+      s.force = Number(m, "force", at, 0.0);
+    } else {
+      CheckKeys(m, {"object_trans", "object_rot", "finger_trans", "finger_rot", "contact", "force"}, at);
+      s.object_trans = Number(m, "object_trans", at, 0.0);
+      s.object_rot = Number(m, "object_rot", at, 0.0);
+      s.finger_trans = Number(m, "finger_trans", at, 0.0);
+      s.finger_rot = Number(m, "finger_rot", at, 0.0);
+      s.contact = Number(m, "contact", at, 0.0);
+      s.force = Number(m, "force", at, 0.0);
+    }
     t.measurement_sigmas = s;
   }
   return t;

@@ -304,6 +304,12 @@ TEST(Estimator, ForcesOrAMassInAnotherUnitAreNamed) {
   push::Trajectory grams = good;
   grams.object.mass *= 1000.0;
   EXPECT_TRUE(HasWarning(Estimate(grams, Model::kCp, Mode::kBatch), "or the mass or mu_surface too large"));
+  // An all-zero stream is said as such (it asked whether 0 N, "1/inf" of the load, was in kN).
+  push::Trajectory zero = good;
+  for (auto& f : zero.measured.force) f.force.setZero();
+  const EstimationResult zero_result = Estimate(zero, Model::kCp, Mode::kBatch);
+  EXPECT_TRUE(HasWarning(zero_result, "every measured force is exactly 0 N"));
+  EXPECT_FALSE(HasWarning(zero_result, "kilonewtons"));
   // kgf: 1/9.81 of the forces, within the factor of 20 above, named by the forces while the
   // object moves (a hostile-user push in kgf: force NEES 673, no warning). A third of the forces
   // (a mu_surface within a factor of 3) is not.

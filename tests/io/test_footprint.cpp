@@ -126,6 +126,35 @@ TEST_F(Footprint, SideViewsAndSeveralObjectsAreWarned) {
   io::MeshFootprint(flat, {}, &flat_report);
   EXPECT_TRUE(flat_report.warnings.empty()) << flat_report.warnings[0];
   EXPECT_TRUE(flat_report.prism_axes.empty());
+  // A flat outline of two squares in z = 0: its vertices lie on two planes across y (three on
+  // each), yet it is no prism: it was told "a prism along y ... --up y", which then failed.
+  const std::string outline =
+      Write("outline.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\nf 1 2 3 4\nf 2 5 6 3\n");
+  io::FootprintReport outline_report;
+  const geometry::Shape two_squares = io::MeshFootprint(outline, {}, &outline_report);
+  EXPECT_TRUE(outline_report.warnings.empty()) << outline_report.warnings[0];
+  EXPECT_TRUE(outline_report.prism_axes.empty());
+  EXPECT_DOUBLE_EQ(two_squares.core_area(), 2.0);
+  // Drawn in a plane across y and read along z: the error names the plane and the --up to use.
+  const std::string side = Write("side.obj", "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nf 1 2 3 4\n");
+  try {
+    io::MeshFootprint(side, {});
+    ADD_FAILURE() << "a mesh seen edge-on was read";
+  } catch (const io::IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("flat, drawn in a plane across y"), std::string::npos) << e.what();
+  }
+  io::FootprintOptions along_y;
+  along_y.up = io::UpAxis::kY;
+  EXPECT_DOUBLE_EQ(io::MeshFootprint(side, along_y).core_area(), 1.0);
+  // --object on a file without named objects says so instead of listing nothing.
+  io::FootprintOptions named;
+  named.object = "nope";
+  try {
+    io::MeshFootprint(outline, named);
+    ADD_FAILURE() << "an unknown object was read";
+  } catch (const io::IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("no named objects"), std::string::npos) << e.what();
+  }
   // OBJ statements the footprint does not use pass; a line of no OBJ kind is counted and named.
   const std::string decorated = Write("d.obj",
                                       "# c\nmtllib a.mtl\no t\ng t\nusemtl m\ns off\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"

@@ -32,12 +32,17 @@ std::string FirstFile(const std::string& dir) {
   return files.empty() ? "" : files.front();
 }
 
-void WriteH5(const std::string& path, const std::vector<std::pair<std::string, std::vector<Row>>>& sets, int columns = 4) {
+void WriteH5(const std::string& path, const std::vector<std::pair<std::string, std::vector<Row>>>& sets, int columns = 4,
+             const H5::PredType& stored_as = H5::PredType::NATIVE_DOUBLE) {
   H5::H5File f(path, H5F_ACC_TRUNC);
   for (const auto& [name, rows] : sets) {
+    if (name.rfind("group:", 0) == 0) {  // a group where a dataset belongs
+      f.createGroup(name.substr(6));
+      continue;
+    }
     hsize_t dims[2] = {rows.size(), static_cast<hsize_t>(columns)};
     H5::DataSpace space(2, dims);
-    H5::DataSet ds = f.createDataSet(name, H5::PredType::NATIVE_DOUBLE, space);
+    H5::DataSet ds = f.createDataSet(name, stored_as, space);
     std::vector<double> flat;
     for (const Row& r : rows)
       for (int c = 0; c < columns; ++c) flat.push_back(r[c % 4]);
@@ -131,6 +136,21 @@ TEST_F(MitPush, SyntheticFaultsAreRepaired) {
   EXPECT_EQ(rec.streams.force[100].force.x(), 1.0 + 0.001 * 100);  // sign flipped
   ASSERT_TRUE(rec.contact_found);
   EXPECT_NEAR(rec.contact_start, 1000.0 + 0.004 * 50 + 0.002, 1e-9);
+  // A yaw step that is no quarter turn is kept and said as such (it read "removed a tracker jump of
+  // 0 x pi/2"), and a yaw beyond a turn asks about degrees.
+  auto degrees = CleanPush();
+  for (std::size_t i = 0; i < degrees[1].second.size(); ++i) degrees[1].second[i][3] = -60.0 + 0.01 * i + (i >= 100 ? 0.6 : 0.0);
+  const std::string degrees_path = (dir_ / "degrees.h5").string();
+  WriteH5(degrees_path, degrees);
+  const io::MitRecording in_degrees = io::ReadMitPush(degrees_path);
+  EXPECT_EQ(in_degrees.yaw_jumps_repaired, 0);
+  auto has = [&](const std::string& needle) {
+    return std::any_of(in_degrees.notes.begin(), in_degrees.notes.end(),
+                       [&](const std::string& n) { return n.find(needle) != std::string::npos; });
+  };
+  EXPECT_TRUE(has("object yaw: a step of 0.61 rad (more than max_yaw_step 0.5, and no quarter turn) kept at t = 1000.4"));
+  EXPECT_TRUE(has("object yaw reaches 60, more than a turn in radians"));
+  EXPECT_FALSE(has("x pi/2"));
   io::MitReadOptions trim;
   trim.trim_to_contact = true;
   const io::MitRecording trimmed = io::ReadMitPush(path, trim);
@@ -232,6 +252,17 @@ TEST_F(MitPush, BrokenFilesGetClearErrors) {
   for (Row& r : same_time[0].second) r[0] = 1.5;
   WriteH5((dir_ / "same_time.h5").string(), same_time);
   expect_error((dir_ / "same_time.h5").string(), "1 distinct time stamp (need >= 2)");
+  // A group named like a dataset (it said "truncated or corrupt HDF5: H5Dopen2 failed").
+  WriteH5((dir_ / "group.h5").string(), {{"group:tip_pose", {}}, sets[1], sets[2]});
+  expect_error((dir_ / "group.h5").string(), "'tip_pose' is a group, not an N x 4 dataset");
+  // Unix times in 32-bit floats are 128 s apart: named as such (it said "1 distinct time stamp").
+  auto unix_times = sets;
+  for (auto& set : unix_times)
+    for (Row& r : set.second) r[0] += 1.4616e9;
+  WriteH5((dir_ / "float32.h5").string(), unix_times, 4, H5::PredType::NATIVE_FLOAT);
+  expect_error((dir_ / "float32.h5").string(), "stored as 32-bit floats, whose time stamps near");
+  WriteH5((dir_ / "float32_short_times.h5").string(), sets, 4, H5::PredType::NATIVE_FLOAT);  // 1000 s: 61 us apart
+  EXPECT_NO_THROW(io::ReadMitPush((dir_ / "float32_short_times.h5").string()));
   const std::string garbage = (dir_ / "garbage.h5").string();
   std::ofstream(garbage) << "not hdf5";
   expect_error(garbage, "not an HDF5 file");

@@ -51,6 +51,18 @@ TEST(LimitSurfaceRanges, AbsurdMassesAndFrictionsAreRefused) {
   }
   spec.mu = 10.0;  // the bound itself is fine
   EXPECT_GT(Summarize(MakeSupport(spec)).f_max, 0.0);
+  // Each within its range, together underflowing: f_max was 0 and c NaN, without a word.
+  spec.mass = 1e-300;
+  spec.mu = 1e-300;
+  try {
+    MakeSupport(spec);
+    ADD_FAILURE() << "accepted";
+  } catch (const LimitSurfaceError& e) {
+    EXPECT_NE(std::string(e.what()).find("friction load mu m g = 0 N"), std::string::npos) << e.what();
+  }
+  spec.mass = 1e-50;  // small but representable: kept
+  spec.mu = 1e-40;
+  EXPECT_GT(Summarize(MakeSupport(spec)).f_max, 0.0);
 }
 
 TEST(LimitSurfaceDisk, SpecialValues) {

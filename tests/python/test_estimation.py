@@ -47,6 +47,21 @@ def test_bad_trajectory_dicts_name_the_key(push):
         pg.estimate(unsorted)
 
 
+def test_measurement_sigmas_take_the_trajectory_files_keys_too(push):
+    s = push["measurement_sigmas"]
+    as_in_file = dict(push, measurement_sigmas={"object_pose": [s["object_trans"], s["object_rot"]],
+                                                "finger_pose": [s["finger_trans"], s["finger_rot"]],
+                                                "contact_point": s["contact"], "force": s["force"]})
+    config = {"covariance": False, "diagnostics": False}
+    a, b = pg.estimate(push, config=config), pg.estimate(as_in_file, config=config)
+    np.testing.assert_array_equal(a["object_pose"], b["object_pose"])
+    np.testing.assert_array_equal(a["force"], b["force"])
+    with pytest.raises(ValueError, match="trajectory file's keys.*unknown key 'contact'"):
+        pg.estimate(dict(push, measurement_sigmas={"object_pose": [0.005, 0.05], "contact": 0.001}))
+    with pytest.raises(ValueError, match=r"\[sigma_trans, sigma_rot\], got 1"):
+        pg.estimate(dict(push, measurement_sigmas={"object_pose": [0.005]}))
+
+
 def test_batch_estimate_equals_the_command_line_tool_to_the_last_bit(push, tmp_path):
     path = tmp_path / "push.json"
     pg.save_trajectory(push, str(path))

@@ -1,7 +1,8 @@
 // pushgraph mit-import RECORDING.h5|.json --object SHAPE.json --finger SHAPE.json --mass KG
-//   --mu-surface MU [--mu-contact MU] [--trim] -o TRAJECTORY.json
+//   --mu-surface MU [--mu-contact MU] [--no-trim] -o TRAJECTORY.json
 // Reads an MIT pushing-dataset recording, repairs it (see docs/formats.md) and writes a
-// pushgraph trajectory file; prints what was repaired on stderr.
+// pushgraph trajectory file; prints what was repaired on stderr. Like `estimate RECORDING.h5`, it
+// keeps only the contact phase unless --no-trim is given, so both estimate the same samples.
 #include "cli_common.h"
 
 #include <pushgraph/io/mit_push.h>
@@ -16,7 +17,7 @@ void RegisterMitImport(CLI::App& app) {
   struct Args {
     std::string recording, object, finger, output;
     double mass = 0.0, mu_surface = 0.0, mu_contact = 0.25;
-    bool trim = false;
+    bool trim = true;
   };
   auto a = std::make_shared<Args>();
   cmd->add_option("RECORDING", a->recording, "Recording (.h5 or .json)")->required();
@@ -27,7 +28,9 @@ void RegisterMitImport(CLI::App& app) {
   cmd->add_option("--mu-contact", a->mu_contact, "Finger-object friction coefficient")
       ->check(FrictionValue(true))
       ->capture_default_str();
-  cmd->add_flag("--trim", a->trim, "Keep only the contact phase");
+  cmd->add_flag("--trim,!--no-trim", a->trim,
+                "Keep only the contact phase, as `estimate RECORDING.h5` does (the default); --no-trim keeps every sample")
+      ->capture_default_str();
   cmd->add_option("-o,--output", a->output, "Trajectory JSON to write")->required();
   cmd->callback([a] {
     CheckOutputsAreNew({{"RECORDING", a->recording}, {"--object", a->object}, {"--finger", a->finger}}, {{"-o", a->output}});
@@ -36,7 +39,10 @@ void RegisterMitImport(CLI::App& app) {
     io::MitReadOptions options;
     options.trim_to_contact = a->trim;
     const io::MitRecording rec = io::ReadMitPush(a->recording, options);
-    push::ObjectDescription object{LoadShapeArgument(a->object, "--object"), a->mass, a->mu_surface};
+    push::ObjectDescription object;
+    object.shape = LoadShapeArgument(a->object, "--object");
+    object.mass = a->mass;
+    object.mu_surface = a->mu_surface;
     push::FingerDescription finger{LoadShapeArgument(a->finger, "--finger"), a->mu_contact};
     io::SaveTrajectoryJson(io::MitToTrajectory(rec, object, finger), a->output);
     for (const std::string& note : rec.notes) std::cerr << "mit-import: " << note << "\n";

@@ -35,6 +35,9 @@ inline constexpr double kStandardGravity = 9.80665;
 inline constexpr double kMaxMass = 1e6;
 inline constexpr double kMaxFriction = 10.0;
 inline constexpr double kMaxGravity = 1e3;
+/// The least friction load mu m g (N): smaller ones underflow in the surface's squared loads
+/// (mass and mu 1e-300 each gave f_max 0 and c null without a word). Refused.
+inline constexpr double kMinFrictionLoad = 1e-100;
 
 /// P(r) = offset + slope . r, r in the shape frame (a tilted plane). Must be >= 0 on the region.
 struct LinearPressure {
