@@ -116,6 +116,20 @@ void CheckNoCrossingAt(const Shape::Impl& impl, int i, int j) {
   const Vec2& v = impl.vertices[i];
   const Vec2 a = impl.vertices[impl.prev[i]] - v, b = impl.vertices[impl.next[i]] - v;
   const Vec2 c = impl.vertices[impl.prev[j]] - v, d = impl.vertices[impl.next[j]] - v;
+  const Vec2 o(0.0, 0.0);
+  for (const Vec2* x : {&c, &d}) {
+    for (const Vec2* y : {&a, &b}) {
+      if (exact::OrientationSign(o, *x, *y) != 0 || exact::DotSign(*x, o, *y) <= 0) continue;
+      // Edges of two rings leaving the vertex in one direction overlap: the rings touch along a
+      // segment (two squares side by side), which no sector test can call a crossing or not.
+      const EdgeId ei = impl.edge_id(i), ej = impl.edge_id(j);
+      std::ostringstream text;
+      text << "boundary runs along " << Where(ej.polygon, ej.ring) << " from their shared vertex (" << v.x() << ", " << v.y()
+           << ", its vertex " << ej.index << "): rings may touch at points, not along edges; unite the two into one "
+           << "polygon, or leave a gap";
+      Fail(text.str(), ei.polygon, ei.ring, ei.index);
+    }
+  }
   if (InSector(c, a, b) != InSector(d, a, b)) {
     const EdgeId ei = impl.edge_id(i), ej = impl.edge_id(j);
     Fail("boundary crosses " + Where(ej.polygon, ej.ring) + " at their shared vertex (its vertex " +
