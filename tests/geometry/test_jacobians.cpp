@@ -453,6 +453,41 @@ TEST(ShapePairJacobians, BoxFingerCornerAtASquaresCorner) {
   EXPECT_NEAR(J.J_sd_finger_pose(2), 0.0345037, 1e-6);
 }
 
+// A capsule finger deep in a notched object with a hole: where the exact rounded depth's nearest
+// point is a corner of C whose one line comes from an object vertex on the capsule's segment
+// core, the line's side was rounding's choice (a segment has no inside), and d sd / d theta came
+// out of the wrong side's line: 0.0097 against 0.0625 and 0.032 against 0.104 (helper-24, 2 of
+// 300 poses; before the fix 25 of 1002 poses from this generator and seed).
+TEST(ShapePairJacobians, CapsuleFingerDeepInANotch) {
+  const Shape object = Shape::FromPolygons({Polygon{{{-0.5, -0.5}, {0.5, -0.5}, {0.5, 0.5}, {0.05, 0.5}, {0.05, 0.2},
+                                                     {-0.05, 0.2}, {-0.05, 0.5}, {-0.5, 0.5}},
+                                                    {{{-0.3, -0.3}, {-0.1, -0.3}, {-0.1, -0.1}, {-0.3, -0.1}}}}});
+  const ShapePairQuerier q(object, Shape::Capsule(Vec2(-0.05, 0.0), Vec2(0.05, 0.0), 0.03));
+  const Pose2 object_pose{0.1, -0.2, 0.4};
+  auto sd = [&](const Pose2& f) { return q.Query(object_pose, f).signed_distance; };
+  std::mt19937_64 rng(2);
+  std::uniform_real_distribution<double> xy(-0.7, 0.7), angle(-3.0, 3.0);
+  std::vector<Pose2> poses = {{-0.002721523115852942, 0.061372860510927385, -1.961161838556021},
+                              {-0.10577451128163073, 0.18862499285682854, 1.337669007836734}};
+  for (int i = 0; i < Scaled(600, 150); ++i) poses.push_back({xy(rng), xy(rng), angle(rng)});
+  int checked = 0, wrong = 0;
+  for (const Pose2& f : poses) {
+    ShapePairJacobians J;
+    q.Query(object_pose, f, &J);
+    const double h = 1e-7;
+    const double forward = (sd({f.x, f.y, f.theta + h}) - sd(f)) / h, backward = (sd(f) - sd({f.x, f.y, f.theta - h})) / h;
+    if (std::abs(forward - backward) > 1e-5) continue;  // a kink: not differentiable there
+    ++checked;
+    if (std::abs(J.J_sd_finger_pose(2) - 0.5 * (forward + backward)) > 1e-5) {
+      ++wrong;
+      ADD_FAILURE() << "finger pose (" << f.x << ", " << f.y << ", " << f.theta << "): d sd / d theta "
+                    << J.J_sd_finger_pose(2) << ", numeric " << 0.5 * (forward + backward);
+    }
+  }
+  EXPECT_GT(checked, static_cast<int>(poses.size()) * 8 / 10);
+  EXPECT_EQ(wrong, 0);
+}
+
 // Rounded fingers where the exact depth exceeds "core depth + radius" (test_rounded_depth.cpp):
 // the nearest point of the grown obstacle lies on another feature's offset or at a corner where
 // two offsets cross, which moves with the relative angle through both features.
