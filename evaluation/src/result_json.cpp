@@ -39,12 +39,15 @@ Json OtherFingerGaps(const graph::Diagnostics& d) {
 
 }  // namespace
 
-std::string ResultToJson(const graph::EstimationResult& r, int indent) {
+namespace {
+
+Json ResultJson(const graph::EstimationResult& r, bool with_states) {
   Json j;
   j["model"] = graph::ModelName(r.model);
   j["mode"] = graph::ModeName(r.mode);
   Json states = Json::array();
   for (const graph::StateEstimate& s : r.states) {
+    if (!with_states) break;
     Json o;
     o["t"] = s.t;
     o["object_pose"] = Pose(s.object_pose);
@@ -84,7 +87,7 @@ std::string ResultToJson(const graph::EstimationResult& r, int indent) {
     }
     states.push_back(std::move(o));
   }
-  j["states"] = std::move(states);
+  if (with_states) j["states"] = std::move(states);
   j["solver"] = {{"iterations", r.solver.iterations},
                  {"time_s", r.solver.time_s},
                  {"total_time_s", r.solver.total_time_s},
@@ -125,12 +128,14 @@ std::string ResultToJson(const graph::EstimationResult& r, int indent) {
     if (a.suggested) {
       Json t = {a.transform.pose.x, a.transform.pose.y, a.transform.pose.theta};
       Json sigma = {a.sigma.x(), a.sigma.y(), a.rotation_observable ? Json(a.sigma.z()) : Json(nullptr)};
+      if (a.units_only) sigma = nullptr;  // no placement fitted: the file's own frame at the units found
+      shape["units_only"] = a.units_only;
       // Unsettled, the curvature's sigmas cover the chosen placement alone: kept apart from the
       // transform's sigma, which is then null.
       shape["placement_settled"] = a.settled;
       if (!a.settled) {
         shape["placement_unsettled_by"] = a.unsettled_by;
-        shape["local_transform_sigma"] = sigma;
+        if (!a.units_only) shape["local_transform_sigma"] = sigma;
         sigma = nullptr;
       }
       if (a.aligned) {
@@ -186,7 +191,17 @@ std::string ResultToJson(const graph::EstimationResult& r, int indent) {
     for (const auto& [k, v] : r.metrics) m[k] = v;
     j["metrics"] = std::move(m);
   }
-  return internal::DumpJson(j, indent);  // warnings quote file names, which need not be UTF-8
+  return j;
+}
+
+}  // namespace
+
+std::string ResultToJson(const graph::EstimationResult& r, int indent) {
+  return internal::DumpJson(ResultJson(r, true), indent);  // warnings quote file names, which need not be UTF-8
+}
+
+std::string ResultSummaryJson(const graph::EstimationResult& r, int indent) {
+  return internal::DumpJson(ResultJson(r, false), indent);
 }
 
 void SaveResultJson(const graph::EstimationResult& result, const std::string& path) {

@@ -485,8 +485,11 @@ EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode 
   // A step of the object's tracker is no placement evidence either: a hostile user's rect1 with a
   // 50 mm step had its true mesh "aligned" by a turn of 18.4 degrees to explain it.
   const std::optional<std::string> tracker_step = internal::TrackerStepNote(trajectory);
+  // Nor a yaw in degrees: the correct shape was "aligned" by a turn of -99.9 degrees to fit it.
+  const std::optional<std::string> yaw_unit = internal::YawUnitNote(trajectory);
   const char* unit_doubt = time_unit      ? "time stamps that read as milliseconds"
                            : length_unit  ? "lengths that read as centimetres or millimetres"
+                           : yaw_unit     ? "yaws that read as degrees"
                            : tracker_step ? "a step of the object's tracker"
                                           : nullptr;
   EstimationResult r = EstimateValidated(input, model, mode, config, unit_doubt);
@@ -518,7 +521,7 @@ EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode 
   add(ToleranceNote(config));
   add(time_unit);
   add(internal::StreamOverlapNote(trajectory));
-  add(internal::YawUnitNote(trajectory));
+  add(yaw_unit);
   add(tracker_step);
   add(length_unit);
   if (!note.empty()) front.push_back(note);
@@ -969,7 +972,10 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
   // Whether the recording settles a placement used or suggested for a misfit, once
   // the frame check (batch: after the estimate as given) has decided (the units alone and
   // the shape as given are the file's own frame, not a placement).
-  if (registration && (align || misfit) && !units_win && (!identity_wins || frame_wins)) {
+  // The units alone are the file's own frame, yet ties (a rect1 mesh in millimetres: a turn of
+  // 7.5 degrees fits about as well) still leave it unsettled (it read settled, sigma [0, 0, 0]).
+  alignment.units_only = units_win;
+  if (registration && (align || misfit) && (!identity_wins || frame_wins)) {
     std::vector<std::string> open;
     if (registration->ambiguous) open.push_back("the contacts fit other placements about as well");
     if (!alignment.ties.empty()) open.push_back("the whole graph fits others about as well");

@@ -65,6 +65,33 @@ double NearestFingerRatio(const push::Trajectory& traj) {
   return size > 0.0 && std::isfinite(nearest) ? nearest / size : 0.0;
 }
 
+// A finger that never comes near the object's tracked origin pushes nothing: a finger and an
+// object tracker in different frames (a fixed offset of metres) or units. Near is within the
+// shapes' reach of their pose origins (a shape file too small by 100 has no say: the streams
+// alone put the finger 2 m away) and at least 0.5 m, more than any tabletop object needs. The
+// shape check had "repaired" such files by scaling the object 100 or 1000 times (a 12 cm block
+// made 12 m, c = 3.9 m).
+void CheckFingerReachesObject(const push::Trajectory& traj) {
+  const auto& fingers = traj.measured.finger_pose;
+  const auto& objects = traj.measured.object_pose;
+  double nearest = INFINITY, at = 0.0;
+  for (std::size_t i = 0, j = 0; i < fingers.size() && !objects.empty(); ++i) {
+    while (j + 1 < objects.size() && std::abs(objects[j + 1].t - fingers[i].t) <= std::abs(objects[j].t - fingers[i].t)) ++j;
+    const double d = (fingers[i].pose.translation() - objects[j].pose.translation()).norm();
+    if (d < nearest) nearest = d, at = fingers[i].t;
+  }
+  auto reach = [](const geometry::Shape& s) { return s.empty() ? 0.0 : geometry::RadiusAbout(s, geometry::Vec2::Zero()); };
+  constexpr double kLeastReach = 0.5;  // m
+  const double bound = std::max(kLeastReach, 2.0 * (reach(traj.object.shape) + reach(traj.finger.shape)));
+  if (!(nearest > bound) || !std::isfinite(nearest)) return;
+  throw GraphError(Format("trajectory: the finger never comes nearer than %.3g m to the object (at t = %s), beyond the "
+                          "%.3g m a push allows (twice the object's and the finger's reach from their pose origins, and at "
+                          "least %.3g m): are streams.finger_pose and streams.object_pose in different frames (an offset "
+                          "between the two trackers) or units?",
+                          nearest, StepTime(at, fingers.front().t, "the finger's first sample").c_str(), bound,
+                          kLeastReach));
+}
+
 void CheckPositionUnits(const std::vector<push::PoseSample>& s, const std::string& stream, double ratio) {
   if (s.size() < 2 || !(s.back().t > s.front().t)) return;
   Eigen::Vector2d low = s.front().pose.translation(), high = low;
@@ -257,6 +284,28 @@ void ValidateTrajectory(const push::Trajectory& traj) {
   for (std::size_t i = 0; i < m.object_pose.size(); ++i) {
     CheckFinite(std::isfinite(m.object_pose[i].t) && m.object_pose[i].pose.vector().allFinite(), "object_pose", i);
   }
+  // Ground truth only scores the estimate, yet a NaN there made every metric NaN without a word
+  // (a Python dict skips the file reader, which refuses it).
+  auto check_truth = [](const auto& samples, const std::string& stream, auto finite) {
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+      if (!std::isfinite(samples[i].t) || !finite(samples[i]))
+        throw GraphError("trajectory: non-finite value in ground_truth." + stream + "[" + std::to_string(i) + "]");
+    }
+  };
+  auto check_truth_streams = [&](const auto& g, const std::string& who) {
+    check_truth(g.finger_pose, who + "finger_pose", [](const push::PoseSample& x) { return x.pose.vector().allFinite(); });
+    check_truth(g.contact_point, who + "contact_point", [](const push::PointSample& x) { return x.point.allFinite(); });
+    check_truth(g.force, who + "force", [](const push::ForceSample& x) { return x.force.allFinite(); });
+  };
+  if (traj.ground_truth) {
+    check_truth(traj.ground_truth->object_pose, "object_pose",
+                [](const push::PoseSample& x) { return x.pose.vector().allFinite(); });
+    check_truth_streams(*traj.ground_truth, "");
+  }
+  for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k) {
+    if (traj.extra_fingers[k].ground_truth)
+      check_truth_streams(*traj.extra_fingers[k].ground_truth, "fingers[" + std::to_string(k + 1) + "].");
+  }
   for (std::size_t i = 0; i < m.object_pose.size(); ++i) {
     const auto& s = m.object_pose[i];
     CheckRange(s.t, std::max(std::abs(s.pose.x), std::abs(s.pose.y)), geometry::kMaxCoordinate, "object_pose", i, "|position|");
@@ -343,6 +392,7 @@ void ValidateTrajectory(const push::Trajectory& traj) {
   for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k)
     CheckPositionUnits(traj.extra_fingers[k].measured.finger_pose, "fingers[" + std::to_string(k + 1) + "].finger_pose",
                        finger_ratio);
+  CheckFingerReachesObject(traj);
   CheckFingerSize(traj.finger.shape, m.finger_pose, m.object_pose, traj.object.shape, "");
   for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k) {
     CheckFingerSize(traj.extra_fingers[k].finger.shape, traj.extra_fingers[k].measured.finger_pose, m.object_pose,
@@ -770,11 +820,13 @@ std::optional<std::string> StreamOverlapNote(const push::Trajectory& traj) {
   const auto& m = traj.measured;
   struct Span {
     const char* name;
-    double first, last;
+    double first, last, period;
   };
   std::vector<Span> spans;
+  // A stream of one sample has no period to judge a gap by (its own warning names it): a 0.02 s
+  // push with one 25 Hz object sample was said to have its clocks offset.
   auto add = [&spans](const char* name, const auto& s) {
-    if (!s.empty()) spans.push_back({name, s.front().t, s.back().t});
+    if (s.size() >= 2) spans.push_back({name, s.front().t, s.back().t, MedianPeriod(s)});
   };
   add("object_pose", m.object_pose);
   add("finger_pose", m.finger_pose);
@@ -789,6 +841,9 @@ std::optional<std::string> StreamOverlapNote(const push::Trajectory& traj) {
       const Span& x = spans[a];
       const Span& y = spans[b];
       if (x.last >= y.first && y.last >= x.first) continue;
+      // Within two sample periods of either stream the two only interleave (a short push).
+      const double gap = std::max(y.first - x.last, x.first - y.last);
+      if (gap <= 2.0 * std::max(x.period, y.period)) continue;
       return Format("streams: %s (%.6g to %.6g s) and %s (%.6g to %.6g s) share no time: one push's sensors record "
                     "together, so their clocks are probably offset (or the streams come from different recordings); "
                     "the estimate never sees them together and may be worse than the measurements",

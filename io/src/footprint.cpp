@@ -307,7 +307,7 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
                  z = coordinates[3 * index + 2] * options.scale;
     switch (options.up) {
       case UpAxis::kX: return {y, z};
-      case UpAxis::kY: return {z, x};
+      case UpAxis::kY: return {x, -z};  // a y-up export (x, z, -y) of a z-up model: its (x, y) again
       default: return {x, y};
     }
   };
@@ -451,6 +451,33 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
   } catch (const geometry::GeometryError& e) {
     throw IoError(path + ": footprint is not a valid shape: " + e.what());
   }
+}
+
+std::optional<std::string> ShapeUnitsWarning(const geometry::Shape& shape, double scale_given) {
+  if (shape.empty()) return std::nullopt;
+  const geometry::Box2 box = shape.bounds();
+  const double across = std::max(box.max.x() - box.min.x(), box.max.y() - box.min.y());
+  if (!(across > 2.0 || across < 1e-3)) return std::nullopt;
+  char text[200];
+  // The units that would make it 1 cm to 1 m across (a centimetre mesh was told "millimetres").
+  std::string units;
+  if (across > 2.0) {
+    for (const auto& [name, scale] :
+         {std::pair<const char*, double>{"millimetres", 1e-3}, {"centimetres", 1e-2}, {"inches", 0.0254}}) {
+      if (across * scale < 0.01 || across * scale > 1.0) continue;
+      std::snprintf(text, sizeof text, "%s%s (--scale %g%s: %.3g m across)", units.empty() ? "" : " or ", name,
+                    scale * scale_given, scale_given != 1.0 ? " in place of the --scale given" : "", across * scale);
+      units += text;
+    }
+  }
+  std::snprintf(text, sizeof text, "the shape is %.6g m across: shapes are in metres (", across);
+  std::string out = text;
+  if (across > 2.0) {
+    out += units.empty() ? std::string("is it in other units? --scale converts") : "is the file in " + units + "?";
+  } else {
+    out += "was it scaled twice, or is it in other units?";
+  }
+  return out + ")";
 }
 
 }  // namespace pushgraph::io

@@ -29,6 +29,7 @@ namespace {
 using Row = std::array<double, 4>;
 struct Raw {
   std::vector<Row> tip, object, ft;
+  std::vector<std::string> notes;  // the JSON variant's fields left unread
 };
 constexpr const char* kDatasets[3] = {"tip_pose", "object_pose", "ft_wrench"};
 
@@ -84,8 +85,10 @@ Raw ReadH5(const std::string& path) {
       if (dims[1] != 4)
         throw IoError(path + ": dataset '" + kDatasets[k] + "' must be N x 4, is " + std::to_string(dims[0]) + " x " +
                       std::to_string(dims[1]));
-      if (ds.getTypeClass() != H5T_FLOAT && ds.getTypeClass() != H5T_INTEGER)
-        throw IoError(path + ": dataset '" + kDatasets[k] + "' is not numeric");
+      if (ds.getTypeClass() == H5T_INTEGER)  // read as such, 1461697633.2 s was 1461697633 s and 0.05 m was 0
+        throw IoError(path + ": dataset '" + kDatasets[k] + "' holds integers, which cannot carry time stamps to the "
+                      "millisecond or positions in metres: the dataset's arrays are 64-bit floats");
+      if (ds.getTypeClass() != H5T_FLOAT) throw IoError(path + ": dataset '" + kDatasets[k] + "' is not numeric");
       // A header that claims more rows than the file can hold (corrupt, or a fuzzer's) must not
       // become a huge allocation: even compressed, 8-byte values rarely shrink 64-fold.
       const double claimed_bytes = static_cast<double>(dims[0]) * 4.0 * sizeof(double);
@@ -242,6 +245,15 @@ Raw ReadJson(const std::string& path) {
   if (const std::string dup = geometry::FindDuplicateJsonKey(text); !dup.empty()) throw IoError(path + ": " + dup);
   if (!doc.is_object()) throw IoError(path + ": top level must be an object with tip_pose, object_pose, ft_wrench");
   Raw raw;
+  // Other fields are left unread, and named: a second tracker's stream under another name must
+  // not vanish without a word.
+  std::string ignored;
+  for (const auto& item : doc.items()) {
+    if (std::find(std::begin(kDatasets), std::end(kDatasets), item.key()) == std::end(kDatasets))
+      ignored += (ignored.empty() ? "'" : ", '") + item.key() + "'";
+  }
+  if (!ignored.empty())
+    raw.notes.push_back("ignored field(s) " + ignored + ": a recording is read from tip_pose, object_pose and ft_wrench");
   for (int k = 0; k < 3; ++k) {
     if (!doc.contains(kDatasets[k])) throw IoError(path + ": missing field '" + std::string(kDatasets[k]) + "'");
     const nlohmann::json& rows = doc[kDatasets[k]];
@@ -378,6 +390,7 @@ MitRecording ReadMitPush(const std::string& path, const MitReadOptions& o) {
   Raw raw = json ? ReadJson(path) : ReadH5InChild(path);
   MitRecording rec;
   rec.file = path;
+  rec.notes = raw.notes;
   for (int k = 0; k < 3; ++k) Clean(&Slot(raw, k), path, kDatasets[k], &rec);
   // The three sensors record one push: their spans overlap (within the same 10 s).
   for (int a = 0; a < 3; ++a)

@@ -127,17 +127,29 @@ class Reader {
   }
 
   template <typename Sample>
-  std::vector<Sample> Sorted(std::vector<Sample> rows, const std::vector<std::size_t>& row_of, const std::string& path,
+  std::vector<Sample> Sorted(std::vector<Sample> rows, std::vector<std::size_t> row_of, const std::string& path,
                              bool repeats, int finger) const {
     const std::string whose = finger >= 0 ? " of finger " + std::to_string(finger) : "";
+    // A stream logged newest first (every row at or before the one above it) is one push read
+    // backwards: reversed, and said so (it was refused as "two recordings joined").
+    bool newest_first = rows.size() >= 2 && rows.back().t < rows.front().t;
+    for (std::size_t i = 1; i < rows.size() && newest_first; ++i) newest_first = rows[i].t <= rows[i - 1].t;
+    if (newest_first) {
+      std::reverse(rows.begin(), rows.end());
+      std::reverse(row_of.begin(), row_of.end());
+      if (notes_ != nullptr) notes_->push_back(path + whose + ": rows logged newest first, read in reverse");
+    }
     // Rows a little out of order (a logger's buffers) are sorted; a stream whose clock goes back
     // by more than max(1 s, 100 median periods) is two recordings joined or a clock reset, which
     // sorting would interleave into one nonsense push (a concatenated file ran, its shape
     // "aligned" by a turn of 132 degrees, object NEES 2887).
     if (rows.size() >= 3) {
-      std::vector<double> steps;
-      for (std::size_t i = 1; i < rows.size(); ++i)
-        if (rows[i].t > rows[i - 1].t) steps.push_back(rows[i].t - rows[i - 1].t);
+      // The period from the time stamps in order (the rows' own order may be any).
+      std::vector<double> times(rows.size()), steps;
+      for (std::size_t i = 0; i < rows.size(); ++i) times[i] = rows[i].t;
+      std::sort(times.begin(), times.end());
+      for (std::size_t i = 1; i < times.size(); ++i)
+        if (times[i] > times[i - 1]) steps.push_back(times[i] - times[i - 1]);
       double period = 0.0;
       if (!steps.empty()) {
         std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());

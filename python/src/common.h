@@ -20,7 +20,9 @@ using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
 /// `a` as an (N, columns) array; a single row (columns,) is taken as N = 1 when `allow_row`.
 /// Throws ValueError naming `what` and the shape it got.
-inline Array Rows(const py::handle& object, int columns, const char* what, bool allow_row = true) {
+/// `expected` replaces "an array of shape (N, columns)" in that message (one pose, one point).
+inline Array Rows(const py::handle& object, int columns, const char* what, bool allow_row = true,
+                  const char* expected = nullptr) {
   // Real numbers only: NumPy would cast complex numbers (dropping the imaginary part, a warning
   // at most), booleans and None (to NaN) without complaint.
   const py::array raw = py::array::ensure(object);
@@ -37,8 +39,9 @@ inline Array Rows(const py::handle& object, int columns, const char* what, bool 
     std::string shape = "(";
     for (py::ssize_t i = 0; i < a.ndim(); ++i) shape += (i ? ", " : "") + std::to_string(a.shape(i));
     shape += a.ndim() == 1 ? ",)" : ")";
-    throw py::value_error(std::string(what) + ": expected an array of shape (N, " + std::to_string(columns) +
-                          "), got " + shape);
+    throw py::value_error(std::string(what) + ": expected " +
+                          (expected ? std::string(expected) : "an array of shape (N, " + std::to_string(columns) + ")") +
+                          ", got " + shape);
   }
   return a;
 }
@@ -80,15 +83,17 @@ inline geometry::Pose2 PoseRow(const double* r) { return {r[0], r[1], r[2]}; }
 /// One pose from a sequence of three numbers (ValueError otherwise; `finite`: non-finite values
 /// too, where the callee names the stream and time of one, as OnlineEstimator does).
 inline geometry::Pose2 ToPose(const py::handle& object, const char* what, bool finite = true) {
-  const Array a = Rows(object, 3, what);
-  if (a.shape(0) != 1) throw py::value_error(std::string(what) + ": expected one pose (x, y, theta)");
+  const Array a = Rows(object, 3, what, true, "one pose (x, y, theta)");
+  if (a.shape(0) != 1)
+    throw py::value_error(std::string(what) + ": expected one pose (x, y, theta), got " + std::to_string(a.shape(0)));
   if (finite) CheckFinite(a, what);
   return PoseRow(a.data());
 }
 
 inline geometry::Vec2 ToVec2(const py::handle& object, const char* what, bool finite = true) {
-  const Array a = Rows(object, 2, what);
-  if (a.shape(0) != 1) throw py::value_error(std::string(what) + ": expected one point (x, y)");
+  const Array a = Rows(object, 2, what, true, "one point (x, y)");
+  if (a.shape(0) != 1)
+    throw py::value_error(std::string(what) + ": expected one point (x, y), got " + std::to_string(a.shape(0)));
   if (finite) CheckFinite(a, what);
   return {a.data()[0], a.data()[1]};
 }

@@ -3,6 +3,7 @@
 #include "common.h"
 #include "convert.h"
 
+#include <pushgraph/evaluation/result_json.h>
 #include <pushgraph/graph/config.h>
 #include <pushgraph/graph/estimator.h>
 #include <pushgraph/graph/incremental.h>
@@ -177,6 +178,12 @@ py::dict ResultToDict(const EstimationResult& r) {
   d["c_sigma"] = r.c_sigma ? py::object(py::float_(*r.c_sigma)) : py::none();
   d["mu"] = r.mu ? py::object(py::float_(*r.mu)) : py::none();
   d["mu_sigma"] = r.mu_sigma ? py::object(py::float_(*r.mu_sigma)) : py::none();
+  // RESULT.json's parameters (the shape transform applied, c, mu), shape check and
+  // self-diagnosis, with the file's keys: a Python caller could not see which transform an
+  // aligned estimate used but by parsing the warning.
+  const py::dict summary = py::module_::import("json").attr("loads")(evaluation::ResultSummaryJson(r));
+  for (const char* key : {"parameters", "shape", "diagnostics"})
+    d[key] = summary.contains(key) ? py::object(summary[key]) : py::object(py::none());
   return d;
 }
 

@@ -356,11 +356,23 @@ own frame (metres). Immutable; copies share their acceleration structures.
             o.up = io::ParseUpAxis(up);
             o.object = object;
             o.scale = scale;
-            return io::MeshFootprint(path, o);
+            io::FootprintReport report;
+            Shape shape = io::MeshFootprint(path, o, &report);
+            // What `pushgraph footprint` warns of (a side view, several objects united, other
+            // units), as Python warnings: it came back silently.
+            std::vector<std::string> warnings = report.warnings;
+            if (const auto units = io::ShapeUnitsWarning(shape, scale)) warnings.push_back(*units);
+            for (const std::string& w : warnings) {
+              const std::string text = path + ": " + w;
+              if (PyErr_WarnEx(PyExc_UserWarning, text.c_str(), 1) != 0) throw py::error_already_set();
+            }
+            return shape;
           },
           "path"_a, "up"_a = "z", "object"_a = "", "scale"_a = 1.0,
-          "The footprint of an OBJ mesh: the exact union of its triangles projected along `up` ('x', 'y' or 'z'), "
-          "holes kept; `object` picks one object/group of the file; `scale` 0.001 for a mesh in millimetres.")
+          "The footprint of an OBJ mesh: the exact union of its triangles projected along `up` ('x', 'y' or 'z'; "
+          "'y' gives (x, -z), the top view of a y-up export), holes kept; `object` picks one object/group of the "
+          "file; `scale` 0.001 for a mesh in millimetres. A UserWarning says when the footprint is probably not "
+          "what was meant: a prism seen from the side, several objects united, a shape outside 1 mm to 2 m across.")
       .def("to_json", &geometry::ShapeToJson, "indent"_a = 2)
       .def("save_json", [](const Shape& s, const std::string& path) { geometry::SaveShapeJson(s, path); }, "path"_a)
       .def_property_readonly("radius", &Shape::radius)

@@ -11,15 +11,37 @@
 #include <pushgraph/limit_surface/errors.h>
 #include <pushgraph/push/errors.h>
 
+namespace {
+
+// A C++ error as the Python exception `name`, its message decoded from UTF-8 with U+FFFD for
+// invalid bytes (a file's own bytes quoted in a message): pybind11's default translation
+// fails to decode those and raised the exception with no message at all.
+template <class Error>
+void RegisterError(pybind11::module_& m, const char* name, PyObject* base) {
+  static pybind11::exception<Error> type(m, name, base);
+  pybind11::register_exception_translator([](std::exception_ptr thrown) {
+    try {
+      if (thrown) std::rethrow_exception(thrown);
+    } catch (const Error& e) {
+      const std::string text = e.what();
+      PyObject* message = PyUnicode_DecodeUTF8(text.data(), static_cast<Py_ssize_t>(text.size()), "replace");
+      PyErr_SetObject(type.ptr(), message);
+      Py_XDECREF(message);
+    }
+  });
+}
+
+}  // namespace
+
 PYBIND11_MODULE(_pushgraph, m) {
   namespace py = pybind11;
   m.doc() = "pushgraph: geometry-exact planar contact, limit surfaces and factor-graph estimation of pushing";
-  py::register_exception<pushgraph::geometry::GeometryError>(m, "GeometryError", PyExc_ValueError);
-  py::register_exception<pushgraph::limit_surface::LimitSurfaceError>(m, "LimitSurfaceError", PyExc_ValueError);
-  py::register_exception<pushgraph::push::PushError>(m, "PushError", PyExc_ValueError);
-  py::register_exception<pushgraph::graph::GraphError>(m, "GraphError", PyExc_ValueError);
-  py::register_exception<pushgraph::io::IoError>(m, "IoError", PyExc_OSError);
-  py::register_exception<pushgraph::evaluation::EvaluationError>(m, "EvaluationError", PyExc_OSError);
+  RegisterError<pushgraph::geometry::GeometryError>(m, "GeometryError", PyExc_ValueError);
+  RegisterError<pushgraph::limit_surface::LimitSurfaceError>(m, "LimitSurfaceError", PyExc_ValueError);
+  RegisterError<pushgraph::push::PushError>(m, "PushError", PyExc_ValueError);
+  RegisterError<pushgraph::graph::GraphError>(m, "GraphError", PyExc_ValueError);
+  RegisterError<pushgraph::io::IoError>(m, "IoError", PyExc_OSError);
+  RegisterError<pushgraph::evaluation::EvaluationError>(m, "EvaluationError", PyExc_OSError);
   pushgraph::python::RegisterGeometry(m);
   pushgraph::python::RegisterLimitSurface(m);
   pushgraph::python::RegisterTrajectory(m);

@@ -94,6 +94,16 @@ TEST_F(EstimateCli, WritesTheResultFormatForEveryModelAndMode) {
   }
 }
 
+// The simulator's shortest push (0.02 s, one 25 Hz object sample): its streams are on one clock,
+// and only the sample count is worth a word (it was told its clocks were probably offset).
+TEST_F(EstimateCli, AShortPushOnOneClockIsNotCalledOffset) {
+  const std::string in = dir() + "/tiny.json", out = dir() + "/tiny_result.json";
+  ASSERT_EQ(Tool("simulate -o " + in + " --distance 0.0005 --standoff 0.0005 --seed 5").status, 0);
+  const pushgraph::testing::ToolRun r = Tool("estimate " + in + " -o " + out);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err.find("share no time"), std::string::npos) << r.err;
+}
+
 TEST_F(EstimateCli, ConfigFileIsApplied) {
   const std::string in = WritePush();
   const std::string cfg = dir() + "/estimate_cfg.json";
@@ -482,6 +492,13 @@ TEST_F(EstimateCli, AMeshInMillimetresAloneIsEstimatedAsTheRightOne) {
   const nlohmann::json j = Load(dir() + "/mm.json");
   ASSERT_TRUE(j["parameters"].contains("shape_transform"));
   for (int k = 0; k < 3; ++k) EXPECT_EQ(j["parameters"]["shape_transform"][k].get<double>(), 0.0);
+  // No placement was fitted: no sigma (it read exactly [0, 0, 0]), and the ties the warning names
+  // leave it unsettled (it read settled).
+  EXPECT_TRUE(j["shape"]["units_only"].get<bool>());
+  EXPECT_TRUE(j["parameters"]["shape_transform_sigma"].is_null());
+  EXPECT_EQ(j["shape"].contains("tied_transforms"), !j["shape"]["placement_settled"].get<bool>()) << j["shape"].dump();
+  std::printf("[registration] rect1 in millimetres: settled %d, ties %s\n", j["shape"]["placement_settled"].get<bool>(),
+              j["shape"].value("tied_transforms", nlohmann::json::array()).dump().c_str());
   const pushgraph::testing::ToolRun shipped = EstimateMit(h5, "rect1.obj", "", kProbe, kRect1Mass, dir() + "/m.json");
   ASSERT_EQ(shipped.status, 0) << shipped.err;
   const double rms = j["metrics"]["object_position_rms"].get<double>();

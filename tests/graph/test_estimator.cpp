@@ -390,7 +390,12 @@ TEST(Estimator, AYawInDegreesIsNamed) {
   EXPECT_FALSE(HasWarning(Estimate(good, Model::kCp, Mode::kBatch), "is it in degrees"));
   push::Trajectory degrees = good;
   for (auto& p : degrees.measured.object_pose) p.pose.theta *= 180.0 / M_PI;
-  EXPECT_TRUE(HasWarning(Estimate(degrees, Model::kCp, Mode::kBatch), "object_pose: the yaw scatters by"));
+  const EstimationResult r = Estimate(degrees, Model::kCp, Mode::kBatch);
+  EXPECT_TRUE(HasWarning(r, "object_pose: the yaw scatters by"));
+  // And no shape is aligned on it (a hostile user's correct shape was turned by -99.9 degrees).
+  ASSERT_TRUE(r.shape_alignment.has_value());
+  EXPECT_FALSE(r.shape_alignment->aligned);
+  std::printf("[yaw in degrees] %s\n", r.warnings.size() > 1 ? r.warnings[1].c_str() : "");
 }
 
 // Measurement sigmas far beyond the values their stream takes (1000 m for a 5 cm push) leave
@@ -666,9 +671,24 @@ TEST(Estimator, BadTrajectoriesGetClearErrors) {
   auto nan = t;
   nan.measured.force[3].force.x() = NAN;
   EXPECT_NE(message(nan).find("force[3]"), std::string::npos);
+  auto nan_truth = t;  // ground truth too: every metric was NaN without a word
+  ASSERT_TRUE(nan_truth.ground_truth.has_value());
+  nan_truth.ground_truth->object_pose[3].pose.x = NAN;
+  EXPECT_NE(message(nan_truth).find("non-finite value in ground_truth.object_pose[3]"), std::string::npos) << message(nan_truth);
   auto no_shape = t;
   no_shape.finger.shape = geometry::Shape();
   EXPECT_NE(message(no_shape).find("finger.shape"), std::string::npos);
+  // A finger tracked in another frame, 2 m or 20 m off: refused (the shape check had scaled the
+  // object 100 or 1000 times to reach it). 0.3 m off is within 0.5 m and left to the shape check.
+  for (const double offset : {2.0, 20.0}) {
+    auto far = t;
+    for (auto& f : far.measured.finger_pose) f.pose.x += offset;
+    for (auto& c : far.measured.contact_point) c.point.x() += offset;
+    EXPECT_NE(message(far).find("the finger never comes nearer than"), std::string::npos) << offset << ": " << message(far);
+  }
+  auto near = t;
+  for (auto& f : near.measured.finger_pose) f.pose.x += 0.3;
+  EXPECT_EQ(message(near).find("the finger never comes nearer than"), std::string::npos);
   // Object and finger parameters out of the file format's bounds (a trajectory built in code or
   // from a Python dict skips the file reader; these were estimated as if valid): named.
   for (const double mass : {-1.0, double(NAN), 1e9}) {

@@ -146,6 +146,13 @@ TEST_F(Footprint, SideViewsAndSeveralObjectsAreWarned) {
   io::FootprintOptions along_y;
   along_y.up = io::UpAxis::kY;
   EXPECT_DOUBLE_EQ(io::MeshFootprint(side, along_y).core_area(), 1.0);
+  // A z-up model exported y-up, (x, y, z) -> (x, z, -y), read with --up y: the model's own (x, y)
+  // (it came back as (z, x), turned by 90 degrees).
+  const std::string z_up = Write("z_up.obj", "v 0 0 0\nv 0.3 0 0\nv 0.05 0.1 0\nf 1 2 3\n");
+  const std::string y_up = Write("y_up.obj", "v 0 0 -0\nv 0.3 0 -0\nv 0.05 0 -0.1\nf 1 2 3\n");
+  const geometry::Shape model = io::MeshFootprint(z_up, {}), exported = io::MeshFootprint(y_up, along_y);
+  ASSERT_EQ(exported.polygons().size(), 1u);
+  EXPECT_EQ(exported.polygons()[0].outer, model.polygons()[0].outer);
   // --object on a file without named objects says so instead of listing nothing.
   io::FootprintOptions named;
   named.object = "nope";

@@ -175,12 +175,15 @@ TEST_F(MitPush, FrozenSyntheticSensorAndJsonVariant) {
     }
     out << "]";
   }
-  out << "}";
+  out << ", \"object_pose_2\": [], \"extra\": 1}";  // unread fields are named
   out.close();
   const io::MitRecording rec = io::ReadMitPush(json_path);
   EXPECT_TRUE(rec.force_frozen);
   EXPECT_TRUE(rec.streams.force.empty());
   EXPECT_EQ(rec.streams.object_pose.size(), 200u);
+  EXPECT_TRUE(std::any_of(rec.notes.begin(), rec.notes.end(), [](const std::string& n) {
+    return n.find("ignored field(s) 'extra', 'object_pose_2'") != std::string::npos;
+  }));
 }
 
 // A finding of fuzz_mit_hdf5: a real recording whose root group's B-tree address (bytes 168 to
@@ -261,6 +264,8 @@ TEST_F(MitPush, BrokenFilesGetClearErrors) {
     for (Row& r : set.second) r[0] += 1.4616e9;
   WriteH5((dir_ / "float32.h5").string(), unix_times, 4, H5::PredType::NATIVE_FLOAT);
   expect_error((dir_ / "float32.h5").string(), "stored as 32-bit floats, whose time stamps near");
+  WriteH5((dir_ / "int64.h5").string(), sets, 4, H5::PredType::NATIVE_INT64);  // 1000.004 s read as 1000 s, 0.05 m as 0
+  expect_error((dir_ / "int64.h5").string(), "dataset 'tip_pose' holds integers");
   WriteH5((dir_ / "float32_short_times.h5").string(), sets, 4, H5::PredType::NATIVE_FLOAT);  // 1000 s: 61 us apart
   EXPECT_NO_THROW(io::ReadMitPush((dir_ / "float32_short_times.h5").string()));
   const std::string garbage = (dir_ / "garbage.h5").string();

@@ -91,6 +91,19 @@ TEST(TrajectoryJson, AClockThatGoesBackIsRefused) {
   ExpectError(Doc(R"({"force": [)" + rows + "]}"), "streams.force: row [301] goes back in time by 1.198 s");
   ExpectError(Doc(R"({"force": [)" + rows + "]}"), "are two recordings joined");
   EXPECT_NO_THROW(ParseTrajectoryJson(Doc(R"({"force": [[0.0, 1, 0], [0.3, 1, 0], [0.1, 2, 0], [0.2, 3, 0]]})")));
+  // A stream logged newest first is read in reverse, with a note (2 s at 25 Hz backwards was
+  // refused as "two recordings joined ... the stream's median period is 0 s").
+  std::string reversed;
+  for (int i = 50; i >= 0; --i) reversed += (i < 50 ? "," : "") + std::string("[") + std::to_string(0.04 * i) + ", " + std::to_string(i) + ", 0]";
+  std::vector<std::string> notes;
+  const auto t = ParseTrajectoryJson(Doc(R"({"force": [)" + reversed + "]}"), "push.json", &notes);
+  ASSERT_EQ(t.measured.force.size(), 51u);
+  EXPECT_EQ(t.measured.force.front().t, 0.0);
+  EXPECT_EQ(t.measured.force.back().force.x(), 50.0);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("streams.force: rows logged newest first, read in reverse"), std::string::npos) << notes[0];
+  // The period in the message comes from the time stamps in order.
+  ExpectError(Doc(R"({"force": [)" + rows + "]}"), "the stream's median period is 0.004 s");
 }
 
 TEST(TrajectoryJson, MeasurementSigmasRoundTripAndAreChecked) {

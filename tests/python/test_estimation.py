@@ -81,6 +81,10 @@ def test_batch_estimate_equals_the_command_line_tool_to_the_last_bit(push, tmp_p
         assert np.array(s["object_pose_cov"]).tolist() == r["object_pose_cov"][i].tolist()
     assert cli["metrics"]["object_position_rms"] == r["metrics"]["object_position_rms"]
     assert r["metrics"]["object_position_rms"] < 0.3 * r["metrics"]["measured_object_position_rms"]
+    # RESULT.json's parameters, shape check and self-diagnosis, with its keys.
+    for key in ("parameters", "shape", "diagnostics"):
+        assert r[key] == cli.get(key), key
+    assert r["shape"]["checked"] and r["parameters"]["c"] > 0
 
 
 def test_incremental_every_step_and_the_chain_solver(push):

@@ -73,6 +73,11 @@ def test_query_arrays_shapes_dtypes_and_bad_arrays(notched_block):
         notched_block.signed_distance(bad)
     with pytest.raises(ValueError, match=r"expected an array of shape \(N, 2\)"):
         notched_block.signed_distance(np.zeros((4, 3)))
+    # A pose is one pose whatever is wrong with it (a pose of two numbers was told to be an (N, 3) array).
+    with pytest.raises(ValueError, match=r"pose: expected one pose \(x, y, theta\), got \(2,\)"):
+        notched_block.query(pts, pose=(0.01, 0.0))
+    with pytest.raises(ValueError, match=r"pose: expected one pose \(x, y, theta\), got 2"):
+        notched_block.query(pts, pose=np.zeros((2, 3)))
     for bad in ([["a", "b"]], [[1j, 0.0]], [[True, False]], np.array([[None, 1.0]], dtype=object)):
         with pytest.raises(TypeError, match="points: expected"):
             notched_block.signed_distance(bad)
@@ -161,12 +166,27 @@ def test_a_mesh_footprint_in_millimetres(tmp_path):
     obj = tmp_path / "box.obj"
     obj.write_text("v 0 0 0\nv 90 0 0\nv 90 60 0\nv 0 60 0\nv 0 0 10\nv 90 0 10\nv 90 60 10\nv 0 60 10\n"
                    "f 1 2 3\nf 1 3 4\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n")
-    s = pg.Shape.from_mesh(str(obj), scale=0.001)
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # nothing to say at the right scale
+        s = pg.Shape.from_mesh(str(obj), scale=0.001)
     assert s.area == pytest.approx(0.09 * 0.06, rel=1e-12)
+    # Read in the file's millimetres as metres: said as `pushgraph footprint` says it.
+    with pytest.warns(UserWarning, match=r"90 m across.*is the file in millimetres \(--scale 0.001"):
+        pg.Shape.from_mesh(str(obj))
     empty = tmp_path / "empty.obj"
     empty.write_text("# nothing\n")
     with pytest.raises(pg.IoError, match="empty.obj"):
         pg.Shape.from_mesh(str(empty))
+
+
+def test_errors_quoting_bytes_that_are_not_utf8_keep_their_message(tmp_path):
+    # A file's own bytes in a message (here a Latin-1 e): the exception came with no message at all.
+    latin = tmp_path / "latin.json"
+    latin.write_bytes(b'{"format": "caf\xe9"}')
+    with pytest.raises(pg.IoError, match="latin.json") as error:
+        pg.load_trajectory(str(latin))
+    assert "\ufffd" in str(error.value)
 
 
 def test_shapes_pickle_and_deepcopy(notched_block):

@@ -244,9 +244,10 @@ geometry::Shape LoadMeshArgument(const std::string& path, const std::string& wha
       std::fprintf(stderr,
                    "pushgraph: %s %s: its footprint is a regular %zu-gon, a tessellated cylinder: used as the disk "
                    "of radius %.4g mm at (%.3f, %.3f) mm it approximates (a polygonal finger solves 6 to 13x "
-                   "slower; pushgraph footprint %s -o SHAPE.json keeps the polygon)\n",
+                   "slower; pushgraph footprint %s%s -o SHAPE.json keeps the polygon)\n",
                    what.c_str(), path.c_str(), shape.polygons()[0].outer.size(), 1e3 * disk->radius(),
-                   1e3 * centre.x(), 1e3 * centre.y(), path.c_str());
+                   1e3 * centre.x(), 1e3 * centre.y(), path.c_str(),
+                   options.up == io::UpAxis::kZ ? "" : (std::string(" --up ") + up).c_str());
       return *disk;
     }
   }
@@ -254,6 +255,11 @@ geometry::Shape LoadMeshArgument(const std::string& path, const std::string& wha
 }
 
 }  // namespace
+
+void WarnShapeUnits(const geometry::Shape& shape, const std::string& what, const std::string& path) {
+  if (const auto units = io::ShapeUnitsWarning(shape))
+    std::fprintf(stderr, "pushgraph: warning: %s %s: %s\n", what.c_str(), path.c_str(), units->c_str());
+}
 
 geometry::Shape LoadShapeArgument(const std::string& path, const std::string& what) {
   std::string extension = std::filesystem::path(path).extension().string();

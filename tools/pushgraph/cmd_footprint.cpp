@@ -74,29 +74,7 @@ void RegisterFootprint(CLI::App& app) {
       geometry::SaveShapeJson(shape, args->output);
     }
     for (const std::string& w : report.warnings) std::cerr << "footprint: warning: " << args->mesh << ": " << w << "\n";
-    // Shapes are in metres: a pushed object outside 1 mm to 2 m across is probably in other units.
-    const geometry::Box2 box = shape.bounds();
-    const double across = std::max(box.max.x() - box.min.x(), box.max.y() - box.min.y());
-    if (across > 2.0 || across < 1e-3) {
-      // The units that would make it 1 cm to 1 m across (a centimetre mesh was told "millimetres").
-      std::string units;
-      if (across > 2.0) {
-        for (const auto& [name, scale] : {std::pair<const char*, double>{"millimetres", 1e-3}, {"centimetres", 1e-2},
-                                          {"inches", 0.0254}}) {
-          if (across * scale < 0.01 || across * scale > 1.0) continue;
-          char text[120];
-          // Relative to the file: a --scale given already is part of `across`.
-          std::snprintf(text, sizeof text, "%s%s (--scale %g%s: %.3g m across)", units.empty() ? "" : " or ", name,
-                        scale * args->scale, args->scale != 1.0 ? " in place of the --scale given" : "", across * scale);
-          units += text;
-        }
-      }
-      std::cerr << "footprint: warning: the shape is " << FormatDouble(across) << " m across: shapes are in metres ("
-                << (across > 2.0 ? (units.empty() ? std::string("is it in other units? --scale converts")
-                                                   : "is the file in " + units + "?")
-                                 : std::string("was it scaled twice, or is it in other units?"))
-                << ")\n";
-    }
+    if (const auto units = io::ShapeUnitsWarning(shape, args->scale)) std::cerr << "footprint: warning: " << *units << "\n";
     if (!args->quiet && !json) {
       int holes = 0;
       for (const geometry::Polygon& p : shape.polygons()) holes += static_cast<int>(p.holes.size());

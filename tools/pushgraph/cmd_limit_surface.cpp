@@ -34,7 +34,8 @@ nlohmann::json ToJson(const ls::EllipsoidError& e) {
 
 void Run(const LimitSurfaceOptions& options) {
   ls::SupportSpec spec;
-  spec.region = geometry::LoadShapeJson(options.shape_path);
+  spec.region = LoadShapeArgument(options.shape_path, "SHAPE");
+  WarnShapeUnits(spec.region, "SHAPE", options.shape_path);
   spec.mass = options.mass;
   spec.mu = options.mu;
   spec.gravity = options.gravity;
@@ -75,7 +76,7 @@ void Run(const LimitSurfaceOptions& options) {
 void RegisterLimitSurface(CLI::App& app) {
   auto options = std::make_shared<LimitSurfaceOptions>();
   auto* cmd = app.add_subcommand("limit-surface", "Limit surface of a sliding shape under uniform pressure");
-  cmd->add_option("SHAPE", options->shape_path, "Support region: shape JSON file (polygons with holes, or a disk)")
+  cmd->add_option("SHAPE", options->shape_path, "Support region: shape JSON file (polygons with holes, or a disk) or OBJ mesh (its footprint along z)")
       ->required();
   cmd->add_option("--mass", options->mass, "Object mass in kg (> 0)")->required()->check(MassValue());
   cmd->add_option("--mu", options->mu, "Object-surface friction coefficient (> 0)")->required()->check(FrictionValue(false));

@@ -109,6 +109,7 @@ void Run(const SimulateOptions& o) {
   NonNegative(o.occlusion_scale, "--occlusion-scale");
 
   plan.object.shape = LoadShapeArgument(o.object_path, "--object");
+  WarnShapeUnits(plan.object.shape, "--object", o.object_path);
   plan.object.mass = o.mass;
   plan.object.mu_surface = o.mu_surface;
   plan.finger = {LoadShapeArgument(o.finger_paths.empty() ? o.finger_path : o.finger_paths[0],

@@ -22,6 +22,9 @@
 namespace pushgraph::evaluation {
 
 std::string ResultToJson(const graph::EstimationResult& result, int indent = 1);
+/// RESULT.json without its states: the solver, parameters, shape check, diagnostics, warnings
+/// and metrics (what the Python result dict takes its "parameters", "shape" and "diagnostics" from).
+std::string ResultSummaryJson(const graph::EstimationResult& result, int indent = -1);
 /// Throws EvaluationError (trajectory_json.h) when the file cannot be written.
 void SaveResultJson(const graph::EstimationResult& result, const std::string& path);
 

@@ -118,6 +118,9 @@ struct ShapeAlignment {
   Eigen::Vector3d sigma = Eigen::Vector3d::Zero();  ///< of (x, y, theta); theta 0 when unobservable
   bool rotation_observable = true;
   bool refined = false;  ///< refined as a static variable of the factor graph (batch)
+  /// The units alone were applied (scale, mirror; the file's own frame): no placement was fitted,
+  /// so the transform has no sigma (RESULT.json: null), not a zero one.
+  bool units_only = false;
   /// The finger radius (m) the estimate used when it is not the given one: the shape did not
   /// fit, and the shape as given with this finger fitted the whole graph clearly better than any
   /// placement (a wrong probe radius or object size; align_shape "auto" only).

@@ -10,12 +10,15 @@
 //   geometry::Shape tip = io::MeshFootprint("tip.obj", options, &report);
 #include <pushgraph/geometry/shape.h>
 
+#include <optional>
 #include <string>
 #include <vector>
 
 namespace pushgraph::io {
 
-/// Projection: kZ -> (x, y), kY -> (z, x), kX -> (y, z) (right-handed: u x v = up).
+/// Projection: kZ -> (x, y), kY -> (x, -z), kX -> (y, z) (right-handed: u x v = up). kY is the
+/// y-up convention of OBJ exports (Blender's, glTF's): a z-up model exported y-up, (x, z, -y),
+/// comes back in the model's own (x, y). (Until 2026-11-27 kY gave (z, x): turned by 90 degrees.)
 enum class UpAxis { kX, kY, kZ };
 
 /// Parses "x", "y" or "z" (throws IoError otherwise).
@@ -45,5 +48,11 @@ struct FootprintReport {
 /// or a footprint of zero area.
 geometry::Shape MeshFootprint(const std::string& obj_path, const FootprintOptions& options = {},
                               FootprintReport* report = nullptr);
+
+/// Shapes are in metres, and a pushed object or finger is 1 mm to 2 m across: outside that, a
+/// warning naming the units that would bring it to 1 cm to 1 m ("the shape is 90 m across: ...
+/// is the file in millimetres (--scale 0.001: 0.09 m across)?"), else nullopt. `scale_given`:
+/// a scale already applied (the suggested --scale is relative to the file).
+std::optional<std::string> ShapeUnitsWarning(const geometry::Shape& shape, double scale_given = 1.0);
 
 }  // namespace pushgraph::io
