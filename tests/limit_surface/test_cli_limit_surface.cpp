@@ -95,4 +95,20 @@ TEST_F(LimitSurfaceCli, BadInputIsAOneLineError) {
   EXPECT_NE(Exec(square_ + " --mu 0.3").status, 0);  // --mass is required
 }
 
+// An OBJ mesh is read as its footprint (it was a raw JSON parse error), and a shape in other
+// units is warned of (a mesh in millimetres gave a 90 m block, c = 34 m, without a word).
+TEST_F(LimitSurfaceCli, MeshesAreReadAndOtherUnitsWarned) {
+  const std::string mesh = Write("box.obj", "v 0 0 0\nv 0.09 0 0\nv 0.09 0.09 0\nv 0 0.09 0\nf 1 2 3 4\n");
+  const ToolRun from_mesh = Exec(mesh + " --mass 1 --mu 0.3");
+  ASSERT_EQ(from_mesh.status, 0) << from_mesh.err;
+  const ToolRun from_json = Exec(square_ + " --mass 1 --mu 0.3");
+  EXPECT_EQ(nlohmann::json::parse(from_mesh.out)["c"], nlohmann::json::parse(from_json.out)["c"]);
+  EXPECT_EQ(from_json.err.find("across"), std::string::npos) << from_json.err;
+  const std::string mm = Write("square_mm.json", R"({"polygons": [{"outer": [[0,0],[90,0],[90,90],[0,90]]}]})");
+  const ToolRun in_mm = Exec(mm + " --mass 1 --mu 0.3");
+  ASSERT_EQ(in_mm.status, 0) << in_mm.err;
+  EXPECT_NE(in_mm.err.find("the shape is 90 m across: shapes are in metres (is the file in millimetres"), std::string::npos)
+      << in_mm.err;
+}
+
 }  // namespace
