@@ -417,6 +417,7 @@ SolveOutcome GraphBuilder::Solve(ceres::Problem& problem, int max_iterations, do
   options.function_tolerance = function_tolerance;
   options.describe = [this](ceres::ResidualBlockId id) { return Describe(id); };
   options.log_iterations = SolverLogLevel() >= 2;
+  options.model_confirms_convergence = !incremental_;
   out.chain = std::make_unique<ChainSolver>(problem);
   ChainSolverSummary summary;
   try {

@@ -128,6 +128,10 @@ class GraphBuilder {
   /// Solves `problem` (built by this builder) with config.solver; `what` names the stage in
   /// logs. Throws GraphError when the solve fails (naming the factor and step when known).
   SolveOutcome Solve(ceres::Problem& problem, int max_iterations, double function_tolerance, const char* what) const;
+  /// The fixed-lag smoother's solves (its windows are refined by later updates and the final
+  /// smoothing pass) stop on the function tolerance alone, as they did; batch solves also need
+  /// the step's model to agree the change is small (ChainSolverOptions::model_confirms_convergence).
+  void set_incremental(bool incremental) { incremental_ = incremental; }
   /// Names a residual block this builder added: "quasi_static factor at step 17 (t = 0.068 s)".
   std::string Describe(ceres::ResidualBlockId id) const;
   /// Drops a removed residual block's record (the fixed-lag smoother's marginalization): Ceres
@@ -425,6 +429,7 @@ class GraphBuilder {
   /// While StageSteps solves the kinematics first: no shape frame, factors not recorded for
   /// Describe or the diagnostics (that problem is gone after it).
   bool warm_start_ = false;
+  bool incremental_ = false;
   int adding_step_ = -1;  ///< the step whose factors are being added (-1: shared)
   int second_contacts_ignored_ = 0;  ///< Yu baseline: steps with two contacts it models as one
   /// Per finger, without a contact stream: whether its force samples so far have shown a contact

@@ -135,6 +135,7 @@ struct FixedLagSmoother {
     if (cfg.estimate_c || cfg.estimate_mu) {
       throw GraphError("estimate_c and estimate_mu are batch only: the incremental mode keeps c and mu fixed");
     }
+    builder.set_incremental(true);
     ceres::Problem::Options po;
     po.enable_fast_removal = true;
     problem = std::make_unique<ceres::Problem>(po);

@@ -144,11 +144,14 @@ TEST(TwoFingers, BothFingersAreEstimatedWithTheirContactsAndForces) {
   }
 }
 
-// The Ceres path and the chain solver reach the same minimum on a two-finger push.
+// The Ceres path and the chain solver reach the same minimum on a two-finger push, both solved to
+// a tight tolerance: at the default 1e-6 Ceres stops on a mispredicted step 1e-5 of the cost above
+// the minimum the chain solver goes on to (docs/estimation.md, Solvers).
 TEST(TwoFingers, BothSolversReachTheSameMinimum) {
   const push::Trajectory t = TwoFingerPush(4);
   EstimatorConfig config = ApplyMeasurementSigmas(EstimatorConfig{}, *t.measurement_sigmas);
   config.covariance = false;
+  config.function_tolerance = 1e-10;
   config.solver = EstimatorConfig::Solver::kCeres;
   const EstimationResult ceres = Estimate(t, Model::kQs, Mode::kBatch, config);
   config.solver = EstimatorConfig::Solver::kChain;

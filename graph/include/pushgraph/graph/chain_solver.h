@@ -32,8 +32,12 @@ namespace pushgraph::graph {
 
 struct ChainSolverOptions {
   int max_iterations = 100;
-  /// Converged when a successful step changes the cost by less than this fraction of it.
+  /// Converged when a successful step changes the cost by less than this fraction of it (and,
+  /// with model_confirms_convergence, its linear model predicted at most 4 times that: a step
+  /// accepted at rho 0.03 changes the cost little because its model failed, not because the
+  /// cost is flat).
   double function_tolerance = 1e-6;
+  bool model_confirms_convergence = true;
   /// Converged when max_i |x_i - Project(x_i - g_i)| is below this (g the gradient).
   double gradient_tolerance = 1e-12;
   /// Converged when |dx| <= parameter_tolerance (|x| + parameter_tolerance).
