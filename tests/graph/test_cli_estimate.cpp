@@ -104,6 +104,25 @@ TEST_F(EstimateCli, AShortPushOnOneClockIsNotCalledOffset) {
   EXPECT_EQ(r.err.find("share no time"), std::string::npos) << r.err;
 }
 
+// A degraded occlusion window is noisier than the one sigma per stream the file records: the
+// simulator says so, and the robust object loss it points to bounds the estimate there.
+TEST_F(EstimateCli, ADegradedOcclusionIsNotedAndARobustLossBoundsIt) {
+  const std::string in = dir() + "/degrade.json", cfg = dir() + "/cauchy.json";
+  const pushgraph::testing::ToolRun sim = Tool("simulate -o " + in + " --occlusion 0.3,0.8 --occlusion-mode degrade --seed 4");
+  ASSERT_EQ(sim.status, 0) << sim.err;
+  EXPECT_NE(sim.err.find("note: --occlusion-mode degrade: inside the windows the object's noise is 10 times"), std::string::npos)
+      << sim.err;
+  std::ofstream(cfg) << R"({"losses": {"object_pose": {"type": "cauchy", "scale": 2}}})";
+  ASSERT_EQ(Tool("estimate " + in + " -o " + dir() + "/as_given.json").status, 0);
+  ASSERT_EQ(Tool("estimate " + in + " --config " + cfg + " -o " + dir() + "/robust.json").status, 0);
+  const nlohmann::json a = Load(dir() + "/as_given.json")["metrics"], b = Load(dir() + "/robust.json")["metrics"];
+  std::printf("[degrade] object %.2f mm, NEES %.1f as given; %.2f mm, NEES %.1f with the Cauchy loss\n",
+              1e3 * a["object_position_rms"].get<double>(), a["object_pose_nees"].get<double>(),
+              1e3 * b["object_position_rms"].get<double>(), b["object_pose_nees"].get<double>());
+  EXPECT_LT(b["object_position_rms"].get<double>(), 0.5 * a["object_position_rms"].get<double>());
+  EXPECT_LT(b["object_pose_nees"].get<double>(), 0.1 * a["object_pose_nees"].get<double>());
+}
+
 TEST_F(EstimateCli, ConfigFileIsApplied) {
   const std::string in = WritePush();
   const std::string cfg = dir() + "/estimate_cfg.json";
