@@ -78,7 +78,9 @@ def estimate(trajectory, model="qs", mode="batch", config=None, apply_measuremen
     Returns a dict: t (N,), object_pose and finger_pose (N, 3), contact and force (N, 2; NaN
     where the state has none), their covariances (N, 3, 3) / (N, 2, 2) (NaN when absent),
     metrics (RMS errors and NEES against ground truth), warnings, solver (name, iterations,
-    times, update_times_s), c, c_sigma, mu, mu_sigma. Raises GraphError naming the bad input.
+    times, update_times_s), c, c_sigma, mu, mu_sigma, and RESULT.json's parameters (the shape
+    transform applied, c, mu), shape (the shape check) and diagnostics with the file's keys (None
+    when absent). Raises GraphError naming the bad input.
     """
     if model not in MODELS:
         raise GraphError("model: expected one of %s, got %r" % (", ".join(MODELS), model))
