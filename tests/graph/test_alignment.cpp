@@ -293,7 +293,9 @@ TEST(Alignment, TooLittleContactIsNotAlignedOn) {
     const EstimationResult r = Estimate(t, Model::kQs, Mode::kBatch, cfg);
     ASSERT_TRUE(r.shape_alignment && r.shape_alignment->checked) << m.name;
     EXPECT_FALSE(r.shape_alignment->aligned) << m.name << ": " << (r.warnings.empty() ? "" : r.warnings[0]);
-    if (HasWarning(r, "does not fit this recording as given")) EXPECT_TRUE(HasWarning(r, "too little contact")) << m.name;
+    if (HasWarning(r, "does not fit this recording as given")) {
+      EXPECT_TRUE(HasWarning(r, "too little contact")) << m.name;
+    }
   }
 }
 
@@ -323,8 +325,9 @@ TEST(Alignment, NothingIsAlignedOnTimeStampsInMilliseconds) {
       EXPECT_NE(r.warnings[0].find("are the times in milliseconds"), std::string::npos) << r.warnings[0];
       ASSERT_TRUE(r.shape_alignment && r.shape_alignment->checked) << m.name;
       EXPECT_FALSE(r.shape_alignment->aligned) << "seed " << seed << ", " << m.name;
-      if (HasWarning(r, "does not fit this recording as given"))
+      if (HasWarning(r, "does not fit this recording as given")) {
         EXPECT_TRUE(HasWarning(r, "not aligned on time stamps that read as milliseconds")) << seed << ", " << m.name;
+      }
     }
   }
 }

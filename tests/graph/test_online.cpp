@@ -111,7 +111,9 @@ TEST(Online, UpdatesThatWaitForTheCameraAreSaid) {
       return w.find("updates at the sensor rate waited for the camera") != std::string::npos;
     });
     EXPECT_EQ(said, latency > 0.0) << latency << ": " << r.solver.updates << " updates for " << r.states.size() << " steps";
-    if (latency == 0.0) EXPECT_GT(2 * r.solver.updates, static_cast<int>(r.states.size()));
+    if (latency == 0.0) {
+      EXPECT_GT(2 * r.solver.updates, static_cast<int>(r.states.size()));
+    }
   }
 }
 
