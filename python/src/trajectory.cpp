@@ -8,6 +8,10 @@
 #include <pushgraph/push/noise.h>
 #include <pushgraph/push/simulator.h>
 
+#include <algorithm>
+#include <cstring>
+#include <fstream>
+
 namespace pushgraph::python {
 namespace {
 
@@ -282,6 +286,12 @@ void RegisterTrajectory(py::module_& m) {
   m.def(
       "load_trajectory",
       [](const std::string& path) {
+        // An MIT recording given here was "malformed JSON ... invalid literal": say what it is.
+        char signature[8] = {};
+        std::ifstream(path, std::ios::binary).read(signature, sizeof signature);
+        if (std::memcmp(signature, "\x89HDF\r\n\x1a\n", 8) == 0)
+          throw io::IoError(path + ": an HDF5 file: load_trajectory reads trajectory JSON (docs/formats.md); an MIT "
+                            "pushing recording is read by read_mit_push");
         Trajectory t;
         {
           py::gil_scoped_release release;

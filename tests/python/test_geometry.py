@@ -187,6 +187,11 @@ def test_errors_quoting_bytes_that_are_not_utf8_keep_their_message(tmp_path):
     with pytest.raises(pg.IoError, match="latin.json") as error:
         pg.load_trajectory(str(latin))
     assert "\ufffd" in str(error.value)
+    # An HDF5 recording given to load_trajectory is named as such (it was "malformed JSON").
+    h5 = tmp_path / "recording.h5"
+    h5.write_bytes(b"\x89HDF\r\n\x1a\n" + bytes(64))
+    with pytest.raises(pg.IoError, match="recording.h5: an HDF5 file: .*read_mit_push"):
+        pg.load_trajectory(str(h5))
 
 
 def test_shapes_pickle_and_deepcopy(notched_block):
