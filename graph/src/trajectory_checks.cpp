@@ -16,6 +16,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <utility>
 
 namespace pushgraph::graph::internal {
 namespace {
@@ -52,14 +53,21 @@ constexpr double kMaxPushSpeed = 5.0, kMinJudgedSpan = 0.2;  // m/s, m
 // finger's and object's frames differ. The nearest, not the median: a finger that retreats 40 cm
 // from a 1 cm block after a brief push spends almost all of the recording far from it (median 24
 // sizes) and was refused. Noise only brings it nearer.
-double NearestFingerRatio(const push::Trajectory& traj) {
-  const auto& fingers = traj.measured.finger_pose;
-  const auto& objects = traj.measured.object_pose;
-  double nearest = INFINITY;
+// The finger's nearest approach to the object's tracked origin (each finger sample against the
+// object sample nearest in time) and the finger sample's time; INFINITY without samples.
+std::pair<double, double> NearestApproach(const std::vector<push::PoseSample>& fingers,
+                                          const std::vector<push::PoseSample>& objects) {
+  double nearest = INFINITY, at = 0.0;
   for (std::size_t i = 0, j = 0; i < fingers.size() && !objects.empty(); ++i) {
     while (j + 1 < objects.size() && std::abs(objects[j + 1].t - fingers[i].t) <= std::abs(objects[j].t - fingers[i].t)) ++j;
-    nearest = std::min(nearest, (fingers[i].pose.translation() - objects[j].pose.translation()).norm());
+    const double d = (fingers[i].pose.translation() - objects[j].pose.translation()).norm();
+    if (d < nearest) nearest = d, at = fingers[i].t;
   }
+  return {nearest, at};
+}
+
+double NearestFingerRatio(const push::Trajectory& traj) {
+  const double nearest = NearestApproach(traj.measured.finger_pose, traj.measured.object_pose).first;
   const geometry::Box2 box = traj.object.shape.bounds();
   const double size = std::max(box.max.x() - box.min.x(), box.max.y() - box.min.y());
   return size > 0.0 && std::isfinite(nearest) ? nearest / size : 0.0;
@@ -72,23 +80,24 @@ double NearestFingerRatio(const push::Trajectory& traj) {
 // shape check had "repaired" such files by scaling the object 100 or 1000 times (a 12 cm block
 // made 12 m, c = 3.9 m).
 void CheckFingerReachesObject(const push::Trajectory& traj) {
-  const auto& fingers = traj.measured.finger_pose;
   const auto& objects = traj.measured.object_pose;
-  double nearest = INFINITY, at = 0.0;
-  for (std::size_t i = 0, j = 0; i < fingers.size() && !objects.empty(); ++i) {
-    while (j + 1 < objects.size() && std::abs(objects[j + 1].t - fingers[i].t) <= std::abs(objects[j].t - fingers[i].t)) ++j;
-    const double d = (fingers[i].pose.translation() - objects[j].pose.translation()).norm();
-    if (d < nearest) nearest = d, at = fingers[i].t;
-  }
   auto reach = [](const geometry::Shape& s) { return s.empty() ? 0.0 : geometry::RadiusAbout(s, geometry::Vec2::Zero()); };
+  // The nearest of every finger (with several, one may push while another waits far away).
+  auto [nearest, at] = NearestApproach(traj.measured.finger_pose, objects);
+  double finger_reach = reach(traj.finger.shape), first = traj.measured.finger_pose.empty() ? 0.0 : traj.measured.finger_pose.front().t;
+  for (const push::ExtraFinger& f : traj.extra_fingers) {
+    const auto [d, t] = NearestApproach(f.measured.finger_pose, objects);
+    if (d < nearest) nearest = d, at = t;
+    finger_reach = std::max(finger_reach, reach(f.finger.shape));
+  }
   constexpr double kLeastReach = 0.5;  // m
-  const double bound = std::max(kLeastReach, 2.0 * (reach(traj.object.shape) + reach(traj.finger.shape)));
+  const double bound = std::max(kLeastReach, 2.0 * (reach(traj.object.shape) + finger_reach));
   if (!(nearest > bound) || !std::isfinite(nearest)) return;
   throw GraphError(Format("trajectory: the finger never comes nearer than %.3g m to the object (at t = %s), beyond the "
                           "%.3g m a push allows (twice the object's and the finger's reach from their pose origins, and at "
                           "least %.3g m): are streams.finger_pose and streams.object_pose in different frames (an offset "
                           "between the two trackers) or units?",
-                          nearest, StepTime(at, fingers.front().t, "the finger's first sample").c_str(), bound,
+                          nearest, StepTime(at, first, "the finger's first sample").c_str(), bound,
                           kLeastReach));
 }
 

@@ -453,7 +453,7 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
   }
 }
 
-std::optional<std::string> ShapeUnitsWarning(const geometry::Shape& shape, double scale_given) {
+std::optional<std::string> ShapeUnitsWarning(const geometry::Shape& shape, double scale_given, const std::string& scale_is) {
   if (shape.empty()) return std::nullopt;
   const geometry::Box2 box = shape.bounds();
   const double across = std::max(box.max.x() - box.min.x(), box.max.y() - box.min.y());
@@ -465,15 +465,15 @@ std::optional<std::string> ShapeUnitsWarning(const geometry::Shape& shape, doubl
     for (const auto& [name, scale] :
          {std::pair<const char*, double>{"millimetres", 1e-3}, {"centimetres", 1e-2}, {"inches", 0.0254}}) {
       if (across * scale < 0.01 || across * scale > 1.0) continue;
-      std::snprintf(text, sizeof text, "%s%s (--scale %g%s: %.3g m across)", units.empty() ? "" : " or ", name,
-                    scale * scale_given, scale_given != 1.0 ? " in place of the --scale given" : "", across * scale);
+      std::snprintf(text, sizeof text, "%s%s (%s%g%s: %.3g m across)", units.empty() ? "" : " or ", name, scale_is.c_str(),
+                    scale * scale_given, scale_given != 1.0 ? " in place of the scale given" : "", across * scale);
       units += text;
     }
   }
   std::snprintf(text, sizeof text, "the shape is %.6g m across: shapes are in metres (", across);
   std::string out = text;
   if (across > 2.0) {
-    out += units.empty() ? std::string("is it in other units? --scale converts") : "is the file in " + units + "?";
+    out += units.empty() ? "is it in other units? " + scale_is + "S converts" : "is the file in " + units + "?";
   } else {
     out += "was it scaled twice, or is it in other units?";
   }

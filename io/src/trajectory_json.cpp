@@ -137,6 +137,12 @@ class Reader {
     if (newest_first) {
       std::reverse(rows.begin(), rows.end());
       std::reverse(row_of.begin(), row_of.end());
+      // Rows of one time (contact_point: one per contact) keep their file order.
+      for (std::size_t a = 0, b = 0; a < rows.size(); a = b) {
+        for (b = a + 1; b < rows.size() && rows[b].t == rows[a].t;) ++b;
+        std::reverse(rows.begin() + a, rows.begin() + b);
+        std::reverse(row_of.begin() + a, row_of.begin() + b);
+      }
       if (notes_ != nullptr) notes_->push_back(path + whose + ": rows logged newest first, read in reverse");
     }
     // Rows a little out of order (a logger's buffers) are sorted; a stream whose clock goes back

@@ -74,6 +74,25 @@ inline void CheckFinite(const Array& a, const char* what) {
   if (bad >= 0) throw py::value_error(std::string(what) + "[" + std::to_string(bad) + "] is not finite");
 }
 
+/// A message from C++ as a Python str, invalid UTF-8 as U+FFFD: messages quote file names and
+/// a file's own bytes, which need not be UTF-8 (pybind11's strict decoding raised instead).
+inline py::str Text(const std::string& text) {
+  PyObject* decoded = PyUnicode_DecodeUTF8(text.data(), static_cast<Py_ssize_t>(text.size()), "replace");
+  if (decoded == nullptr) throw py::error_already_set();
+  return py::reinterpret_steal<py::str>(decoded);
+}
+
+inline py::list TextList(const std::vector<std::string>& texts) {
+  py::list out;
+  for (const std::string& t : texts) out.append(Text(t));
+  return out;
+}
+
+/// A Python UserWarning at the caller's line.
+inline void WarnUser(const std::string& message) {
+  py::module_::import("warnings").attr("warn")(Text(message), py::handle(PyExc_UserWarning), 1);
+}
+
 /// A new float64 array of the given shape (uninitialized).
 inline py::array_t<double> NewArray(std::vector<py::ssize_t> shape) { return py::array_t<double>(shape); }
 
@@ -85,7 +104,8 @@ inline geometry::Pose2 PoseRow(const double* r) { return {r[0], r[1], r[2]}; }
 inline geometry::Pose2 ToPose(const py::handle& object, const char* what, bool finite = true) {
   const Array a = Rows(object, 3, what, true, "one pose (x, y, theta)");
   if (a.shape(0) != 1)
-    throw py::value_error(std::string(what) + ": expected one pose (x, y, theta), got " + std::to_string(a.shape(0)));
+    throw py::value_error(std::string(what) + ": expected one pose (x, y, theta), got " + std::to_string(a.shape(0)) +
+                          " poses");
   if (finite) CheckFinite(a, what);
   return PoseRow(a.data());
 }
@@ -93,7 +113,8 @@ inline geometry::Pose2 ToPose(const py::handle& object, const char* what, bool f
 inline geometry::Vec2 ToVec2(const py::handle& object, const char* what, bool finite = true) {
   const Array a = Rows(object, 2, what, true, "one point (x, y)");
   if (a.shape(0) != 1)
-    throw py::value_error(std::string(what) + ": expected one point (x, y), got " + std::to_string(a.shape(0)));
+    throw py::value_error(std::string(what) + ": expected one point (x, y), got " + std::to_string(a.shape(0)) +
+                          " points");
   if (finite) CheckFinite(a, what);
   return {a.data()[0], a.data()[1]};
 }

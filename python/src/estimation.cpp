@@ -158,9 +158,7 @@ py::dict ResultToDict(const EstimationResult& r) {
   py::dict metrics;
   for (const auto& [k, v] : r.metrics) metrics[k.c_str()] = v;
   d["metrics"] = metrics;
-  py::list warnings;
-  for (const std::string& w : r.warnings) warnings.append(w);
-  d["warnings"] = warnings;
+  d["warnings"] = TextList(r.warnings);
   py::dict solver;
   solver["name"] = r.solver.name;
   solver["iterations"] = r.solver.iterations;

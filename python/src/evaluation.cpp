@@ -57,7 +57,7 @@ void RegisterEvaluation(py::module_& m) {
           table["title"] = t.title;
           table["columns"] = t.columns;
           table["rows"] = table_rows;
-          table["notes"] = t.notes;
+          table["notes"] = TextList(t.notes);
           tables.append(table);
         }
         py::list trajectories;
@@ -67,13 +67,13 @@ void RegisterEvaluation(py::module_& m) {
           d["group"] = r.group;
           d["error"] = r.error;
           d["stats"] = r.stats;
-          d["notes"] = r.notes;
+          d["notes"] = TextList(r.notes);
           trajectories.append(d);
         }
         py::dict out;
         out["tables"] = tables;
         out["trajectories"] = trajectories;
-        out["notes"] = notes;
+        out["notes"] = TextList(notes);
         return out;
       },
       "inputs"_a, "protocols"_a, "simulate"_a, "sim_object"_a, "sim_finger"_a, "sim_mass"_a, "sim_mu"_a,

@@ -361,7 +361,7 @@ own frame (metres). Immutable; copies share their acceleration structures.
             // What `pushgraph footprint` warns of (a side view, several objects united, other
             // units), as Python warnings: it came back silently.
             std::vector<std::string> warnings = report.warnings;
-            if (const auto units = io::ShapeUnitsWarning(shape, scale)) warnings.push_back(*units);
+            if (const auto units = io::ShapeUnitsWarning(shape, scale, "scale=")) warnings.push_back(*units);
             for (std::string w : warnings) {
               // The command line's flags, as this function's arguments.
               for (const auto& [flag, argument] : {std::pair<std::string, std::string>{"--object NAME", "object='NAME'"},
@@ -369,8 +369,7 @@ own frame (metres). Immutable; copies share their acceleration structures.
                 for (std::size_t at = w.find(flag); at != std::string::npos; at = w.find(flag, at + argument.size()))
                   w.replace(at, flag.size(), argument);
               }
-              const std::string text = path + ": " + w;
-              if (PyErr_WarnEx(PyExc_UserWarning, text.c_str(), 1) != 0) throw py::error_already_set();
+              WarnUser(path + ": " + w);
             }
             return shape;
           },

@@ -25,6 +25,7 @@ void RegisterError(pybind11::module_& m, const char* name, PyObject* base) {
     } catch (const Error& e) {
       const std::string text = e.what();
       PyObject* message = PyUnicode_DecodeUTF8(text.data(), static_cast<Py_ssize_t>(text.size()), "replace");
+      if (message == nullptr) return;  // out of memory: that error stays set
       PyErr_SetObject(type.ptr(), message);
       Py_XDECREF(message);
     }

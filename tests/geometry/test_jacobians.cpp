@@ -473,6 +473,13 @@ TEST(ShapePairJacobians, CapsuleFingerDeepInANotch) {
                               {-0.10577451128163073, 0.18862499285682854, 1.337669007836734}};
   for (int i = 0; i < Scaled(600, 150); ++i) poses.push_back({xy(rng), xy(rng), angle(rng)});
   EXPECT_GT(CheckFingerThetaDerivative(q, object_pose, poses), static_cast<int>(poses.size()) * 8 / 10);
+  // The two poses it was found at, whether or not a kink is near: central differences 0.06254
+  // and 0.10368 (the wrong side's line gave 0.0097 and 0.032).
+  for (const auto& [pose, expected] : {std::pair<Pose2, double>{poses[0], 0.0625437}, {poses[1], 0.1036815}}) {
+    ShapePairJacobians J;
+    q.Query(object_pose, pose, &J);
+    EXPECT_NEAR(J.J_sd_finger_pose(2), expected, 1e-6);
+  }
 }
 
 // Rounded fingers where the exact depth exceeds "core depth + radius" (test_rounded_depth.cpp):

@@ -536,7 +536,8 @@ TEST_F(EstimateCli, AMeshInMillimetresAloneIsEstimatedAsTheRightOne) {
   // leave it unsettled (it read settled).
   EXPECT_TRUE(j["shape"]["units_only"].get<bool>());
   EXPECT_TRUE(j["parameters"]["shape_transform_sigma"].is_null());
-  EXPECT_EQ(j["shape"].contains("tied_transforms"), !j["shape"]["placement_settled"].get<bool>()) << j["shape"].dump();
+  ASSERT_TRUE(j["shape"].contains("tied_transforms")) << j["shape"].dump();  // a turn of 4 degrees ties here
+  EXPECT_FALSE(j["shape"]["placement_settled"].get<bool>()) << j["shape"].dump();
   std::printf("[registration] rect1 in millimetres: settled %d, ties %s\n", j["shape"]["placement_settled"].get<bool>(),
               j["shape"].value("tied_transforms", nlohmann::json::array()).dump().c_str());
   const pushgraph::testing::ToolRun shipped = EstimateMit(h5, "rect1.obj", "", kProbe, kRect1Mass, dir() + "/m.json");

@@ -102,8 +102,24 @@ TEST(TrajectoryJson, AClockThatGoesBackIsRefused) {
   EXPECT_EQ(t.measured.force.back().force.x(), 50.0);
   ASSERT_EQ(notes.size(), 1u);
   EXPECT_NE(notes[0].find("streams.force: rows logged newest first, read in reverse"), std::string::npos) << notes[0];
-  // The period in the message comes from the time stamps in order.
-  ExpectError(Doc(R"({"force": [)" + rows + "]}"), "the stream's median period is 0.004 s");
+  // The period in the message comes from the time stamps in order: rows swapped in pairs have
+  // forward steps of 12 ms in file order but a period of 4 ms, so a clock that then goes back by
+  // 1.1 s is refused (with 12 ms the limit was max(1 s, 1.2 s) and it passed).
+  std::string swapped;
+  for (int i = 0; i < 300; i += 2)
+    for (const int k : {i + 1, i}) swapped += (swapped.empty() ? "" : ",") + std::string("[") + std::to_string(0.004 * k) + ", 1, 0]";
+  swapped += ",[" + std::to_string(0.004 * 299 - 1.1) + ", 2, 0]";
+  ExpectError(Doc(R"({"force": [)" + swapped + "]}"), "the stream's median period is 0.004 s");
+  // Contacts of one time keep their file order when the stream is reversed.
+  notes.clear();
+  const auto two = ParseTrajectoryJson(
+      Doc(R"({"contact_point": [[0.2, 5, 0], [0.1, 3, 0], [0.1, 4, 0], [0.0, 1, 0], [0.0, 2, 0]]})"), "push.json", &notes);
+  ASSERT_EQ(two.measured.contact_point.size(), 5u);
+  EXPECT_EQ(two.measured.contact_point[0].point.x(), 1.0);
+  EXPECT_EQ(two.measured.contact_point[1].point.x(), 2.0);
+  EXPECT_EQ(two.measured.contact_point[2].point.x(), 3.0);
+  EXPECT_EQ(two.measured.contact_point[3].point.x(), 4.0);
+  ASSERT_EQ(notes.size(), 1u);
 }
 
 TEST(TrajectoryJson, MeasurementSigmasRoundTripAndAreChecked) {

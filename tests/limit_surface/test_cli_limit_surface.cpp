@@ -107,7 +107,7 @@ TEST_F(LimitSurfaceCli, MeshesAreReadAndOtherUnitsWarned) {
   const std::string mm = Write("square_mm.json", R"({"polygons": [{"outer": [[0,0],[90,0],[90,90],[0,90]]}]})");
   const ToolRun in_mm = Exec(mm + " --mass 1 --mu 0.3");
   ASSERT_EQ(in_mm.status, 0) << in_mm.err;
-  EXPECT_NE(in_mm.err.find("the shape is 90 m across: shapes are in metres (is the file in millimetres"), std::string::npos)
+  EXPECT_NE(in_mm.err.find("the shape is 90 m across: shapes are in metres (is the file in millimetres (pushgraph footprint "), std::string::npos)
       << in_mm.err;
 }
 

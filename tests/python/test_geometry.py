@@ -76,7 +76,7 @@ def test_query_arrays_shapes_dtypes_and_bad_arrays(notched_block):
     # A pose is one pose whatever is wrong with it (a pose of two numbers was told to be an (N, 3) array).
     with pytest.raises(ValueError, match=r"pose: expected one pose \(x, y, theta\), got \(2,\)"):
         notched_block.query(pts, pose=(0.01, 0.0))
-    with pytest.raises(ValueError, match=r"pose: expected one pose \(x, y, theta\), got 2"):
+    with pytest.raises(ValueError, match=r"pose: expected one pose \(x, y, theta\), got 2 poses"):
         notched_block.query(pts, pose=np.zeros((2, 3)))
     for bad in ([["a", "b"]], [[1j, 0.0]], [[True, False]], np.array([[None, 1.0]], dtype=object)):
         with pytest.raises(TypeError, match="points: expected"):
@@ -172,7 +172,7 @@ def test_a_mesh_footprint_in_millimetres(tmp_path):
         s = pg.Shape.from_mesh(str(obj), scale=0.001)
     assert s.area == pytest.approx(0.09 * 0.06, rel=1e-12)
     # Read in the file's millimetres as metres: said as `pushgraph footprint` says it.
-    with pytest.warns(UserWarning, match=r"90 m across.*is the file in millimetres \(--scale 0.001"):
+    with pytest.warns(UserWarning, match=r"90 m across.*is the file in millimetres \(scale=0.001"):
         pg.Shape.from_mesh(str(obj))
     empty = tmp_path / "empty.obj"
     empty.write_text("# nothing\n")
@@ -187,6 +187,12 @@ def test_errors_quoting_bytes_that_are_not_utf8_keep_their_message(tmp_path):
     with pytest.raises(pg.IoError, match="latin.json") as error:
         pg.load_trajectory(str(latin))
     assert "\ufffd" in str(error.value)
+    # Warnings quoting such bytes (a group's name) are warnings, not a UnicodeDecodeError.
+    groups = tmp_path / "groups.obj"
+    groups.write_bytes(b"v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nv 0.2 0 0\nv 0.3 0 0\nv 0.2 0.1 0\n"
+                       b"g caf\xe9\nf 1 2 3\ng other\nf 4 5 6\n")
+    with pytest.warns(UserWarning, match="holds 2 objects or groups \\(caf\ufffd, other\\)"):
+        assert pg.Shape.from_mesh(str(groups)).area > 0
     # An HDF5 recording given to load_trajectory is named as such (it was "malformed JSON").
     h5 = tmp_path / "recording.h5"
     h5.write_bytes(b"\x89HDF\r\n\x1a\n" + bytes(64))

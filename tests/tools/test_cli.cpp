@@ -293,7 +293,7 @@ TEST_F(CliTest, OutputsThatAreInputsAreRefusedAndInputsKept) {
   EXPECT_EQ(scaled.err.find("taken as metres"), std::string::npos) << scaled.err;
   const ToolRun huge = Exec("footprint " + shape + " --scale 1000 -o " + (dir_ / "t5.json").string() + " -q");
   // The suggestion is relative to the file: here the --scale given was the error.
-  EXPECT_NE(huge.err.find("is the file in millimetres (--scale 1 in place of the --scale given"), std::string::npos)
+  EXPECT_NE(huge.err.find("is the file in millimetres (--scale 1 in place of the scale given"), std::string::npos)
       << huge.err;
   // A shape 100 times too large: the units that make it 1 cm to 1 m across, centimetres among them.
   const ToolRun centimetres = Exec("footprint " + shape + " --scale 100 -o " + (dir_ / "t6.json").string() + " -q");

@@ -257,7 +257,7 @@ geometry::Shape LoadMeshArgument(const std::string& path, const std::string& wha
 }  // namespace
 
 void WarnShapeUnits(const geometry::Shape& shape, const std::string& what, const std::string& path) {
-  if (const auto units = io::ShapeUnitsWarning(shape))
+  if (const auto units = io::ShapeUnitsWarning(shape, 1.0, "pushgraph footprint " + path + " --scale "))
     std::fprintf(stderr, "pushgraph: warning: %s %s: %s\n", what.c_str(), path.c_str(), units->c_str());
 }
 
