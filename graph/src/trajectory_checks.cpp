@@ -82,15 +82,33 @@ double NearestFingerRatio(const push::Trajectory& traj) {
 void CheckFingerReachesObject(const push::Trajectory& traj) {
   const auto& objects = traj.measured.object_pose;
   auto reach = [](const geometry::Shape& s) { return s.empty() ? 0.0 : geometry::RadiusAbout(s, geometry::Vec2::Zero()); };
-  // The nearest of every finger (with several, one may push while another waits far away).
-  auto [nearest, at] = NearestApproach(traj.measured.finger_pose, objects);
-  double finger_reach = reach(traj.finger.shape), first = traj.measured.finger_pose.empty() ? 0.0 : traj.measured.finger_pose.front().t;
-  for (const push::ExtraFinger& f : traj.extra_fingers) {
-    const auto [d, t] = NearestApproach(f.measured.finger_pose, objects);
-    if (d < nearest) nearest = d, at = t;
-    finger_reach = std::max(finger_reach, reach(f.finger.shape));
+  // Every finger that measures a contact or a force must come near (an idle finger parked next to
+  // the object passed the check for a pusher 2 m off); with none, the nearest finger.
+  struct Finger {
+    const std::vector<push::PoseSample>* pose;
+    double reach;
+    bool touches;
+  };
+  std::vector<Finger> fingers = {{&traj.measured.finger_pose, reach(traj.finger.shape),
+                                  !traj.measured.contact_point.empty() || !traj.measured.force.empty()}};
+  for (const push::ExtraFinger& f : traj.extra_fingers)
+    fingers.push_back({&f.measured.finger_pose, reach(f.finger.shape), !f.measured.contact_point.empty() || !f.measured.force.empty()});
+  const bool any_touches = std::any_of(fingers.begin(), fingers.end(), [](const Finger& f) { return f.touches; });
+  double nearest = any_touches ? -INFINITY : INFINITY, at = 0.0, finger_reach = 0.0, first = 0.0;
+  for (const Finger& f : fingers) {
+    if (any_touches && !f.touches) continue;
+    const auto [d, t] = NearestApproach(*f.pose, objects);
+    // Touching fingers: the farthest one's nearest approach; otherwise the nearest of all.
+    if (std::isfinite(d) && (any_touches ? d > nearest : d < nearest)) {
+      nearest = d, at = t, finger_reach = f.reach;
+      first = f.pose->empty() ? 0.0 : f.pose->front().t;
+    }
   }
   constexpr double kLeastReach = 0.5;  // m
+  // The object's reach as given: a shape alone in millimetres lifts the bound with it (a tracker
+  // 2 m off then passes, and the shape check rescales the shape), but a large object in metres
+  // (the notched block 100 times larger, pushed by a 5 cm finger) is no error; the two cannot be
+  // told apart from the streams here.
   const double bound = std::max(kLeastReach, 2.0 * (reach(traj.object.shape) + finger_reach));
   if (!(nearest > bound) || !std::isfinite(nearest)) return;
   throw GraphError(Format("trajectory: the finger never comes nearer than %.3g m to the object (at t = %s), beyond the "

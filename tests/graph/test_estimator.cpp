@@ -686,6 +686,14 @@ TEST(Estimator, BadTrajectoriesGetClearErrors) {
     for (auto& c : far.measured.contact_point) c.point.x() += offset;
     EXPECT_NE(message(far).find("the finger never comes nearer than"), std::string::npos) << offset << ": " << message(far);
   }
+  // Nor with an idle second finger parked next to the object while the finger that touches is 2 m off.
+  auto idle_near = t;
+  push::ExtraFinger idle;
+  idle.finger = t.finger;
+  idle.measured.finger_pose = t.measured.finger_pose;  // where the pusher really was, but touching nothing
+  idle_near.extra_fingers.push_back(idle);
+  for (auto& f : idle_near.measured.finger_pose) f.pose.x += 2.0;
+  EXPECT_NE(message(idle_near).find("the finger never comes nearer than"), std::string::npos) << message(idle_near);
   auto near = t;
   for (auto& f : near.measured.finger_pose) f.pose.x += 0.3;
   EXPECT_EQ(message(near).find("the finger never comes nearer than"), std::string::npos);

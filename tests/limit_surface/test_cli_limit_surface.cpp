@@ -109,6 +109,13 @@ TEST_F(LimitSurfaceCli, MeshesAreReadAndOtherUnitsWarned) {
   ASSERT_EQ(in_mm.status, 0) << in_mm.err;
   EXPECT_NE(in_mm.err.find("the shape is 90 m across: shapes are in metres (is the file in millimetres (pushgraph footprint "), std::string::npos)
       << in_mm.err;
+  // A prism seen from the side: the command that reads its cross-section (this one has no --up).
+  const std::string tip = std::string(PUSHGRAPH_SHARED_DIR) + "/data/mit-push/obj/tip.obj";
+  if (!std::ifstream(tip)) GTEST_SKIP() << "no MIT data";
+  const ToolRun side = Exec(tip + " --mass 0.1 --mu 0.3");
+  ASSERT_EQ(side.status, 0) << side.err;
+  EXPECT_NE(side.err.find("pushgraph footprint " + tip + " --up y -o SHAPE.json gives its cross-section"), std::string::npos)
+      << side.err;
 }
 
 }  // namespace

@@ -232,10 +232,11 @@ geometry::Shape LoadMeshArgument(const std::string& path, const std::string& wha
                shape.polygons().size(), holes, box.max.x() - box.min.x(),
                box.max.y() - box.min.y(), path.c_str());
   for (std::string w : report.warnings) {
-    // footprint's own flag is named --object; here that names the shape file.
-    const std::string flag = "--object NAME takes one";
-    if (const std::size_t at = w.find(flag); at != std::string::npos)
-      w.replace(at, flag.size(), "pushgraph footprint " + path + " --object NAME -o SHAPE.json takes one");
+    // footprint's own flags (--object names the shape file here, and there is no --up): the command.
+    for (const std::string flag : {"--object NAME", "--up x", "--up y", "--up z"}) {
+      if (const std::size_t at = w.find(flag); at != std::string::npos)
+        w.replace(at, flag.size(), "pushgraph footprint " + path + " " + flag + " -o SHAPE.json");
+    }
     std::fprintf(stderr, "pushgraph: warning: %s %s: %s\n", what.c_str(), path.c_str(), w.c_str());
   }
   if (finger) {
