@@ -46,8 +46,8 @@ Json ResultJson(const graph::EstimationResult& r, bool with_states) {
   j["model"] = graph::ModelName(r.model);
   j["mode"] = graph::ModeName(r.mode);
   Json states = Json::array();
-  for (const graph::StateEstimate& s : r.states) {
-    if (!with_states) break;
+  const std::vector<graph::StateEstimate> none;
+  for (const graph::StateEstimate& s : with_states ? r.states : none) {
     Json o;
     o["t"] = s.t;
     o["object_pose"] = Pose(s.object_pose);

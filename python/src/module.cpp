@@ -23,11 +23,11 @@ void RegisterError(pybind11::module_& m, const char* name, PyObject* base) {
     try {
       if (thrown) std::rethrow_exception(thrown);
     } catch (const Error& e) {
-      const std::string text = e.what();
-      PyObject* message = PyUnicode_DecodeUTF8(text.data(), static_cast<Py_ssize_t>(text.size()), "replace");
-      if (message == nullptr) return;  // out of memory: that error stays set
-      PyErr_SetObject(type.ptr(), message);
-      Py_XDECREF(message);
+      try {
+        PyErr_SetObject(type.ptr(), pushgraph::python::Text(e.what()).ptr());
+      } catch (pybind11::error_already_set& decoding) {
+        decoding.restore();  // out of memory: that error is raised instead
+      }
     }
   });
 }
