@@ -118,9 +118,10 @@ push::Trajectory LoadCleanTrajectory(const EvaluationItem& item, const Evaluatio
 }  // namespace internal
 
 push::Trajectory ReadMitTrajectory(const std::string& path, const ObjectModel& model, double rate,
-                                   std::vector<std::string>* notes) {
+                                   std::vector<std::string>* notes, bool trim) {
   io::MitReadOptions read;
-  read.trim_to_contact = true;
+  read.trim_to_contact = trim;
+  read.contact_force = io::MitContactForce(model.object.mass, model.object.mu_surface);
   io::MitRecording rec = io::ReadMitPush(path, read);
   if (notes) notes->insert(notes->end(), rec.notes.begin(), rec.notes.end());
   if (!rec.contact_found) {
@@ -169,7 +170,7 @@ push::Trajectory LoadEstimationInput(const std::string& path, const InputOverrid
   model.object.mass = *given.mass;
   model.object.mu_surface = *given.mu_surface;
   model.finger.shape = *given.finger_shape;
-  return ReadMitTrajectory(path, model, /*rate=*/0.0, notes);
+  return ReadMitTrajectory(path, model, /*rate=*/0.0, notes, given.trim_to_contact);
 }
 
 push::NoiseModel MakePaperNoise(push::NoiseKind kind, const PaperNoise& s) {

@@ -1342,9 +1342,23 @@ void GraphBuilder::AddOneContactQuasiStatic(ceres::Problem& problem, int i, doub
 }
 
 bool GraphBuilder::MeasuredAtRest(int i) const {
+  // Quasi-statically the object moves only while a finger does: at rest where every finger with
+  // a pose stream is measured at rest (with finger 0 alone, an idle finger 0 beside the pusher
+  // held the pushed object still for 275 steps). No finger stream: the object's own.
   const auto& m = traj_.measured;
-  if (!m.finger_pose.empty()) return PoseStreamAtRest(m.finger_pose, steps_[i].t, cfg_.measurement.finger_trans);
-  return PoseStreamAtRest(m.object_pose, steps_[i].t, cfg_.measurement.object_trans);
+  const double t = steps_[i].t;
+  bool any_finger = false;
+  auto finger_at_rest = [&](const std::vector<push::PoseSample>& poses) {
+    if (poses.empty()) return true;
+    any_finger = true;
+    return PoseStreamAtRest(poses, t, cfg_.measurement.finger_trans);
+  };
+  if (!finger_at_rest(m.finger_pose)) return false;
+  if (other_fingers_ > 0)
+    for (const push::ExtraFinger& f : traj_.extra_fingers)
+      if (!finger_at_rest(f.measured.finger_pose)) return false;
+  if (any_finger) return true;
+  return PoseStreamAtRest(m.object_pose, t, cfg_.measurement.object_trans);
 }
 
 bool GraphBuilder::LoadFactorAt(int i) const {

@@ -475,6 +475,11 @@ Diagnostics Diagnose(const push::Trajectory& trajectory, Model model, const Esti
 /// stream, sample and value): missing shapes or streams, NaN, unsupported magnitudes, unsorted
 /// samples, clock jumps within or between streams.
 void ValidateTrajectory(const push::Trajectory& trajectory);
+/// Refuses a push whose fingers never come near the object's tracked origin: every finger that
+/// measures a contact point or a force above `force_threshold` (none: the nearest finger) must
+/// come within max(0.5 m, twice the object's and its reach from their pose origins). Part of
+/// ValidateTrajectory (threshold 0); OnlineEstimator runs it at the first update after a touch.
+void CheckFingerReachesObject(const push::Trajectory& trajectory, double force_threshold);
 /// A warning when every stream is sampled at 0.2 s or slower (5 Hz) and the streams read in
 /// milliseconds or microseconds are a push (at most 20 kHz, a finger at most 2 m/s): a 250 Hz
 /// sensor in milliseconds reads 4 s apart, and the noise model's per-second scales then no longer

@@ -639,6 +639,11 @@ struct OnlineEstimator::Impl {
   int dropped_faults = 0;
   std::string first_fault;
   bool finished = false;
+  // The batch's check that the fingers come near the object (trajectory_checks.cpp), run once at
+  // the first update after a contact point or a force above 3 sigma: before the touch a finger
+  // may still be on its way; without it a pusher 2 m off (another tracker's frame) gave an
+  // object 1.87 m off, and no word (helper-27 N0b).
+  bool touched = false, reach_checked = false;
   std::vector<bool> declared;
   int fingers = 1;
   double max_latency = 0.2;
@@ -816,6 +821,7 @@ bool OnlineEstimator::AddContactPoint(double t, int finger, const geometry::Vec2
   const int stream = m.FingerStream(finger, 1, "AddContactPoint");
   if (!m.Accept(stream, "contact_point", t, point.allFinite())) return false;
   (finger == 0 ? m.traj.measured.contact_point : m.traj.extra_fingers[finger - 1].measured.contact_point).push_back({t, point});
+  m.touched = true;
   return true;
 }
 bool OnlineEstimator::AddForce(double t, int finger, const geometry::Vec2& force) {
@@ -844,6 +850,7 @@ bool OnlineEstimator::AddForce(double t, int finger, const geometry::Vec2& force
   m.recent_force.push_back(magnitude);
   if (m.recent_force.size() > Impl::kRecentForces) m.recent_force.pop_front();
   (finger == 0 ? m.traj.measured.force : m.traj.extra_fingers[finger - 1].measured.force).push_back({t, force});
+  m.touched = m.touched || magnitude > 3.0 * m.smoother.cfg.measurement.force;
   return true;
 }
 int OnlineEstimator::DroppedLateSamples() const { return impl_->dropped_late; }
@@ -891,6 +898,16 @@ double OnlineEstimator::Update(double until) {
                          "].finger_pose) up to t = " + Precise(until));
       }
     }
+  }
+  if (m.touched && !m.reach_checked) {
+    try {
+      internal::CheckFingerReachesObject(m.traj, 3.0 * m.smoother.cfg.measurement.force);
+    } catch (const GraphError& e) {
+      std::string what = e.what();
+      if (what.rfind("trajectory: ", 0) == 0) what.replace(0, 12, "");
+      throw GraphError("OnlineEstimator::Update at t = " + Precise(until) + ": " + what);
+    }
+    m.reach_checked = true;
   }
   // Samples within 1e-9 s after `until` join its step now (as batch merges them), so no later
   // step can be closer than that to a solved one.

@@ -79,7 +79,9 @@ double NearestFingerRatio(const push::Trajectory& traj) {
 // alone put the finger 2 m away) and at least 0.5 m, more than any tabletop object needs. The
 // shape check had "repaired" such files by scaling the object 100 or 1000 times (a 12 cm block
 // made 12 m, c = 3.9 m).
-void CheckFingerReachesObject(const push::Trajectory& traj) {
+}  // namespace
+
+void CheckFingerReachesObject(const push::Trajectory& traj, double force_threshold) {
   const auto& objects = traj.measured.object_pose;
   auto reach = [](const geometry::Shape& s) { return s.empty() ? 0.0 : geometry::RadiusAbout(s, geometry::Vec2::Zero()); };
   // Every finger that measures a contact or a force must come near (an idle finger parked next to
@@ -89,10 +91,15 @@ void CheckFingerReachesObject(const push::Trajectory& traj) {
     double reach;
     bool touches;
   };
-  std::vector<Finger> fingers = {{&traj.measured.finger_pose, reach(traj.finger.shape),
-                                  !traj.measured.contact_point.empty() || !traj.measured.force.empty()}};
+  auto touches = [&](const push::FingerStreams& s) {
+    return !s.contact_point.empty() || std::any_of(s.force.begin(), s.force.end(), [&](const push::ForceSample& f) {
+             return f.force.norm() > force_threshold;
+           });
+  };
+  const push::Streams& m = traj.measured;
+  std::vector<Finger> fingers = {{&m.finger_pose, reach(traj.finger.shape), touches({m.finger_pose, m.contact_point, m.force})}};
   for (const push::ExtraFinger& f : traj.extra_fingers)
-    fingers.push_back({&f.measured.finger_pose, reach(f.finger.shape), !f.measured.contact_point.empty() || !f.measured.force.empty()});
+    fingers.push_back({&f.measured.finger_pose, reach(f.finger.shape), touches(f.measured)});
   const bool any_touches = std::any_of(fingers.begin(), fingers.end(), [](const Finger& f) { return f.touches; });
   double nearest = any_touches ? -INFINITY : INFINITY, at = 0.0, finger_reach = 0.0, first = 0.0;
   for (const Finger& f : fingers) {
@@ -118,6 +125,8 @@ void CheckFingerReachesObject(const push::Trajectory& traj) {
                           nearest, StepTime(at, first, "the finger's first sample").c_str(), bound,
                           kLeastReach));
 }
+
+namespace {
 
 void CheckPositionUnits(const std::vector<push::PoseSample>& s, const std::string& stream, double ratio) {
   if (s.size() < 2 || !(s.back().t > s.front().t)) return;
@@ -419,7 +428,7 @@ void ValidateTrajectory(const push::Trajectory& traj) {
   for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k)
     CheckPositionUnits(traj.extra_fingers[k].measured.finger_pose, "fingers[" + std::to_string(k + 1) + "].finger_pose",
                        finger_ratio);
-  CheckFingerReachesObject(traj);
+  CheckFingerReachesObject(traj, 0.0);
   CheckFingerSize(traj.finger.shape, m.finger_pose, m.object_pose, traj.object.shape, "");
   for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k) {
     CheckFingerSize(traj.extra_fingers[k].finger.shape, traj.extra_fingers[k].measured.finger_pose, m.object_pose,

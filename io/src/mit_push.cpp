@@ -342,7 +342,9 @@ void FindContactPhase(MitRecording* rec, const MitReadOptions& o) {
   if (!rec->force_frozen) {
     for (const auto& f : s.force)
       if (f.force.norm() > o.contact_force) times.push_back(f.t);
-    rec->notes.push_back("contact phase from the force magnitude (> " + std::to_string(o.contact_force) + " N)");
+    std::ostringstream note;
+    note << "contact phase from the force magnitude (> " << o.contact_force << " N)";
+    rec->notes.push_back(note.str());
   } else {
     // The object moves only while pushed: its speed over ~20 ms windows.
     const auto& p = s.object_pose;
@@ -384,6 +386,12 @@ void Trim(std::vector<Sample>* v, double t0, double t1) {
 }
 
 }  // namespace
+
+double MitContactForce(double mass, double mu_surface) {
+  const double kDefault = MitReadOptions{}.contact_force;
+  if (!(mass > 0.0) || !(mu_surface > 0.0)) return kDefault;
+  return std::min(kDefault, 0.25 * mu_surface * mass * 9.81);
+}
 
 MitRecording ReadMitPush(const std::string& path, const MitReadOptions& o) {
   const bool json = path.size() >= 5 && path.compare(path.size() - 5, 5, ".json") == 0;

@@ -3,11 +3,13 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>  // paths: str or os.PathLike (pathlib.Path)
 
 #include <pushgraph/geometry/pose.h>
 #include <pushgraph/geometry/shape.h>
 
 #include <cmath>
+#include <filesystem>
 #include <string>
 #include <vector>
 

@@ -343,7 +343,9 @@ own frame (metres). Immutable; copies share their acceleration structures.
           [](const py::handle& a, const py::handle& b, double r) { return Shape::Capsule(ToVec2(a, "a"), ToVec2(b, "b"), r); },
           "a"_a, "b"_a, "radius"_a)
       .def_static("regular_polygon", &Shape::RegularPolygon, "n"_a, "circumradius"_a, "radius"_a = 0.0)
-      .def_static("load_json", &geometry::LoadShapeJson, "path"_a, "A shape JSON file (docs/formats.md).")
+      .def_static(
+          "load_json", [](const std::filesystem::path& path) { return geometry::LoadShapeJson(path.string()); }, "path"_a,
+          "A shape JSON file (docs/formats.md).")
       .def_static("from_json", &geometry::ParseShapeJson, "text"_a, "source_name"_a = "<string>")
       // Pickling (copy.deepcopy of a trajectory dict, multiprocessing): its JSON, whose numbers
       // round-trip exactly.
@@ -351,7 +353,8 @@ own frame (metres). Immutable; copies share their acceleration structures.
                       [](const std::string& json) { return geometry::ParseShapeJson(json, "<pickled Shape>"); }))
       .def_static(
           "from_mesh",
-          [](const std::string& path, const std::string& up, const std::string& object, double scale) {
+          [](const std::filesystem::path& file, const std::string& up, const std::string& object, double scale) {
+            const std::string path = file.string();
             io::FootprintOptions o;
             o.up = io::ParseUpAxis(up);
             o.object = object;
@@ -379,7 +382,7 @@ own frame (metres). Immutable; copies share their acceleration structures.
           "file; `scale` 0.001 for a mesh in millimetres. A UserWarning says when the footprint is probably not "
           "what was meant: a prism seen from the side, several objects united, a shape outside 1 mm to 2 m across.")
       .def("to_json", &geometry::ShapeToJson, "indent"_a = 2)
-      .def("save_json", [](const Shape& s, const std::string& path) { geometry::SaveShapeJson(s, path); }, "path"_a)
+      .def("save_json", [](const Shape& s, const std::filesystem::path& path) { geometry::SaveShapeJson(s, path.string()); }, "path"_a)
       .def_property_readonly("radius", &Shape::radius)
       .def_property_readonly("area", &Shape::core_area, "Area of the core polygons (rounding not included).")
       .def_property_readonly("num_vertices", &Shape::num_vertices)

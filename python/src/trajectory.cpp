@@ -285,7 +285,8 @@ void RegisterTrajectory(py::module_& m) {
   using namespace pybind11::literals;
   m.def(
       "load_trajectory",
-      [](const std::string& path) {
+      [](const std::filesystem::path& file) {
+        const std::string path = file.string();
         // An MIT recording given here was "malformed JSON ... invalid literal": say what it is.
         char signature[8] = {};
         std::ifstream(path, std::ios::binary).read(signature, sizeof signature);
@@ -293,10 +294,13 @@ void RegisterTrajectory(py::module_& m) {
           throw io::IoError(path + ": an HDF5 file: load_trajectory reads trajectory JSON (docs/formats.md); an MIT "
                             "pushing recording is read by read_mit_push");
         Trajectory t;
+        std::vector<std::string> notes;
         {
           py::gil_scoped_release release;
-          t = io::LoadTrajectoryJson(path);
+          t = io::LoadTrajectoryJson(path, &notes);
         }
+        // What the reader repaired (rows sorted, a stream read newest first), as the tool prints it.
+        for (const std::string& note : notes) WarnUser(path + ": " + note);
         return TrajectoryToDict(t);
       },
       "path"_a, R"doc(
@@ -307,16 +311,20 @@ A pushgraph-trajectory-1 JSON file as a dict:
  'ground_truth': the same streams or None, 'measurement_sigmas': dict or None}.
 A push with several fingers also has 'fingers': [{'shape', 'mu_contact', 'measured': {'finger_pose',
 'contact_point', 'force'}, 'ground_truth': ... or None}, ...] (fingers 1, 2, ...; 'finger' is finger 0).
+Rows are sorted by time; what was repaired so (and other notes of the reader) comes as a UserWarning.
 Raises IoError naming the file and the field.)doc");
   m.def(
-      "save_trajectory", [](const py::handle& t, const std::string& path) { io::SaveTrajectoryJson(TrajectoryFromDict(t), path); },
+      "save_trajectory",
+      [](const py::handle& t, const std::filesystem::path& path) { io::SaveTrajectoryJson(TrajectoryFromDict(t), path.string()); },
       "trajectory"_a, "path"_a, "Writes the dict (as load_trajectory returns it) atomically.");
   m.def(
       "read_mit_push",
-      [](const std::string& path, const geometry::Shape& object, double mass, double mu_surface,
+      [](const std::filesystem::path& file, const geometry::Shape& object, double mass, double mu_surface,
          const geometry::Shape& finger, double mu_contact, bool trim_to_contact) {
+        const std::string path = file.string();
         io::MitReadOptions options;
         options.trim_to_contact = trim_to_contact;
+        options.contact_force = io::MitContactForce(mass, mu_surface);  // as `pushgraph estimate` reads it
         Trajectory t;
         std::string fault;
         {

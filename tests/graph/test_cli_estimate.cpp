@@ -347,6 +347,16 @@ TEST_F(EstimateCli, MitImportTrimsToTheContactPhaseAsEstimateDoes) {
   ASSERT_EQ(d.size(), i.size());
   EXPECT_DOUBLE_EQ(d[0]["t"].get<double>(), i[0]["t"].get<double>());
   EXPECT_DOUBLE_EQ(d.back()["t"].get<double>(), i.back()["t"].get<double>());
+  // estimate's --no-trim keeps every sample as mit-import's does; a trajectory file has nothing to trim.
+  const std::string untrimmed = dir() + "/direct_untrimmed.json";
+  ASSERT_EQ(Tool("estimate '" + h5 + "' --no-trim --object " + shared + "obj/rect1.obj --finger " + tip +
+                 " --mass 0.8374 --mu 0.35 --config " + cfg + " -o " + untrimmed).status, 0);
+  const nlohmann::json u = Load(untrimmed)["states"];
+  EXPECT_GT(u.size(), d.size());
+  EXPECT_LT(u[0]["t"].get<double>(), d[0]["t"].get<double>());
+  const pushgraph::testing::ToolRun refused = Tool("estimate " + trimmed + " --no-trim -o " + dir() + "/never.json");
+  EXPECT_NE(refused.status, 0);
+  EXPECT_NE(refused.err.find("--no-trim applies to MIT recordings"), std::string::npos) << refused.err;
 }
 
 // A user's mesh turned by 37 degrees, on the three rect1 recordings where it went wrong: the

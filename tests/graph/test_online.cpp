@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <string>
 #include <vector>
 
 namespace pushgraph::graph {
@@ -88,6 +89,30 @@ TEST(Online, SameEstimateAsTheReplayOfTheRecording) {
     EXPECT_NEAR(std::sqrt((*r.states.back().object_pose_cov)(0, 0)),
                 std::sqrt((*expected.states.back().object_pose_cov)(0, 0)), 1e-9);
   }
+}
+
+// A finger tracked in another frame (2 m off), fed sample by sample: refused at the first update
+// after it touched, as the batch refuses the file (helper-27 N0b: an object 1.87 m off, no word).
+TEST(Online, AFingerInAnotherFrameIsRefusedAtTheFirstTouch) {
+  push::Trajectory t = GeneratePush(OffsetPush(22, 1.0));
+  for (auto& f : t.measured.finger_pose) f.pose.x += 2.0;
+  for (auto& c : t.measured.contact_point) c.point.x() += 2.0;
+  OnlineEstimator online(SetupOf(t), Model::kQs, {}, StreamsOf(t));
+  std::string error;
+  int updates = 0;
+  try {
+    Feed(t, online, [&] {
+      if (!online.UpdateDue()) return;
+      online.Update();
+      ++updates;
+    });
+  } catch (const GraphError& e) {
+    error = e.what();
+  }
+  std::printf("[online] finger 2 m off: %d updates, then: %s\n", updates, error.c_str());
+  EXPECT_NE(error.find("OnlineEstimator::Update at t = "), std::string::npos) << error;
+  EXPECT_NE(error.find("the finger never comes nearer than"), std::string::npos) << error;
+  EXPECT_LE(updates, 1);
 }
 
 // Updates at the sensor rate with the default max_latency (0.2 s, above the 25 Hz camera's

@@ -236,6 +236,48 @@ TEST(TwoFingers, AShapeOffAlongThePushIsAligned) {
   EXPECT_LT(r.metrics.at("object_position_rms"), 1.5 * reference.metrics.at("object_position_rms"));
 }
 
+// An idle finger 0 parked behind the pusher, which is finger 1: the object is measured at rest
+// only where every finger is. With finger 0's stream alone, its rest held the pushed object still
+// by zero-velocity factors at every step (helper-27: 275 of them, rotation 0.027 against
+// 0.012 rad).
+TEST(TwoFingers, AnIdleFingerZeroDoesNotHoldThePushedObject) {
+  push::PushPlan plan = testing::NotchedBlockPlan(14);
+  plan.finger = {geometry::Shape::Disk(0.004), 0.4};
+  plan.object_pose = {0.0, 0.0, 0.1};
+  plan.finger_theta = M_PI / 2 + 0.2;
+  plan.waypoints = push::StraightPushPath(plan, plan.finger_theta, 0.012, 0.005, 0.05);
+  const push::Trajectory one = push::Simulate(plan).trajectory;
+  push::Trajectory two = one;
+  two.extra_fingers = {{one.finger, {one.measured.finger_pose, one.measured.contact_point, one.measured.force},
+                        push::FingerStreams{one.ground_truth->finger_pose, one.ground_truth->contact_point,
+                                            one.ground_truth->force}}};
+  const Vec2 start = one.measured.finger_pose.front().pose.translation();
+  const Vec2 away = (start - one.measured.object_pose.front().pose.translation()).normalized();
+  const geometry::Pose2 parked{start.x() + 0.05 * away.x(), start.y() + 0.05 * away.y(), 0.0};
+  for (push::Streams* s : {&two.measured, &*two.ground_truth}) {
+    for (push::PoseSample& p : s->finger_pose) p.pose = parked;
+    s->contact_point.clear();
+    s->force.clear();
+  }
+  EstimatorConfig config = ApplyMeasurementSigmas(EstimatorConfig{}, *one.measurement_sigmas);
+  config.covariance = false;
+  auto zero_velocity = [](const EstimationResult& r) {
+    for (const FactorStatistics& f : r.diagnostics->factors)
+      if (f.type == "zero_velocity") return f.count;
+    return 0;
+  };
+  const EstimationResult r1 = Estimate(one, Model::kQs, Mode::kBatch, config);
+  const EstimationResult r2 = Estimate(two, Model::kQs, Mode::kBatch, config);
+  ASSERT_TRUE(r1.diagnostics && r2.diagnostics);
+  std::printf("[two fingers] idle finger 0: zero-velocity factors %d (pusher alone %d), object rotation %.4f rad "
+              "(pusher alone %.4f)\n",
+              zero_velocity(r2), zero_velocity(r1), r2.metrics.at("object_rotation_rms"),
+              r1.metrics.at("object_rotation_rms"));
+  EXPECT_EQ(zero_velocity(r2), zero_velocity(r1));
+  EXPECT_LT(r2.metrics.at("object_rotation_rms"), 1.5 * r1.metrics.at("object_rotation_rms"));
+  EXPECT_LT(r2.metrics.at("object_position_rms"), 1.5 * r1.metrics.at("object_position_rms"));
+}
+
 // A finger without the sensor the other finger has is said in the warnings, not left silent:
 // without contact rows it never touches (its forces are left out), without force rows its force
 // is only what the motion says.

@@ -158,6 +158,35 @@ TEST_F(MitPush, SyntheticFaultsAreRepaired) {
   EXPECT_LT(trimmed.streams.object_pose.size(), rec.streams.object_pose.size());
 }
 
+// A 45 g object (friction load mu m g = 0.11 N at mu 0.25) pushed for 0.6 s with 0.08 to 0.12 N:
+// the fixed 0.3 N threshold found no contact phase (helper-27 N4); the object's own threshold,
+// a quarter of its friction load, finds the push.
+TEST_F(MitPush, ALightObjectsContactPhaseUsesItsFrictionLoad) {
+  auto sets = CleanPush();
+  for (std::size_t i = 0; i < sets[2].second.size(); ++i) {
+    Row& f = sets[2].second[i];
+    f[1] = i >= 50 ? -0.08 - 0.0002 * i : 0.002 * ((i % 5) - 2.0);  // sensor noise of 4 mN before
+    f[2] = 0.001 * (i % 3);
+  }
+  const std::string path = (dir_ / "light.h5").string();
+  WriteH5(path, sets);
+  EXPECT_EQ(io::MitContactForce(0.045, 0.25), 0.25 * 0.25 * 0.045 * 9.81);
+  EXPECT_EQ(io::MitContactForce(0.8374, 0.25), 0.3);  // rect1: unchanged
+  EXPECT_EQ(io::MitContactForce(0.0, 0.25), 0.3);     // unknown mass: the default
+  io::MitReadOptions fixed;
+  fixed.trim_to_contact = true;
+  EXPECT_FALSE(io::ReadMitPush(path, fixed).contact_found);
+  io::MitReadOptions own = fixed;
+  own.contact_force = io::MitContactForce(0.045, 0.25);
+  const io::MitRecording rec = io::ReadMitPush(path, own);
+  ASSERT_TRUE(rec.contact_found);
+  EXPECT_NEAR(rec.contact_start, 1000.0 + 0.004 * 50 + 0.002, 1e-9);
+  EXPECT_NEAR(rec.contact_end, 1000.0 + 0.004 * 199 + 0.002, 1e-9);
+  EXPECT_TRUE(std::any_of(rec.notes.begin(), rec.notes.end(), [](const std::string& n) {
+    return n.find("contact phase from the force magnitude (> 0.0275") != std::string::npos;
+  }));
+}
+
 TEST_F(MitPush, FrozenSyntheticSensorAndJsonVariant) {
   auto sets = CleanPush();
   for (std::size_t i = 0; i < sets[2].second.size(); ++i) {  // stuck, with spikes, like rect1

@@ -24,6 +24,26 @@ def test_trajectory_round_trip(push, tmp_path):
     assert again["object"]["mass"] == push["object"]["mass"]
 
 
+def test_paths_and_repaired_rows(push, tmp_path):
+    # pathlib.Path as well as str (helper-27 N8: "incompatible function arguments"); rows the
+    # reader sorted come as a UserWarning (N9: sorted silently).
+    path = tmp_path / "push.json"
+    pg.save_trajectory(push, path)
+    again = pg.load_trajectory(path)
+    np.testing.assert_array_equal(again["measured"]["object_pose"]["t"], push["measured"]["object_pose"]["t"])
+    shape_path = tmp_path / "box.json"
+    pg.Shape.box(0.09, 0.05).save_json(shape_path)
+    assert pg.Shape.load_json(shape_path).area == pytest.approx(0.09 * 0.05)
+    data = json.loads(path.read_text())
+    rows = data["streams"]["object_pose"]
+    rows[1], rows[2] = rows[2], rows[1]
+    swapped = tmp_path / "swapped.json"
+    swapped.write_text(json.dumps(data))
+    with pytest.warns(UserWarning, match="object_pose"):
+        sorted_again = pg.load_trajectory(swapped)
+    np.testing.assert_array_equal(sorted_again["measured"]["object_pose"]["t"], push["measured"]["object_pose"]["t"])
+
+
 def test_bad_trajectory_dicts_name_the_key(push):
     bad = dict(push)
     bad["measured"] = dict(push["measured"], camera={"t": [0.0], "pose": [[0, 0, 0]]})

@@ -1,6 +1,6 @@
 // pushgraph estimate INPUT --model cp|sdf|qs|yu --mode batch|incremental -o RESULT.json
 // [--config CONFIG.json] [--object SHAPE.json --finger SHAPE.json --mass KG --mu MU]
-// [--add-noise gaussian|bimodal [--seed N]] [--svg PLOT.svg]: factor-graph estimation of a push
+// [--add-noise gaussian|bimodal [--seed N]] [--svg PLOT.svg] [--no-trim]: factor-graph estimation of a push
 // (docs/estimation.md). INPUT is a pushgraph trajectory file or an MIT recording (HDF5 or the
 // dataset's JSON), told apart by content. Prints a one-line JSON summary on stdout.
 #include "cli_common.h"
@@ -31,6 +31,7 @@ struct EstimateOptions {
   std::uint64_t seed = 1;
   std::string svg;
   std::string align_shape;  // empty: the configuration's (default auto)
+  bool trim = true;         // an MIT recording: its contact phase only
 };
 
 push::Trajectory LoadInput(const EstimateOptions& o, std::string* source) {
@@ -39,9 +40,12 @@ push::Trajectory LoadInput(const EstimateOptions& o, std::string* source) {
   if (!o.finger.empty()) given.finger_shape = LoadShapeArgument(o.finger, "--finger");
   if (o.mass > 0.0) given.mass = o.mass;
   if (o.mu >= 0.0) given.mu_surface = o.mu;
+  given.trim_to_contact = o.trim;
   std::vector<std::string> notes;
   evaluation::InputKind kind;
   push::Trajectory t = evaluation::LoadEstimationInput(o.input, given, &notes, &kind);
+  if (!o.trim && kind == evaluation::InputKind::kTrajectory)
+    throw CliError(o.input + ": --no-trim applies to MIT recordings; a trajectory file is estimated as it is");
   for (const std::string& note : notes) std::cerr << "estimate: " << o.input << ": " << note << "\n";
   *source = kind == evaluation::InputKind::kTrajectory ? "trajectory" : "mit";
   return t;
@@ -158,6 +162,8 @@ void RegisterEstimate(CLI::App& app) {
       ->check(CLI::IsMember({"gaussian", "bimodal"}));
   AddSeedOption(sub, &opts->seed, "Seed of --add-noise");
   sub->add_option("--svg", opts->svg, "Also write a picture of the estimate (SVG)");
+  sub->add_flag("--trim,!--no-trim", opts->trim,
+                "An MIT recording: keep only its contact phase (the default); --no-trim keeps every sample");
   AddAlignShapeOption(sub, &opts->align_shape);
   sub->callback([opts]() { RunEstimate(*opts); });
 }

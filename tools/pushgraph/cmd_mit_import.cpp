@@ -38,6 +38,7 @@ void RegisterMitImport(CLI::App& app) {
     if (!(a->mu_surface >= 0.0) || !(a->mu_contact >= 0.0)) throw CliError("friction coefficients must be >= 0");
     io::MitReadOptions options;
     options.trim_to_contact = a->trim;
+    options.contact_force = io::MitContactForce(a->mass, a->mu_surface);
     const io::MitRecording rec = io::ReadMitPush(a->recording, options);
     push::ObjectDescription object;
     object.shape = LoadShapeArgument(a->object, "--object");

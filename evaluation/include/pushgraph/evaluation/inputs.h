@@ -73,6 +73,9 @@ ObjectModel MitObjectModel(const std::string& object_name, const std::string& me
 struct InputOverrides {
   std::optional<geometry::Shape> object_shape, finger_shape;
   std::optional<double> mass, mu_surface;
+  /// An MIT recording: keep only its contact phase (false: every sample, the finger's approach
+  /// and the rest after the push included).
+  bool trim_to_contact = true;
 };
 
 /// A trajectory file or an MIT recording (DetectInputKind) as the estimator's input: a trajectory
@@ -82,11 +85,12 @@ struct InputOverrides {
 push::Trajectory LoadEstimationInput(const std::string& path, const InputOverrides& overrides,
                                      std::vector<std::string>* notes = nullptr, InputKind* kind = nullptr);
 
-/// An MIT recording trimmed to its contact phase (refused when nothing was pushed), each stream
+/// An MIT recording trimmed to its contact phase (force above io::MitContactForce of the model's
+/// object; refused when nothing was pushed; `trim` false keeps every sample), each stream
 /// decimated to at most one sample per 1/rate s (0: every sample), with `model`'s object and
 /// finger. Notes as above.
 push::Trajectory ReadMitTrajectory(const std::string& path, const ObjectModel& model, double rate,
-                                   std::vector<std::string>* notes = nullptr);
+                                   std::vector<std::string>* notes = nullptr, bool trim = true);
 
 /// Simulated pushes: the finger pushes `shape` straight over `push_distance` at `speed`; push
 /// direction uniform in [0, 2 pi) and sideways offset uniform in +-offset_fraction of the shape's
