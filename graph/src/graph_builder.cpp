@@ -73,6 +73,10 @@ bool ObjectSeenMoving(const std::vector<push::PoseSample>& poses, double sigma, 
 }
 
 bool PoseStreamAtRest(const std::vector<push::PoseSample>& poses, double t, double sigma) {
+  return PoseStreamRest(poses, t, sigma) == Rest::kAtRest;
+}
+
+Rest PoseStreamRest(const std::vector<push::PoseSample>& poses, double t, double sigma) {
   // The window: long enough that 8 mm/s moves the stream by its bound below (200 sigma s/m),
   // from 0.1 s to 1 s (0.1 s under a 0.5 mm tracker, 1 s under 5 mm): a slow push is not taken
   // for rest, and a rest is found only where it lasts longer than the window's half.
@@ -82,7 +86,7 @@ bool PoseStreamAtRest(const std::vector<push::PoseSample>& poses, double t, doub
   const auto b = std::upper_bound(poses.begin(), poses.end(), t + half_window,
                                   [](double tt, const push::PoseSample& p) { return tt < p.t; });
   const std::ptrdiff_t n = b - a;
-  if (n < 4 || (b - 1)->t - a->t < half_window) return false;  // too little to tell (a stream's ends, a gap)
+  if (n < 4 || (b - 1)->t - a->t < half_window) return Rest::kUnknown;  // too little to tell (a stream's ends, a gap)
   const std::ptrdiff_t k = std::min<std::ptrdiff_t>(5, n / 2);  // samples in each end's median
   auto median_of = [k](auto first) {
     std::vector<double> x, y;
@@ -92,7 +96,7 @@ bool PoseStreamAtRest(const std::vector<push::PoseSample>& poses, double t, doub
   // Two medians of k samples differ by about 1.25 sigma sqrt(2 / k) under Gaussian noise: four
   // of those, and at least 1 mm.
   const double bound = std::max(1e-3, 4.0 * 1.25 * sigma * std::sqrt(2.0 / static_cast<double>(k)));
-  return (median_of(b - k) - median_of(a)).norm() < bound;
+  return (median_of(b - k) - median_of(a)).norm() < bound ? Rest::kAtRest : Rest::kMoving;
 }
 
 bool ForceSaysTouching(const std::vector<push::ForceSample>& force, double t, double max_gap, double threshold,
@@ -1345,19 +1349,23 @@ bool GraphBuilder::MeasuredAtRest(int i) const {
   // Quasi-statically the object moves only while a finger does: at rest where every finger with
   // a pose stream is measured at rest (with finger 0 alone, an idle finger 0 beside the pusher
   // held the pushed object still for 275 steps). No finger stream: the object's own.
+  // A finger whose stream cannot tell there (its ends, a gap) does not block the others' rest;
+  // one finger alone must be seen at rest, as before.
   const auto& m = traj_.measured;
   const double t = steps_[i].t;
-  bool any_finger = false;
-  auto finger_at_rest = [&](const std::vector<push::PoseSample>& poses) {
-    if (poses.empty()) return true;
+  bool any_finger = false, seen_at_rest = false;
+  auto moving = [&](const std::vector<push::PoseSample>& poses) {
+    if (poses.empty()) return false;
     any_finger = true;
-    return PoseStreamAtRest(poses, t, cfg_.measurement.finger_trans);
+    const Rest rest = PoseStreamRest(poses, t, cfg_.measurement.finger_trans);
+    seen_at_rest = seen_at_rest || rest == Rest::kAtRest;
+    return rest == Rest::kMoving;
   };
-  if (!finger_at_rest(m.finger_pose)) return false;
+  if (moving(m.finger_pose)) return false;
   if (other_fingers_ > 0)
     for (const push::ExtraFinger& f : traj_.extra_fingers)
-      if (!finger_at_rest(f.measured.finger_pose)) return false;
-  if (any_finger) return true;
+      if (moving(f.measured.finger_pose)) return false;
+  if (any_finger) return seen_at_rest;
   return PoseStreamAtRest(m.object_pose, t, cfg_.measurement.object_trans);
 }
 

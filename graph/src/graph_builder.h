@@ -476,10 +476,15 @@ Diagnostics Diagnose(const push::Trajectory& trajectory, Model model, const Esti
 /// samples, clock jumps within or between streams.
 void ValidateTrajectory(const push::Trajectory& trajectory);
 /// Refuses a push whose fingers never come near the object's tracked origin: every finger that
-/// measures a contact point or a force above `force_threshold` (none: the nearest finger) must
-/// come within max(0.5 m, twice the object's and its reach from their pose origins). Part of
-/// ValidateTrajectory (threshold 0); OnlineEstimator runs it at the first update after a touch.
-void CheckFingerReachesObject(const push::Trajectory& trajectory, double force_threshold);
+/// measures a contact point or a non-zero force (none: the nearest finger) must come within
+/// max(0.5 m, twice the object's and its reach from their pose origins), and every contact stream
+/// lie that near (its median). Part of ValidateTrajectory.
+void CheckFingerReachesObject(const push::Trajectory& trajectory);
+/// OnlineEstimator's form of that check at a finger's first touch (time t; `contact` its first
+/// contact sample, or null when a force said so): why finger `finger` (0: the trajectory's
+/// finger, k: extra_fingers[k - 1]) or that contact cannot touch the object there, or nullopt.
+std::optional<std::string> FingerFarFromObject(const push::Trajectory& trajectory, int finger, double t,
+                                               const push::PointSample* contact);
 /// A warning when every stream is sampled at 0.2 s or slower (5 Hz) and the streams read in
 /// milliseconds or microseconds are a push (at most 20 kHz, a finger at most 2 m/s): a 250 Hz
 /// sensor in milliseconds reads 4 s apart, and the noise model's per-second scales then no longer
@@ -537,6 +542,9 @@ bool ObjectSeenMoving(const std::vector<push::PoseSample>& poses, double sigma, 
 /// samples at both ends) move less than their noise allows (at least 1 mm); false where the window
 /// holds too few samples to tell.
 bool PoseStreamAtRest(const std::vector<push::PoseSample>& poses, double t, double sigma);
+/// The same with "too few samples to tell" apart from "moving".
+enum class Rest { kAtRest, kMoving, kUnknown };
+Rest PoseStreamRest(const std::vector<push::PoseSample>& poses, double t, double sigma);
 /// The finger count (at most two) and every finger's shape; ValidateTrajectory's first checks.
 void ValidateFingers(const push::Trajectory& trajectory);
 /// The 95th percentile of `values` (non-empty).

@@ -639,11 +639,42 @@ struct OnlineEstimator::Impl {
   int dropped_faults = 0;
   std::string first_fault;
   bool finished = false;
-  // The batch's check that the fingers come near the object (trajectory_checks.cpp), run once at
-  // the first update after a contact point or a force above 3 sigma: before the touch a finger
-  // may still be on its way; without it a pusher 2 m off (another tracker's frame) gave an
-  // object 1.87 m off, and no word (helper-27 N0b).
-  bool touched = false, reach_checked = false;
+  // The batch's check that a touching finger is near the object (trajectory_checks.cpp), per
+  // finger at its first touch: its first contact point, or the first force sample the estimator's
+  // own contact gating takes as a touch (ForceSaysTouching). Without it a pusher 2 m off
+  // (another tracker's frame) gave an object 1.87 m off, and no word (helper-27 N0b).
+  std::vector<bool> reach_checked;        // per finger
+  std::vector<std::size_t> touch_scanned;  // per finger: force samples looked at
+
+  void CheckTouchingFingersAreNear() {
+    const EstimatorConfig& cfg = smoother.cfg;
+    for (int k = 0; k < fingers; ++k) {
+      if (reach_checked[k]) continue;
+      const auto& contacts = k == 0 ? traj.measured.contact_point : traj.extra_fingers[k - 1].measured.contact_point;
+      const auto& forces = k == 0 ? traj.measured.force : traj.extra_fingers[k - 1].measured.force;
+      double touch = INFINITY;
+      if (!contacts.empty()) {
+        touch = contacts.front().t;
+      } else {
+        // Held for 0.1 s (the gating's test at t, t + 0.05 and t + 0.1 s): one window's median
+        // crosses the noise bound now and then (a finger 0.58 m away on its approach).
+        auto says = [&](double at) {
+          return internal::ForceSaysTouching(forces, at, cfg.contact_max_gap, cfg.contact_force_threshold,
+                                             cfg.measurement.force);
+        };
+        for (std::size_t& j = touch_scanned[k]; j < forces.size() && forces.back().t >= forces[j].t + 0.12; ++j) {
+          if (says(forces[j].t) && says(forces[j].t + 0.05) && says(forces[j].t + 0.1)) {
+            touch = forces[j].t;
+            break;
+          }
+        }
+      }
+      if (!std::isfinite(touch)) continue;
+      reach_checked[k] = true;
+      if (const std::optional<std::string> far = internal::FingerFarFromObject(traj, k, touch, contacts.empty() ? nullptr : &contacts.front()))
+        throw GraphError("OnlineEstimator::Update: " + *far);
+    }
+  }
   std::vector<bool> declared;
   int fingers = 1;
   double max_latency = 0.2;
@@ -668,6 +699,8 @@ struct OnlineEstimator::Impl {
     seen.assign(1 + 3 * fingers, 0);
     declared.assign(1 + 3 * fingers, false);
     repeated_contact.assign(fingers, false);
+    reach_checked.assign(fingers, false);
+    touch_scanned.assign(fingers, 0);
     declared[0] = true;
     for (int k = 0; k < fingers; ++k) {
       declared[3 * k + 1] = true;
@@ -821,7 +854,6 @@ bool OnlineEstimator::AddContactPoint(double t, int finger, const geometry::Vec2
   const int stream = m.FingerStream(finger, 1, "AddContactPoint");
   if (!m.Accept(stream, "contact_point", t, point.allFinite())) return false;
   (finger == 0 ? m.traj.measured.contact_point : m.traj.extra_fingers[finger - 1].measured.contact_point).push_back({t, point});
-  m.touched = true;
   return true;
 }
 bool OnlineEstimator::AddForce(double t, int finger, const geometry::Vec2& force) {
@@ -850,7 +882,6 @@ bool OnlineEstimator::AddForce(double t, int finger, const geometry::Vec2& force
   m.recent_force.push_back(magnitude);
   if (m.recent_force.size() > Impl::kRecentForces) m.recent_force.pop_front();
   (finger == 0 ? m.traj.measured.force : m.traj.extra_fingers[finger - 1].measured.force).push_back({t, force});
-  m.touched = m.touched || magnitude > 3.0 * m.smoother.cfg.measurement.force;
   return true;
 }
 int OnlineEstimator::DroppedLateSamples() const { return impl_->dropped_late; }
@@ -899,16 +930,7 @@ double OnlineEstimator::Update(double until) {
       }
     }
   }
-  if (m.touched && !m.reach_checked) {
-    try {
-      internal::CheckFingerReachesObject(m.traj, 3.0 * m.smoother.cfg.measurement.force);
-    } catch (const GraphError& e) {
-      std::string what = e.what();
-      if (what.rfind("trajectory: ", 0) == 0) what.replace(0, 12, "");
-      throw GraphError("OnlineEstimator::Update at t = " + Precise(until) + ": " + what);
-    }
-    m.reach_checked = true;
-  }
+  m.CheckTouchingFingersAreNear();
   // Samples within 1e-9 s after `until` join its step now (as batch merges them), so no later
   // step can be closer than that to a solved one.
   m.last_update_t = until;  // later samples must come more than 1e-9 s after it (Accept)

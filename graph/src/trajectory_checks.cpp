@@ -79,11 +79,51 @@ double NearestFingerRatio(const push::Trajectory& traj) {
 // alone put the finger 2 m away) and at least 0.5 m, more than any tabletop object needs. The
 // shape check had "repaired" such files by scaling the object 100 or 1000 times (a 12 cm block
 // made 12 m, c = 3.9 m).
+// The sample of a time-sorted stream nearest to t (the stream is not empty).
+template <typename Sample>
+const Sample& NearestInTime(const std::vector<Sample>& s, double t) {
+  auto it = std::lower_bound(s.begin(), s.end(), t, [](const Sample& a, double x) { return a.t < x; });
+  if (it == s.end()) return s.back();
+  if (it != s.begin() && t - std::prev(it)->t < it->t - t) --it;
+  return *it;
+}
+
+double Reach(const geometry::Shape& s) { return s.empty() ? 0.0 : geometry::RadiusAbout(s, geometry::Vec2::Zero()); }
+
 }  // namespace
 
-void CheckFingerReachesObject(const push::Trajectory& traj, double force_threshold) {
+std::optional<std::string> FingerFarFromObject(const push::Trajectory& traj, int finger, double t,
+                                               const push::PointSample* contact) {
   const auto& objects = traj.measured.object_pose;
-  auto reach = [](const geometry::Shape& s) { return s.empty() ? 0.0 : geometry::RadiusAbout(s, geometry::Vec2::Zero()); };
+  const auto& poses = finger == 0 ? traj.measured.finger_pose : traj.extra_fingers[finger - 1].measured.finger_pose;
+  const geometry::Shape& shape = finger == 0 ? traj.finger.shape : traj.extra_fingers[finger - 1].finger.shape;
+  if (objects.empty() || poses.empty()) return std::nullopt;
+  constexpr double kLeastReach = 0.5;  // m, as CheckFingerReachesObject
+  const double bound = std::max(kLeastReach, 2.0 * (Reach(traj.object.shape) + Reach(shape)));
+  const std::string prefix = finger == 0 ? "" : "fingers[" + std::to_string(finger) + "].";
+  const double d = (NearestInTime(poses, t).pose.translation() - NearestInTime(objects, t).pose.translation()).norm();
+  if (d > bound) {
+    return Format("finger %d is %.3g m from the object at t = %.9g s, where its %s says it touches, beyond the %.3g m a "
+                  "push allows (twice the object's and the finger's reach from their pose origins, and at least %.3g m): "
+                  "are streams.%sfinger_pose and streams.object_pose in different frames (an offset between the two "
+                  "trackers) or units?",
+                  finger, d, t, contact != nullptr ? "contact stream" : "force", bound, kLeastReach, prefix.c_str());
+  }
+  if (contact != nullptr) {
+    const double c = (contact->point - NearestInTime(objects, contact->t).pose.translation()).norm();
+    if (c > bound) {
+      return Format("streams.%scontact_point's first sample lies %.3g m from the object's tracked origin (t = %.9g s), "
+                    "beyond the %.3g m a contact on the object allows: is the contact sensor in another frame or unit "
+                    "than streams.object_pose?",
+                    prefix.c_str(), c, contact->t, bound);
+    }
+  }
+  return std::nullopt;
+}
+
+void CheckFingerReachesObject(const push::Trajectory& traj) {
+  const auto& objects = traj.measured.object_pose;
+  const auto reach = Reach;
   // Every finger that measures a contact or a force must come near (an idle finger parked next to
   // the object passed the check for a pusher 2 m off); with none, the nearest finger.
   struct Finger {
@@ -91,15 +131,15 @@ void CheckFingerReachesObject(const push::Trajectory& traj, double force_thresho
     double reach;
     bool touches;
   };
-  auto touches = [&](const push::FingerStreams& s) {
-    return !s.contact_point.empty() || std::any_of(s.force.begin(), s.force.end(), [&](const push::ForceSample& f) {
-             return f.force.norm() > force_threshold;
-           });
+  // A force stream of zeros alone (an idle finger's sensor) is no touch.
+  auto touches = [](const std::vector<push::PointSample>& contacts, const std::vector<push::ForceSample>& forces) {
+    return !contacts.empty() ||
+           std::any_of(forces.begin(), forces.end(), [](const push::ForceSample& f) { return f.force.norm() > 0.0; });
   };
   const push::Streams& m = traj.measured;
-  std::vector<Finger> fingers = {{&m.finger_pose, reach(traj.finger.shape), touches({m.finger_pose, m.contact_point, m.force})}};
+  std::vector<Finger> fingers = {{&m.finger_pose, reach(traj.finger.shape), touches(m.contact_point, m.force)}};
   for (const push::ExtraFinger& f : traj.extra_fingers)
-    fingers.push_back({&f.measured.finger_pose, reach(f.finger.shape), touches(f.measured)});
+    fingers.push_back({&f.measured.finger_pose, reach(f.finger.shape), touches(f.measured.contact_point, f.measured.force)});
   const bool any_touches = std::any_of(fingers.begin(), fingers.end(), [](const Finger& f) { return f.touches; });
   double nearest = any_touches ? -INFINITY : INFINITY, at = 0.0, finger_reach = 0.0, first = 0.0;
   for (const Finger& f : fingers) {
@@ -117,13 +157,36 @@ void CheckFingerReachesObject(const push::Trajectory& traj, double force_thresho
   // (the notched block 100 times larger, pushed by a 5 cm finger) is no error; the two cannot be
   // told apart from the streams here.
   const double bound = std::max(kLeastReach, 2.0 * (reach(traj.object.shape) + finger_reach));
-  if (!(nearest > bound) || !std::isfinite(nearest)) return;
-  throw GraphError(Format("trajectory: the finger never comes nearer than %.3g m to the object (at t = %s), beyond the "
-                          "%.3g m a push allows (twice the object's and the finger's reach from their pose origins, and at "
-                          "least %.3g m): are streams.finger_pose and streams.object_pose in different frames (an offset "
-                          "between the two trackers) or units?",
-                          nearest, StepTime(at, first, "the finger's first sample").c_str(), bound,
-                          kLeastReach));
+  if (nearest > bound && std::isfinite(nearest)) {
+    throw GraphError(Format("trajectory: the finger never comes nearer than %.3g m to the object (at t = %s), beyond the "
+                            "%.3g m a push allows (twice the object's and the finger's reach from their pose origins, and at "
+                            "least %.3g m): are streams.finger_pose and streams.object_pose in different frames (an offset "
+                            "between the two trackers) or units?",
+                            nearest, StepTime(at, first, "the finger's first sample").c_str(), bound, kLeastReach));
+  }
+  // A contact stream lies on the object: its median distance from the object's tracked origin
+  // (the object sample nearest in time) is within the same bound, or the contact sensor reports
+  // in another frame (a stream 2 m off was estimated, its factors' residuals blamed on the probe).
+  auto contacts_far = [&](const std::vector<push::PointSample>& contacts, const std::string& stream, double contact_reach) {
+    if (contacts.empty() || objects.empty()) return;
+    std::vector<double> distances;
+    for (std::size_t i = 0, j = 0; i < contacts.size(); ++i) {
+      while (j + 1 < objects.size() && std::abs(objects[j + 1].t - contacts[i].t) <= std::abs(objects[j].t - contacts[i].t)) ++j;
+      distances.push_back((contacts[i].point - objects[j].pose.translation()).norm());
+    }
+    std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
+    const double median = distances[distances.size() / 2];
+    const double contact_bound = std::max(kLeastReach, 2.0 * (reach(traj.object.shape) + contact_reach));
+    if (!(median > contact_bound)) return;
+    throw GraphError(Format("trajectory: streams.%s lies %.3g m from the object's tracked origin (the median of its %zu "
+                            "samples), beyond the %.3g m a contact on the object allows: is the contact sensor in another "
+                            "frame or unit than streams.object_pose?",
+                            stream.c_str(), median, contacts.size(), contact_bound));
+  };
+  contacts_far(traj.measured.contact_point, "contact_point", reach(traj.finger.shape));
+  for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k)
+    contacts_far(traj.extra_fingers[k].measured.contact_point, "fingers[" + std::to_string(k + 1) + "].contact_point",
+                 reach(traj.extra_fingers[k].finger.shape));
 }
 
 namespace {
@@ -428,7 +491,7 @@ void ValidateTrajectory(const push::Trajectory& traj) {
   for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k)
     CheckPositionUnits(traj.extra_fingers[k].measured.finger_pose, "fingers[" + std::to_string(k + 1) + "].finger_pose",
                        finger_ratio);
-  CheckFingerReachesObject(traj, 0.0);
+  CheckFingerReachesObject(traj);
   CheckFingerSize(traj.finger.shape, m.finger_pose, m.object_pose, traj.object.shape, "");
   for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k) {
     CheckFingerSize(traj.extra_fingers[k].finger.shape, traj.extra_fingers[k].measured.finger_pose, m.object_pose,

@@ -389,8 +389,9 @@ void Trim(std::vector<Sample>* v, double t0, double t1) {
 
 double MitContactForce(double mass, double mu_surface) {
   const double kDefault = MitReadOptions{}.contact_force;
+  constexpr double kMinimum = 0.05;  // N: graph::EstimatorConfig's contact_force_threshold, above a sensor's noise
   if (!(mass > 0.0) || !(mu_surface > 0.0)) return kDefault;
-  return std::min(kDefault, 0.25 * mu_surface * mass * 9.81);
+  return std::clamp(0.25 * mu_surface * mass * 9.81, kMinimum, kDefault);
 }
 
 MitRecording ReadMitPush(const std::string& path, const MitReadOptions& o) {

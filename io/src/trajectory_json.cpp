@@ -130,10 +130,16 @@ class Reader {
   std::vector<Sample> Sorted(std::vector<Sample> rows, std::vector<std::size_t> row_of, const std::string& path,
                              bool repeats, int finger) const {
     const std::string whose = finger >= 0 ? " of finger " + std::to_string(finger) : "";
-    // A stream logged newest first (every row at or before the one above it) is one push read
-    // backwards: reversed, and said so (it was refused as "two recordings joined").
-    bool newest_first = rows.size() >= 2 && rows.back().t < rows.front().t;
-    for (std::size_t i = 1; i < rows.size() && newest_first; ++i) newest_first = rows[i].t <= rows[i - 1].t;
+    // A stream logged newest first (its last row before its first, and nine in ten steps between
+    // rows going back) is one push read backwards: reversed, and said so (it was refused as "two
+    // recordings joined"); rows still out of order after that are sorted below, as in any stream
+    // (one swapped pair had the whole stream refused again).
+    std::size_t back_steps = 0, forward_steps = 0;
+    for (std::size_t i = 1; i < rows.size(); ++i) {
+      back_steps += rows[i].t < rows[i - 1].t;
+      forward_steps += rows[i].t > rows[i - 1].t;
+    }
+    const bool newest_first = rows.size() >= 2 && rows.back().t < rows.front().t && back_steps >= 9 * forward_steps;
     if (newest_first) {
       std::reverse(rows.begin(), rows.end());
       std::reverse(row_of.begin(), row_of.end());

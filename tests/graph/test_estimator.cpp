@@ -694,6 +694,12 @@ TEST(Estimator, BadTrajectoriesGetClearErrors) {
   idle_near.extra_fingers.push_back(idle);
   for (auto& f : idle_near.measured.finger_pose) f.pose.x += 2.0;
   EXPECT_NE(message(idle_near).find("the finger never comes nearer than"), std::string::npos) << message(idle_near);
+  // A contact sensor in another frame: its stream 2 m off the object (helper-27 N0c: estimated,
+  // and the residuals blamed on the probe).
+  auto contact_far = t;
+  ASSERT_FALSE(contact_far.measured.contact_point.empty());
+  for (auto& c : contact_far.measured.contact_point) c.point.x() += 2.0;
+  EXPECT_NE(message(contact_far).find("streams.contact_point lies 1.9"), std::string::npos) << message(contact_far);
   auto near = t;
   for (auto& f : near.measured.finger_pose) f.pose.x += 0.3;
   EXPECT_EQ(message(near).find("the finger never comes nearer than"), std::string::npos);

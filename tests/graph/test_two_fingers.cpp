@@ -356,6 +356,35 @@ TEST(TwoFingers, TwoRowsOfFingerOneAtOneTimeAreTwoContacts) {
 // Fed sample by sample to OnlineEstimator (both fingers' streams in time order, UpdateDue polled
 // after each time stamp, as a robot loop would), a two-finger push is estimated as the replay of
 // the recording estimates it at the same update times: every 5 object samples and at every step.
+// Online, each finger is checked at its own first touch: finger 0 tracked 2 m off is refused
+// when it touches (0.32 s), after finger 1 (near) touched first (0.10 s) and passed.
+TEST(TwoFingers, OnlineEstimatorChecksEachFingerAtItsFirstTouch) {
+  push::Trajectory t = TwoFingerPush(8);
+  for (auto& f : t.measured.finger_pose) f.pose.x += 2.0;
+  for (auto& c : t.measured.contact_point) c.point.x() += 2.0;
+  ASSERT_GT(t.measured.contact_point.front().t, t.extra_fingers[0].measured.contact_point.front().t + 0.1);
+  const EstimatorConfig config = ApplyMeasurementSigmas(EstimatorConfig{}, *t.measurement_sigmas);
+  OnlineEstimator online(testing::SetupOf(t), Model::kQs, config, testing::StreamsOf(t));
+  const std::vector<testing::Arrival> arrivals = testing::ArrivalOrder(t);
+  int updates = 0;
+  std::string error;
+  try {
+    for (std::size_t k = 0; k < arrivals.size(); ++k) {
+      testing::Deliver(arrivals[k], t, online);
+      if (k + 1 < arrivals.size() && arrivals[k + 1].t <= arrivals[k].t + 1e-9) continue;
+      if (!online.UpdateDue()) continue;
+      online.Update();
+      ++updates;
+    }
+  } catch (const GraphError& e) {
+    error = e.what();
+  }
+  std::printf("[two fingers] online, finger 0 2 m off: %d updates, then: %s\n", updates, error.c_str());
+  EXPECT_GT(updates, 0);
+  EXPECT_NE(error.find("finger 0 is 2 m from the object at t = 0.32 s"), std::string::npos) << error;
+  EXPECT_NE(error.find("streams.finger_pose and"), std::string::npos) << error;
+}
+
 TEST(TwoFingers, OnlineEstimatorTakesBothFingersSampleBySample) {
   const push::Trajectory t = TwoFingerPush(8);
   const std::vector<testing::Arrival> arrivals = testing::ArrivalOrder(t);

@@ -102,6 +102,20 @@ TEST(TrajectoryJson, AClockThatGoesBackIsRefused) {
   EXPECT_EQ(t.measured.force.back().force.x(), 50.0);
   ASSERT_EQ(notes.size(), 1u);
   EXPECT_NE(notes[0].find("streams.force: rows logged newest first, read in reverse"), std::string::npos) << notes[0];
+  // With one pair of rows swapped too: reversed, then that pair sorted (helper-27 N5: it was
+  // refused as "two recordings joined" again).
+  std::string reversed_swapped;
+  for (int i = 50; i >= 0; --i) {
+    const int k = i == 30 ? 29 : i == 29 ? 30 : i;
+    reversed_swapped += (i < 50 ? "," : "") + std::string("[") + std::to_string(0.04 * k) + ", " + std::to_string(k) + ", 0]";
+  }
+  notes.clear();
+  const auto again = ParseTrajectoryJson(Doc(R"({"force": [)" + reversed_swapped + "]}"), "push.json", &notes);
+  ASSERT_EQ(again.measured.force.size(), 51u);
+  for (std::size_t i = 0; i < again.measured.force.size(); ++i) EXPECT_EQ(again.measured.force[i].force.x(), double(i));
+  ASSERT_EQ(notes.size(), 2u);
+  EXPECT_NE(notes[0].find("rows logged newest first, read in reverse"), std::string::npos) << notes[0];
+  EXPECT_NE(notes[1].find("sorted 1 row(s)"), std::string::npos) << notes[1];
   // The period in the message comes from the time stamps in order: rows swapped in pairs have
   // forward steps of 12 ms in file order but a period of 4 ms, so a clock that then goes back by
   // 1.1 s is refused (with 12 ms the limit was max(1 s, 1.2 s) and it passed).

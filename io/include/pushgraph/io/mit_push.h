@@ -59,7 +59,8 @@ struct MitRecording {
 
 /// The contact threshold for an object of `mass` (kg) on a table of friction `mu_surface`: 0.3 N
 /// (the dataset's objects need 1 N or more to slide), or a quarter of the friction load
-/// mu m g when that is less. A fixed 0.3 N cut a 45 g object's push to 20 ms, or found none.
+/// mu m g when that is less (below 0.49 kg at mu 0.25), and at least 0.05 N (the estimator's
+/// contact_force_threshold). A fixed 0.3 N cut a 45 g object's push to 20 ms, or found none.
 double MitContactForce(double mass, double mu_surface);
 
 /// Reads a .h5 (HDF5) or .json recording, chosen by the file's extension. Throws IoError naming
