@@ -18,7 +18,16 @@ if [ "${1:-}" = "--sanitize" ]; then
   bash scripts/sanitize-build.sh
   export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
   export LSAN_OPTIONS="suppressions=$PWD/fuzz/lsan.supp"
-  skip='^(Alignment\.MisframedShapesAreAlignedAndEstimatedAsWellAsTheTrueOne|Alignment\.IncrementalModeUsesTheAlignedShape)$'
+  # Also left out: seven tests of 88 to 150 s each under ASan (measured 2026-11-28) whose code runs
+  # sanitized in shorter ones: the wedge's and finger 1's probe-radius diagnostics
+  # (TwoContacts.AWedgedFingerIsEstimatedWithBothContacts, TwoFingers.BothFingersAre..., Diagnostics.*),
+  # and five MIT runs of the tool (a mesh in millimetres twice more, a turned mesh, a long recording,
+  # the chain solver's stopping rule), whose paths EstimateCli.AMeshInMillimetresAloneIsEstimatedAsTheRightOne,
+  # the Registration tests and the ChainSolver tests run.
+  skip='^(Alignment\.MisframedShapesAreAlignedAndEstimatedAsWellAsTheTrueOne|Alignment\.IncrementalModeUsesTheAlignedShape'
+  skip+='|TwoContacts\.AWedgedFingerIsNotTakenForAWrongProbeRadius|TwoFingers\.AWrongRadiusOfFingerOneIsNamed'
+  skip+='|EstimateCli\.(ATrueMeshOnALongRecordingIsNotMovedByTheFrameCheck|AMeshInMillimetresOnARestingPushIsOnlyItsUnits'
+  skip+='|AMeshInMillimetresIsOfferedItsUnitsAlone|TheChainSolverDoesNotStopOnAMispredictedStep|AMeshTurnedBy37DegreesIsAligned))$'
   PUSHGRAPH_TEST_SCALE=${PUSHGRAPH_TEST_SCALE:-0.25} ctest --test-dir build-sanitize -LE docs -E "$skip" \
     --output-on-failure -j"$jobs"
   exit 0
