@@ -1346,11 +1346,11 @@ void GraphBuilder::AddOneContactQuasiStatic(ceres::Problem& problem, int i, doub
 }
 
 bool GraphBuilder::MeasuredAtRest(int i) const {
-  // Quasi-statically the object moves only while a finger does: at rest where every finger with
-  // a pose stream is measured at rest (with finger 0 alone, an idle finger 0 beside the pusher
-  // held the pushed object still for 275 steps). No finger stream: the object's own.
-  // A finger whose stream cannot tell there (its ends, a gap) does not block the others' rest;
-  // one finger alone must be seen at rest, as before.
+  // Quasi-statically the object moves only while a finger does: at rest where no finger with a
+  // pose stream is measured moving and one is measured at rest (finger 0 alone decided before:
+  // an idle finger 0 beside the pusher held the pushed object by 274 zero-velocity factors). A
+  // finger whose stream cannot tell there (its ends, a gap) does not count. No finger stream:
+  // the object's own.
   const auto& m = traj_.measured;
   const double t = steps_[i].t;
   bool any_finger = false, seen_at_rest = false;

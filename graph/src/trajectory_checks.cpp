@@ -73,12 +73,6 @@ double NearestFingerRatio(const push::Trajectory& traj) {
   return size > 0.0 && std::isfinite(nearest) ? nearest / size : 0.0;
 }
 
-// A finger that never comes near the object's tracked origin pushes nothing: a finger and an
-// object tracker in different frames (a fixed offset of metres) or units. Near is within the
-// shapes' reach of their pose origins (a shape file too small by 100 has no say: the streams
-// alone put the finger 2 m away) and at least 0.5 m, more than any tabletop object needs. The
-// shape check had "repaired" such files by scaling the object 100 or 1000 times (a 12 cm block
-// made 12 m, c = 3.9 m).
 // The sample of a time-sorted stream nearest to t (the stream is not empty).
 template <typename Sample>
 const Sample& NearestInTime(const std::vector<Sample>& s, double t) {
@@ -90,6 +84,22 @@ const Sample& NearestInTime(const std::vector<Sample>& s, double t) {
 
 double Reach(const geometry::Shape& s) { return s.empty() ? 0.0 : geometry::RadiusAbout(s, geometry::Vec2::Zero()); }
 
+constexpr double kLeastReach = 0.5;  // m
+
+// A finger that never comes near the object's tracked origin pushes nothing: a finger and an
+// object tracker in different frames (a fixed offset of metres) or units. Near is within the
+// shapes' reach of their pose origins (a shape file too small by 100 has no say: the streams
+// alone put the finger 2 m away) and at least 0.5 m, more than any tabletop object needs. The
+// shape check had "repaired" such files by scaling the object 100 or 1000 times (a 12 cm block
+// made 12 m, c = 3.9 m).
+// The object's reach as given: a shape alone in millimetres lifts the bound with it (a tracker
+// 2 m off then passes, and the shape check rescales the shape), but a large object in metres
+// (the notched block 100 times larger, pushed by a 5 cm finger) is no error; the two cannot be
+// told apart from the streams here.
+double ReachBound(const geometry::Shape& object, const geometry::Shape& finger) {
+  return std::max(kLeastReach, 2.0 * (Reach(object) + Reach(finger)));
+}
+
 }  // namespace
 
 std::optional<std::string> FingerFarFromObject(const push::Trajectory& traj, int finger, double t,
@@ -98,8 +108,7 @@ std::optional<std::string> FingerFarFromObject(const push::Trajectory& traj, int
   const auto& poses = finger == 0 ? traj.measured.finger_pose : traj.extra_fingers[finger - 1].measured.finger_pose;
   const geometry::Shape& shape = finger == 0 ? traj.finger.shape : traj.extra_fingers[finger - 1].finger.shape;
   if (objects.empty() || poses.empty()) return std::nullopt;
-  constexpr double kLeastReach = 0.5;  // m, as CheckFingerReachesObject
-  const double bound = std::max(kLeastReach, 2.0 * (Reach(traj.object.shape) + Reach(shape)));
+  const double bound = ReachBound(traj.object.shape, shape);
   const std::string prefix = finger == 0 ? "" : "fingers[" + std::to_string(finger) + "].";
   const double d = (NearestInTime(poses, t).pose.translation() - NearestInTime(objects, t).pose.translation()).norm();
   if (d > bound) {
@@ -123,12 +132,11 @@ std::optional<std::string> FingerFarFromObject(const push::Trajectory& traj, int
 
 void CheckFingerReachesObject(const push::Trajectory& traj) {
   const auto& objects = traj.measured.object_pose;
-  const auto reach = Reach;
   // Every finger that measures a contact or a force must come near (an idle finger parked next to
   // the object passed the check for a pusher 2 m off); with none, the nearest finger.
   struct Finger {
     const std::vector<push::PoseSample>* pose;
-    double reach;
+    const geometry::Shape* shape;
     bool touches;
   };
   // A force stream of zeros alone (an idle finger's sensor) is no touch.
@@ -137,26 +145,22 @@ void CheckFingerReachesObject(const push::Trajectory& traj) {
            std::any_of(forces.begin(), forces.end(), [](const push::ForceSample& f) { return f.force.norm() > 0.0; });
   };
   const push::Streams& m = traj.measured;
-  std::vector<Finger> fingers = {{&m.finger_pose, reach(traj.finger.shape), touches(m.contact_point, m.force)}};
+  std::vector<Finger> fingers = {{&m.finger_pose, &traj.finger.shape, touches(m.contact_point, m.force)}};
   for (const push::ExtraFinger& f : traj.extra_fingers)
-    fingers.push_back({&f.measured.finger_pose, reach(f.finger.shape), touches(f.measured.contact_point, f.measured.force)});
+    fingers.push_back({&f.measured.finger_pose, &f.finger.shape, touches(f.measured.contact_point, f.measured.force)});
   const bool any_touches = std::any_of(fingers.begin(), fingers.end(), [](const Finger& f) { return f.touches; });
-  double nearest = any_touches ? -INFINITY : INFINITY, at = 0.0, finger_reach = 0.0, first = 0.0;
+  double nearest = any_touches ? -INFINITY : INFINITY, at = 0.0, first = 0.0;
+  const geometry::Shape* farthest = &traj.finger.shape;
   for (const Finger& f : fingers) {
     if (any_touches && !f.touches) continue;
     const auto [d, t] = NearestApproach(*f.pose, objects);
     // Touching fingers: the farthest one's nearest approach; otherwise the nearest of all.
     if (std::isfinite(d) && (any_touches ? d > nearest : d < nearest)) {
-      nearest = d, at = t, finger_reach = f.reach;
+      nearest = d, at = t, farthest = f.shape;
       first = f.pose->empty() ? 0.0 : f.pose->front().t;
     }
   }
-  constexpr double kLeastReach = 0.5;  // m
-  // The object's reach as given: a shape alone in millimetres lifts the bound with it (a tracker
-  // 2 m off then passes, and the shape check rescales the shape), but a large object in metres
-  // (the notched block 100 times larger, pushed by a 5 cm finger) is no error; the two cannot be
-  // told apart from the streams here.
-  const double bound = std::max(kLeastReach, 2.0 * (reach(traj.object.shape) + finger_reach));
+  const double bound = ReachBound(traj.object.shape, *farthest);
   if (nearest > bound && std::isfinite(nearest)) {
     throw GraphError(Format("trajectory: the finger never comes nearer than %.3g m to the object (at t = %s), beyond the "
                             "%.3g m a push allows (twice the object's and the finger's reach from their pose origins, and at "
@@ -167,26 +171,25 @@ void CheckFingerReachesObject(const push::Trajectory& traj) {
   // A contact stream lies on the object: its median distance from the object's tracked origin
   // (the object sample nearest in time) is within the same bound, or the contact sensor reports
   // in another frame (a stream 2 m off was estimated, its factors' residuals blamed on the probe).
-  auto contacts_far = [&](const std::vector<push::PointSample>& contacts, const std::string& stream, double contact_reach) {
+  auto contacts_far = [&](const std::vector<push::PointSample>& contacts, const std::string& stream,
+                          const geometry::Shape& finger) {
     if (contacts.empty() || objects.empty()) return;
     std::vector<double> distances;
-    for (std::size_t i = 0, j = 0; i < contacts.size(); ++i) {
-      while (j + 1 < objects.size() && std::abs(objects[j + 1].t - contacts[i].t) <= std::abs(objects[j].t - contacts[i].t)) ++j;
-      distances.push_back((contacts[i].point - objects[j].pose.translation()).norm());
-    }
+    for (const push::PointSample& c : contacts)
+      distances.push_back((c.point - NearestInTime(objects, c.t).pose.translation()).norm());
     std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
     const double median = distances[distances.size() / 2];
-    const double contact_bound = std::max(kLeastReach, 2.0 * (reach(traj.object.shape) + contact_reach));
+    const double contact_bound = ReachBound(traj.object.shape, finger);
     if (!(median > contact_bound)) return;
     throw GraphError(Format("trajectory: streams.%s lies %.3g m from the object's tracked origin (the median of its %zu "
                             "samples), beyond the %.3g m a contact on the object allows: is the contact sensor in another "
                             "frame or unit than streams.object_pose?",
                             stream.c_str(), median, contacts.size(), contact_bound));
   };
-  contacts_far(traj.measured.contact_point, "contact_point", reach(traj.finger.shape));
+  contacts_far(traj.measured.contact_point, "contact_point", traj.finger.shape);
   for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k)
     contacts_far(traj.extra_fingers[k].measured.contact_point, "fingers[" + std::to_string(k + 1) + "].contact_point",
-                 reach(traj.extra_fingers[k].finger.shape));
+                 traj.extra_fingers[k].finger.shape);
 }
 
 namespace {
