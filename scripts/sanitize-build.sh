@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The one sanitizer build that `scripts/test.sh --sanitize` and scripts/fuzz.sh share: clang with
-# AddressSanitizer and UndefinedBehaviorSanitizer on every library, test, example and the tool,
-# plus libFuzzer's coverage instrumentation (PUSHGRAPH_BUILD_FUZZERS), at -O1 with line tables
-# (symbolized reports, a build that fits CI), in build-sanitize/ (SANITIZE_BUILD_DIR). Installs
+# AddressSanitizer and UndefinedBehaviorSanitizer on every library, test and the tool (not the
+# examples), plus libFuzzer's coverage instrumentation (PUSHGRAPH_BUILD_FUZZERS; the libraries and
+# harnesses, not the tests' own code), at -O3 with line tables (symbolized reports), in
+# build-sanitize/ (SANITIZE_BUILD_DIR). Installs
 # clang with its libFuzzer and sanitizer runtimes (Debian 12: clang 14) when missing. Builds the
 # targets given, or everything.
 #
@@ -28,7 +29,7 @@ fi
 # (their compile 88 -> 29 s a heavy file, but the sanitizer tests took 48 instead of about 25
 # minutes: the tests' -O0 copies of inline templates stand in for the libraries' at link time).
 CC=clang CXX=clang++ cmake -S . -B "$BUILD" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_FLAGS="-gline-tables-only" \
-  -DPUSHGRAPH_BUILD_FUZZERS=ON -DPUSHGRAPH_BUILD_TESTS=ON -DPUSHGRAPH_BUILD_EXAMPLES=ON -DPUSHGRAPH_BUILD_BENCH=OFF \
+  -DPUSHGRAPH_BUILD_FUZZERS=ON -DPUSHGRAPH_BUILD_TESTS=ON -DPUSHGRAPH_BUILD_EXAMPLES=OFF -DPUSHGRAPH_BUILD_BENCH=OFF \
   -DPUSHGRAPH_BUILD_PYTHON=OFF > /dev/null
 start=$(date +%s)
 if [ $# -gt 0 ]; then
