@@ -41,6 +41,27 @@ void CheckKeys(const json& object, std::initializer_list<const char*> allowed, c
   }
 }
 
+// A mesh given where a shape file is asked for read as "malformed JSON ... last read: 'o'".
+std::string MeshFileHint(const std::string& text) {
+  const std::size_t start = text.find_first_not_of(" \t\r\n");
+  if (start == std::string::npos) return "";
+  auto line_starts_with = [&text](const char* word) {
+    const std::string w(word);
+    for (std::size_t at = 0; at < text.size() && at < 4096; at = text.find('\n', at) + 1) {
+      if (text.compare(at, w.size(), w) == 0) return true;
+      if (text.find('\n', at) == std::string::npos) break;
+    }
+    return false;
+  };
+  if (text.compare(start, 6, "solid ") == 0)
+    return " (this is an STL mesh: a shape file is JSON; convert the mesh to OBJ and make one with "
+           "`pushgraph footprint MESH.obj -o SHAPE.json`)";
+  if (text[start] != '{' && text[start] != '[' && (line_starts_with("v ") || line_starts_with("f ")))
+    return " (this looks like an OBJ mesh: a shape file is JSON; `pushgraph footprint MESH.obj -o SHAPE.json` makes "
+           "one from it)";
+  return "";
+}
+
 }  // namespace
 
 Shape ParseShapeJson(const std::string& text, const std::string& source) {
@@ -48,7 +69,7 @@ Shape ParseShapeJson(const std::string& text, const std::string& source) {
   try {
     doc = json::parse(text);
   } catch (const json::exception& e) {  // syntax errors, and numbers that overflow a double
-    Fail(source, "malformed JSON: " + JsonSyntaxErrorText(e.what()));
+    Fail(source, "malformed JSON: " + JsonSyntaxErrorText(e.what()) + MeshFileHint(text));
   }
   if (const std::string dup = FindDuplicateJsonKey(text); !dup.empty()) Fail(source, dup);
   if (!doc.is_object()) Fail(source, "top level must be an object with \"polygons\"");

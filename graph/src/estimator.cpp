@@ -521,6 +521,7 @@ EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode 
   add(ToleranceNote(config));
   add(time_unit);
   add(internal::StreamOverlapNote(trajectory));
+  add(internal::StreamCoverageNote(trajectory));
   add(yaw_unit);
   add(tracker_step);
   add(length_unit);

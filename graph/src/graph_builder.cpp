@@ -542,9 +542,11 @@ void GraphBuilder::Initialize(int i, double limit) {
     } else if (causal && prev != nullptr && steps_[i - 1].in_contact) {
       v.f[0] = prev->f[0]; v.f[1] = prev->f[1];
     } else {
-      // Towards the object's centre, small: D's gradient in f is well defined for any f.
-      Vec2 d = Vec2(v.x[0], v.x[1]) - Vec2(v.p[0], v.p[1]);
-      d = d.norm() > 0 ? Vec2(0.1 * d.normalized()) : Vec2(0.1, 0.0);
+      // Small, into the object along its inward normal at the contact (D's gradient in f is
+      // defined for any f, but not its sign: towards the object's origin, as it was, pointed
+      // outwards from a contact beside an origin at a corner).
+      const auto q = geometry::QueryPoint(traj_.object.shape, Pose2{v.x[0], v.x[1], v.x[2]}, Vec2(v.p[0], v.p[1]));
+      const Vec2 d = q.normal.allFinite() && q.normal.norm() > 0.5 ? Vec2(-0.1 * q.normal) : Vec2(0.1, 0.0);
       v.f[0] = d.x(); v.f[1] = d.y();
     }
     if (s.two_contacts) {

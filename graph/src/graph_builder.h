@@ -493,6 +493,12 @@ std::optional<std::string> TimeUnitNote(const push::Trajectory& trajectory);
 /// Two of the trajectory's streams whose time spans do not overlap at all (a clock offset, a
 /// stream from another recording), named with their spans.
 std::optional<std::string> StreamOverlapNote(const push::Trajectory& trajectory);
+/// Throws when a finger stream is 100 times as long as the object's and has most of its rows
+/// outside the object's time (another time unit), naming it.
+void CheckStreamTimeUnits(const push::Trajectory& trajectory);
+/// A finger's pose or force stream that has no rows where the object moves more than 10 mm at
+/// the start or end of the push (a sensor that stopped, or started late). Null when there is none.
+std::optional<std::string> StreamCoverageNote(const push::Trajectory& trajectory);
 /// A warning when the measured force does negative work on the object over the samples where it
 /// is above a quarter of its 95th percentile (f . v summed, v the finger's velocity over +-0.1 s):
 /// a quasi-static push takes positive work from the finger, so such a stream has its sign flipped

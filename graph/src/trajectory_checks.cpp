@@ -243,6 +243,23 @@ void CheckSorted(const std::vector<Sample>& s, const std::string& stream, bool r
 using push::kClockJumpPeriods;
 using push::kClockJumpSeconds;
 
+// Calls visit(stream, name) on each finger's pose, contact and force streams, finger 0's first
+// (named "finger_pose", ..., then "fingers[k].finger_pose", ...).
+template <typename Visit>
+void ForEachFingerStream(const push::Trajectory& traj, Visit&& visit) {
+  const auto& m = traj.measured;
+  visit(m.finger_pose, std::string("finger_pose"));
+  visit(m.contact_point, std::string("contact_point"));
+  visit(m.force, std::string("force"));
+  for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k) {
+    const push::FingerStreams& f = traj.extra_fingers[k].measured;
+    const std::string who = "fingers[" + std::to_string(k + 1) + "].";
+    visit(f.finger_pose, who + "finger_pose");
+    visit(f.contact_point, who + "contact_point");
+    visit(f.force, who + "force");
+  }
+}
+
 template <class Sample>
 double MedianPeriod(const std::vector<Sample>& s) {
   std::vector<double> d;
@@ -459,16 +476,7 @@ void ValidateTrajectory(const push::Trajectory& traj) {
       if (!s.empty()) spans.push_back({s.front().t, {s.back().t, name}});
     };
     add(m.object_pose, "object_pose");
-    add(m.finger_pose, "finger_pose");
-    add(m.contact_point, "contact_point");
-    add(m.force, "force");
-    for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k) {
-      const push::FingerStreams& f = traj.extra_fingers[k].measured;
-      const std::string who = "fingers[" + std::to_string(k + 1) + "].";
-      add(f.finger_pose, who + "finger_pose");
-      add(f.contact_point, who + "contact_point");
-      add(f.force, who + "force");
-    }
+    ForEachFingerStream(traj, add);
     std::sort(spans.begin(), spans.end());
     const double bound = std::max(kClockJumpSeconds, kClockJumpPeriods * finest);
     double reach = spans.empty() ? 0.0 : spans.front().second.first;
@@ -485,6 +493,7 @@ void ValidateTrajectory(const push::Trajectory& traj) {
   if (m.object_pose.empty()) {
     throw GraphError("trajectory: no object pose measurements (streams.object_pose is empty): nothing anchors the object");
   }
+  CheckStreamTimeUnits(traj);
   if (m.finger_pose.empty()) {
     throw GraphError("trajectory: no finger pose measurements (streams.finger_pose is empty)");
   }
@@ -566,7 +575,7 @@ std::optional<std::string> ForceDirectionNote(const push::Trajectory& traj) {
   // (a 5 mm tracker at 250 Hz is noisier than a 50 mm/s push sample by sample) averages out of
   // the work sum f . v while |f| |v| keeps it: the ratio is a lower bound of the mean cosine.
   const double h = std::max(0.1, 2.0 * MedianPeriod(finger));
-  double work = 0.0, scale = 0.0;
+  double work = 0.0, scale = 0.0, work_swapped = 0.0;
   std::size_t used = 0, against = 0;
   for (const auto& f : forces) {
     if (!(f.force.norm() >= strong) || !(f.force.norm() > 0.0)) continue;
@@ -574,6 +583,7 @@ std::optional<std::string> ForceDirectionNote(const push::Trajectory& traj) {
     if (!a || !b) continue;
     const geometry::Vec2 v = (*b - *a) / (2.0 * h);
     work += f.force.dot(v);
+    work_swapped += f.force.y() * v.x() + f.force.x() * v.y();
     scale += f.force.norm() * v.norm();
     against += f.force.dot(v) < 0.0;
     ++used;
@@ -584,6 +594,14 @@ std::optional<std::string> ForceDirectionNote(const push::Trajectory& traj) {
   const double mean_cosine = work / scale;
   // Real pushes: 0.20 to 0.93 (the dataset's ellip1 recordings with the paper's noise); a flipped
   // stream about -0.9. Some margin below 0 for slow pushes under heavy finger noise.
+  // Axes swapped: the force is then at an angle to the motion that swapping undoes (a diagonal
+  // push read 0.30 as recorded, 0.95 swapped, and ran with no word, force RMS 1.27 N against 0.07;
+  // a 0.5 s push along x under 5 mm finger noise 0.10 and 0.71).
+  const double swapped_cosine = work_swapped / scale;
+  if (mean_cosine >= -0.2 && swapped_cosine > 0.5 && swapped_cosine > mean_cosine + 0.4)
+    return Format("force: the measured force and the finger's motion are at a mean cosine of %.2f over the %zu samples "
+                  "where it pushes, %.2f with its x and y exchanged: are the force stream's x and y swapped?",
+                  mean_cosine, used, swapped_cosine);
   if (mean_cosine >= -0.2) return std::nullopt;
   return Format("force: the measured force does negative work on the object (the force and the finger's motion are at a "
                 "mean cosine of %.2f over the %zu samples where it pushes, %.0f%% of them pointing against the motion), "
@@ -951,6 +969,84 @@ std::optional<std::string> StreamOverlapNote(const push::Trajectory& traj) {
                     "the estimate never sees them together and may be worse than the measurements",
                     x.name, x.first, x.last, y.name, y.first, y.last);
     }
+  return std::nullopt;
+}
+
+// A stream 100 times as long as the object's, most of its rows outside the object's time: another
+// time unit (a force stream in milliseconds beside poses in seconds lost every force with no word,
+// and the estimate ran over 1100 s of an object tracked for 1.1).
+void CheckStreamTimeUnits(const push::Trajectory& traj) {
+  const auto& object = traj.measured.object_pose;
+  if (object.size() < 2) return;
+  const double t0 = object.front().t, t1 = object.back().t, span = t1 - t0;
+  if (!(span > 0.0)) return;
+  auto check = [&](const auto& s, const std::string& name) {
+    if (s.size() < 2) return;
+    const double first = s.front().t, last = s.back().t;
+    const auto inside = std::count_if(s.begin(), s.end(), [&](const auto& a) { return a.t >= t0 && a.t <= t1; });
+    if (last - first >= 100.0 * span && static_cast<std::size_t>(inside) * 10 < s.size())
+      throw GraphError(Format("trajectory: streams.%s runs from %.6g to %.6g s, %.0f times as long as streams.object_pose "
+                              "(%.6g to %.6g s), and only %zu of its %zu rows fall within the object's time: are its "
+                              "time stamps in another unit (milliseconds?) than the object's?",
+                              name.c_str(), first, last, (last - first) / span, t0, t1,
+                              static_cast<std::size_t>(inside), s.size()));
+  };
+  ForEachFingerStream(traj, check);
+}
+
+std::optional<std::string> StreamCoverageNote(const push::Trajectory& traj) {
+  const auto& object = traj.measured.object_pose;
+  if (object.size() < 3) return std::nullopt;
+  const double t0 = object.front().t, t1 = object.back().t, span = t1 - t0;
+  if (!(span > 0.0)) return std::nullopt;
+  // The object's position over up to five samples from index `from` on (medians: tracker noise).
+  auto position = [&object](std::size_t from) {
+    from = std::min(from, object.size() - 1);
+    std::vector<double> x, y;
+    for (std::size_t i = from; i < std::min(object.size(), from + 5); ++i) x.push_back(object[i].pose.x), y.push_back(object[i].pose.y);
+    std::nth_element(x.begin(), x.begin() + x.size() / 2, x.end());
+    std::nth_element(y.begin(), y.begin() + y.size() / 2, y.end());
+    return Vec2(x[x.size() / 2], y[y.size() / 2]);
+  };
+  auto first_at_or_after = [&object](double t) {
+    return static_cast<std::size_t>(std::lower_bound(object.begin(), object.end(), t,
+                                                     [](const auto& a, double b) { return a.t < b; }) - object.begin());
+  };
+  const std::size_t last5 = object.size() >= 5 ? object.size() - 5 : 0;
+  constexpr double kMoves = 0.01;  // m: ten times a good tracker's noise, a tenth of a push
+  auto check = [&](const auto& s, const std::string& name, const char* without) -> std::optional<std::string> {
+    if (s.size() < 2) return std::nullopt;
+    const double first = s.front().t, last = s.back().t;
+    // A sensor that stopped (or started late) while the object moved: force RMS 0.07 -> 0.23 N
+    // with a force stream cut halfway, and no word.
+    if (last < t1) {
+      const std::size_t from = first_at_or_after(last);
+      const double moved = (position(last5) - position(from)).norm();
+      if (from < last5 && moved > kMoves)
+        return Format("streams.%s ends at t = %.6g s, and the object moves %.0f mm after that (streams.object_pose "
+                      "goes on to %.6g s): %s there",
+                      name.c_str(), last, 1e3 * moved, t1, without);
+    }
+    if (first > t0) {
+      const std::size_t to = first_at_or_after(first);
+      const double moved = (position(to >= 5 ? to - 5 : 0) - position(0)).norm();
+      if (to >= 5 && moved > kMoves)
+        return Format("streams.%s starts at t = %.6g s, and the object moves %.0f mm before that (streams.object_pose "
+                      "from %.6g s): %s there",
+                      name.c_str(), first, 1e3 * moved, t0, without);
+    }
+    return std::nullopt;
+  };
+  const char* no_force = "the forces come from the pushing model alone";
+  const char* no_pose = "the finger's path rests on the contacts and the motion prior";
+  if (auto note = check(traj.measured.finger_pose, "finger_pose", no_pose)) return note;
+  if (auto note = check(traj.measured.force, "force", no_force)) return note;
+  for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k) {
+    const push::FingerStreams& f = traj.extra_fingers[k].measured;
+    const std::string who = "fingers[" + std::to_string(k + 1) + "].";
+    if (auto note = check(f.finger_pose, who + "finger_pose", no_pose)) return note;
+    if (auto note = check(f.force, who + "force", no_force)) return note;
+  }
   return std::nullopt;
 }
 

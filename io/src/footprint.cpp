@@ -11,6 +11,7 @@
 #include <tiny_obj_loader.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -257,10 +258,38 @@ UpAxis ParseUpAxis(const std::string& text) {
   throw IoError("up axis must be x, y or z, got '" + text + "'");
 }
 
+namespace {
+
+// tinyobjloader reads any text and skips what it does not know: an STL file read as "the mesh
+// has no faces", with no word of the format.
+void RefuseOtherMeshFormats(const std::string& path) {
+  std::string extension = std::filesystem::path(path).extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::ifstream in(path, std::ios::binary);
+  std::string head(80, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(std::max<std::streamsize>(in.gcount(), 0)));
+  const std::size_t start = head.find_first_not_of(" \t\r\n");
+  const bool ascii_stl = start != std::string::npos && head.compare(start, 6, "solid ") == 0;
+  const char* format = extension == ".stl" || ascii_stl ? "STL"
+                       : extension == ".ply"           ? "PLY"
+                       : extension == ".off"           ? "OFF"
+                       : extension == ".3mf"           ? "3MF"
+                       : extension == ".dae"           ? "COLLADA"
+                       : extension == ".gltf" || extension == ".glb" ? "glTF"
+                                                                     : nullptr;
+  if (format != nullptr)
+    throw IoError(path + ": " + format + " meshes are not read, only Wavefront OBJ (export it as OBJ, e.g. with "
+                  "MeshLab, Blender or assimp: assimp export " + std::filesystem::path(path).filename().string() + " MESH.obj)");
+}
+
+}  // namespace
+
 geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& options, FootprintReport* report) {
   if (!(options.scale > 0.0) || !std::isfinite(options.scale)) throw IoError(path + ": scale must be finite and > 0");
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw IoError(path + ": is a directory, not a mesh file");
+  RefuseOtherMeshFormats(path);
   tinyobj::ObjReaderConfig config;
   // Faces as the file gives them: tinyobjloader's triangulation of a polygon face depends on the
   // vertex it starts at (a U-shaped 8-gon listed from its fourth vertex had its notch filled).

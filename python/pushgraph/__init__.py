@@ -106,6 +106,13 @@ def evaluate(inputs=(), protocols="all", simulate=0, sim_object=None, sim_finger
                                 _os.fspath(mesh_dir), _config_json(estimator_config))
 
 
+def _sample_time(t):
+    # float() reads '0.5' and True as times; the docs' rule (docs/python.md) is a TypeError.
+    if isinstance(t, (str, bytes, bool)) or type(t).__name__ in ("bool_", "str_", "bytes_"):
+        raise TypeError(f"a sample's time must be a number of seconds, not {type(t).__name__} {t!r}")
+    return float(t)
+
+
 def _finger_index(finger, fingers):
     # bool and numpy.bool_ are not indices (numpy.bool_ passes operator.index).
     have = "finger 0 only" if fingers == 1 else "fingers 0 to %d" % (fingers - 1)
@@ -147,16 +154,16 @@ class OnlineEstimator:
         self._fingers = 1 + len(setup.get("fingers") or ())
 
     def add_object_pose(self, t, pose):
-        return self._core.add_object_pose(float(t), pose)
+        return self._core.add_object_pose(_sample_time(t), pose)
 
     def add_finger_pose(self, t, pose, finger=0):
-        return self._core.add_finger_pose(float(t), pose, _finger_index(finger, self._fingers))
+        return self._core.add_finger_pose(_sample_time(t), pose, _finger_index(finger, self._fingers))
 
     def add_contact_point(self, t, point, finger=0):
-        return self._core.add_contact_point(float(t), point, _finger_index(finger, self._fingers))
+        return self._core.add_contact_point(_sample_time(t), point, _finger_index(finger, self._fingers))
 
     def add_force(self, t, force, finger=0):
-        return self._core.add_force(float(t), force, _finger_index(finger, self._fingers))
+        return self._core.add_force(_sample_time(t), force, _finger_index(finger, self._fingers))
 
     def update_due(self):
         return self._core.update_due()

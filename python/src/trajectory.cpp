@@ -106,6 +106,9 @@ Streams StreamsFrom(const py::handle& object, const std::string& where) {
 
 double Number(const py::dict& d, const char* key, const std::string& where, double fallback) {
   if (!d.contains(key) || d[key].is_none()) return fallback;
+  // pybind11 casts True to 1.0: a mass of True ran as 1 kg.
+  if (py::isinstance<py::bool_>(d[key]) || std::string(py::str(py::type::of(d[key]).attr("__name__"))) == "bool_")
+    throw py::type_error(where + "['" + key + "']: expected a number, not a boolean");
   try {
     return d[key].cast<double>();
   } catch (const py::cast_error&) {

@@ -130,6 +130,10 @@ TEST(ShapeJson, MalformedJson) {
   EXPECT_TRUE(FailsWith(R"({"polygons": [{"outer": [[0,0],[1,0],[0,1],]}]})", {}));  // trailing comma
   EXPECT_TRUE(FailsWith("", {}));
   EXPECT_TRUE(FailsWith("not json", {}));
+  // A mesh where a shape file is asked for says what it is and how to make a shape of it.
+  EXPECT_TRUE(FailsWith("o L\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", {"looks like an OBJ mesh", "pushgraph footprint"}));
+  EXPECT_TRUE(FailsWith("solid L\nfacet normal 0 0 1\n", {"this is an STL mesh", "pushgraph footprint"}));
+  EXPECT_FALSE(FailsWith("not json", {"mesh"}));
 }
 
 TEST(ShapeJson, InvalidGeometryNamesFileAndLocation) {

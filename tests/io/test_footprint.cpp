@@ -260,6 +260,10 @@ TEST_F(Footprint, ClearErrors) {
   };
   expect_error((dir_ / "missing.obj").string(), {}, "cannot read mesh");
   expect_error(Write("empty.obj", "# nothing here\n"), {}, "no faces");
+  // Other mesh formats are named (an STL read as "the mesh has no faces").
+  expect_error(Write("part.stl", "solid part\nendsolid part\n"), {}, "STL meshes are not read, only Wavefront OBJ");
+  expect_error(Write("part_stl.obj", "solid part\nfacet normal 0 0 1\n"), {}, "STL meshes are not read");
+  expect_error(Write("part.PLY", "ply\nformat ascii 1.0\n"), {}, "PLY meshes are not read");
   io::FootprintOptions up_y;
   up_y.up = io::UpAxis::kY;
   expect_error(Write("flat.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), up_y, "zero area");

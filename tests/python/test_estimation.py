@@ -55,6 +55,9 @@ def test_bad_trajectory_dicts_name_the_key(push):
         pg.estimate(bad)
     with pytest.raises(TypeError, match="expected a dict"):
         pg.estimate([1, 2, 3])
+    heavy = dict(push, object=dict(push["object"], mass=True))
+    with pytest.raises(TypeError, match=r"\['mass'\]: expected a number, not a boolean"):
+        pg.estimate(heavy)
     with pytest.raises(pg.GraphError, match="model"):
         pg.estimate(push, model="qs2")
     with pytest.raises(pg.GraphError, match="sigma_typo"):
@@ -272,6 +275,9 @@ def test_two_fingers_online_from_python(tmp_path):
     for bad in (1.0, True, np.bool_(True)):
         with pytest.raises(TypeError, match="finger: expected an integer"):
             online.add_force(samples[-1][0] + 1.0, (0.1, 0.0), finger=bad)
+    for bad in ("100.0", True, np.bool_(True), b"1"):
+        with pytest.raises(TypeError, match="a sample's time must be a number"):
+            online.add_object_pose(bad, (0.0, 0.0, 0.0))
     r = online.finish()
     assert updates > 3
     assert r["finger1_pose"].shape == r["object_pose"].shape and np.isfinite(r["finger1_pose"]).all()
