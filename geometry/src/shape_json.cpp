@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -45,11 +46,13 @@ void CheckKeys(const json& object, std::initializer_list<const char*> allowed, c
 std::string MeshFileHint(const std::string& text) {
   const std::size_t start = text.find_first_not_of(" \t\r\n");
   if (start == std::string::npos) return "";
-  auto line_starts_with = [&text](const char* word) {
-    const std::string w(word);
-    for (std::size_t at = 0; at < text.size() && at < 4096; at = text.find('\n', at) + 1) {
-      if (text.compare(at, w.size(), w) == 0) return true;
-      if (text.find('\n', at) == std::string::npos) break;
+  // Any of the first 4 kB's lines.
+  auto line_starts_with = [&text](const std::string& word) {
+    for (std::size_t at = 0; at < std::min<std::size_t>(text.size(), 4096);) {
+      if (text.compare(at, word.size(), word) == 0) return true;
+      const std::size_t end = text.find('\n', at);
+      if (end == std::string::npos) break;
+      at = end + 1;
     }
     return false;
   };

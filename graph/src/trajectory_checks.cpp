@@ -16,6 +16,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <utility>
 
 namespace pushgraph::graph::internal {
@@ -1014,7 +1015,7 @@ std::optional<std::string> StreamCoverageNote(const push::Trajectory& traj) {
   };
   const std::size_t last5 = object.size() >= 5 ? object.size() - 5 : 0;
   constexpr double kMoves = 0.01;  // m: ten times a good tracker's noise, a tenth of a push
-  auto check = [&](const auto& s, const std::string& name, const char* without) -> std::optional<std::string> {
+  auto coverage_gap = [&](const auto& s, const std::string& name, const char* without) -> std::optional<std::string> {
     if (s.size() < 2) return std::nullopt;
     const double first = s.front().t, last = s.back().t;
     // A sensor that stopped (or started late) while the object moved: force RMS 0.07 -> 0.23 N
@@ -1037,17 +1038,18 @@ std::optional<std::string> StreamCoverageNote(const push::Trajectory& traj) {
     }
     return std::nullopt;
   };
-  const char* no_force = "the forces come from the pushing model alone";
-  const char* no_pose = "the finger's path rests on the contacts and the motion prior";
-  if (auto note = check(traj.measured.finger_pose, "finger_pose", no_pose)) return note;
-  if (auto note = check(traj.measured.force, "force", no_force)) return note;
-  for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k) {
-    const push::FingerStreams& f = traj.extra_fingers[k].measured;
-    const std::string who = "fingers[" + std::to_string(k + 1) + "].";
-    if (auto note = check(f.finger_pose, who + "finger_pose", no_pose)) return note;
-    if (auto note = check(f.force, who + "force", no_force)) return note;
-  }
-  return std::nullopt;
+  std::optional<std::string> note;
+  // Pose and force streams (a contact stream has rows only while touching).
+  auto check = [&](const auto& s, const std::string& name) {
+    using Sample = typename std::decay_t<decltype(s)>::value_type;
+    if constexpr (!std::is_same_v<Sample, push::PointSample>) {
+      if (!note) note = coverage_gap(s, name, std::is_same_v<Sample, push::ForceSample>
+                                                 ? "the forces come from the pushing model alone"
+                                                 : "the finger's path rests on the contacts and the motion prior");
+    }
+  };
+  ForEachFingerStream(traj, check);
+  return note;
 }
 
 double LongObjectGap(const push::Trajectory& trajectory) {

@@ -108,7 +108,7 @@ def evaluate(inputs=(), protocols="all", simulate=0, sim_object=None, sim_finger
 
 def _sample_time(t):
     # float() reads '0.5' and True as times; the docs' rule (docs/python.md) is a TypeError.
-    if isinstance(t, (str, bytes, bool)) or type(t).__name__ in ("bool_", "str_", "bytes_"):
+    if isinstance(t, (str, bytes, bool)) or type(t).__name__ == "bool_":  # numpy.bool_ is no bool
         raise TypeError(f"a sample's time must be a number of seconds, not {type(t).__name__} {t!r}")
     return float(t)
 
