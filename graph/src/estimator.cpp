@@ -389,10 +389,25 @@ push::Trajectory WithoutFinalRest(const push::Trajectory& traj) {
 // With RegistrationResult::size_mismatch: the shape against the finger's path, and what to check.
 std::string SizeMismatchText(const RegistrationResult& r) {
   if (!r.size_mismatch) return "";
-  return internal::Format(": it is %.3g times the size of the finger's path around the object's origin, and no unit tried "
-                          "(metres, centimetres, millimetres, inches, 100 or 1000 times larger) makes it fit: check the "
-                          "shape file's size and units, and that the finger and object pose streams share one frame",
-                          r.size_ratio);
+  std::string text = internal::Format(
+      ": it is %.3g times the size of the finger's path around the object's origin, and no unit tried (metres, "
+      "centimetres, millimetres, inches, 100 or 1000 times larger) makes it fit: check the shape file's size and units, "
+      "and that the finger and object pose streams share one frame",
+      r.size_ratio);
+  // Within a unit's reach, the units may be right and the frame not: an origin on the object's
+  // edge, where the finger pushes, puts the path inside a few times the shape's radius (a turned
+  // U-shaped block whose origin is on its outer edge was "6.61 times the size" and refused).
+  for (double unit : {1.0, 0.01, 0.001, 0.0254, 100.0, 1000.0}) {
+    const double ratio = r.size_ratio * unit;
+    if (ratio > 4.0 && ratio <= 30.0) {
+      text += internal::Format(
+          " (%s, %.3g times: if the object's origin lies on its edge where the finger pushes, the size may be right "
+          "and the shape's frame not; --align-shape on places it)",
+          unit == 1.0 ? "in the file's units" : internal::Format("at scale %g", unit).c_str(), ratio);
+      break;
+    }
+  }
+  return text;
 }
 
 }  // namespace
@@ -653,6 +668,9 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
   // the right turn 462.6 at the cap, 429.2 converged; the finger 4.3 mm larger, 436.7, won).
   // Each placement's graph cost and its transform refined by the graph (the shape frame).
   bool best_stalled = false;     // the winning placement's solve stalled
+  // The shape as given beat the contacts' best placement in the whole graph by more than what the
+  // graph's frame alone buys (kFrameMargin), both solves converged.
+  bool graph_rejects_contacts_best = false;
   std::vector<std::string> stalled_losers;  // turns (deg) of placements that lost on a stalled solve
   std::string best_label;
   // Returns the solve's statistics: its final cost, and whether it stalled or stopped at its limit.
@@ -703,6 +721,8 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
       char text[200];
       std::snprintf(text, sizeof text, "the shape as given: graph cost %.1f against %.1f for the best placement", cost, best_cost);
       alignment.notes.push_back(text);
+      // The whole graph's verdict on the contacts' best placement, where its solve converged.
+      if (!first.stalled) graph_rejects_contacts_best = cost + kFrameMargin < first.final_cost;
       // Ties between placements the data cannot tell apart keep the shape as given: a placement
       // must do better by more than 2 in cost (a log-likelihood).
       if (cost <= best_cost + kTieMargin) {
@@ -1053,7 +1073,34 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
                                       : "; align_shape \"on\" ") +
                        AlignedText(*registration, alignment));
   }
-  if (registration && registration->fits_as_given && registration->better_elsewhere && !alignment.aligned) {
+  // A suspicion the whole graph settled is a note, not a warning: an L-shaped plate's true shape
+  // "fit better turned by 110.3 degrees" by the contacts (+16.5), graph cost 797.4 against 529.3
+  // as given, and every push of it warned so, suggesting --align-shape on (a hostile user's session).
+  // Where the contacts leave several placements open, the same verdict from the whole graph (QS:
+  // the CP and SDF graphs have no mechanics to place the support by): true L-shaped plates
+  // "fit better turned by 108.7 to 152 degrees" on 5 of 6 simulated pushes, each warned.
+  if (registration && registration->fits_as_given && registration->better_elsewhere && registration->ambiguous &&
+      !alignment.aligned && config.align_shape == Align::kAuto && model == Model::kQs && !unit_gate && !too_little) {
+    try {
+      const push::Trajectory judged = WithoutFinalRest(trajectory);
+      ShapeTransform refined;
+      const SolverStats placed = framed_cost(judged, registration->transform, &refined, quick);
+      const double given = EstimateBatch(judged, model, quick).solver.final_cost;
+      alignment.notes.push_back(internal::Format("the contacts' best placement: graph cost %.1f against %.1f as given%s",
+                                                 placed.final_cost, given,
+                                                 placed.stalled ? " (its solve stalled: no comparison)" : ""));
+      graph_rejects_contacts_best = !placed.stalled && given + kFrameMargin < placed.final_cost;
+      identity_wins = identity_wins || graph_rejects_contacts_best;
+    } catch (const std::exception& e) {
+      alignment.notes.push_back(std::string("the contacts' best placement not compared in the graph: ") + e.what());
+    }
+  }
+  if ((suspect || (registration && registration->ambiguous)) && identity_wins && graph_rejects_contacts_best && !unit_gate) {
+    alignment.notes.push_back(internal::Format(
+        "the contacts fit the shape better %s (log-likelihood +%.1f), but the whole graph rejects that placement "
+        "(by more than %.0f in cost): the shape as given is used",
+        registration->Describe().c_str(), registration->identity_cost - registration->aligned_cost, kFrameMargin));
+  } else if (registration && registration->fits_as_given && registration->better_elsewhere && !alignment.aligned) {
     // The gaps are within tolerance, but a different placement explains the contacts clearly
     // better: say so; aligning on this alone misfired on pushes that break the model.
     // Where other placements fit the contacts about as well, "on" would apply the graph's pick

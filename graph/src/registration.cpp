@@ -302,6 +302,22 @@ RegistrationResult RegisterShape(const std::vector<const push::Trajectory*>& rec
     const double ratio = s * file_radius / std::max(path_radius, 1e-6);
     if (ratio >= 0.25 && ratio <= 4.0) plausible.push_back(s);
   }
+  // The path's radius is taken about the tracked origin, which lies near the middle of most
+  // objects but may sit on an edge: a U-shaped block whose origin is on its outer edge, pushed
+  // beside it, had its contacts 10 mm from the origin against a 60 mm radius (6 times), and its
+  // true shape, in metres or millimetres, was refused as "no unit makes it fit". A unit within 30
+  // times is plausible too where the shape in it, as given, lies on the contacts (the window
+  // alone let a finger stream 0.4 m off in another frame reach the notched block made 100 times
+  // larger: Alignment.AFingerStreamInAnotherFrameIsRefused).
+  // The verdict on the shape as given (its gaps alone; the likelihood ratio comes below).
+  const ShapeFitCheck as_given_check = CheckContacts(file_shape, finger, refine, o);
+  for (double s : scales) {
+    const double ratio = s * file_radius / std::max(path_radius, 1e-6);
+    if (ratio <= 4.0 || ratio > 30.0 || std::find(plausible.begin(), plausible.end(), s) != plausible.end()) continue;
+    const bool fits = s == 1.0 ? as_given_check.fits
+                               : CheckContacts(geometry::TransformShape(file_shape, Pose2{}, s), finger, refine, o).fits;
+    if (fits) plausible.push_back(s);
+  }
   if (plausible.empty()) {
     plausible = scales;
     result.size_mismatch = true;
@@ -465,7 +481,7 @@ RegistrationResult RegisterShape(const std::vector<const push::Trajectory*>& rec
   // The verdict rests on the shape as given alone, not on how much better the best fit is:
   // a better fit can come from samples that were never in contact (a finger sliding past the
   // end of a side makes the side look longer).
-  result.check = CheckContacts(file_shape, finger, refine, o);
+  result.check = as_given_check;
   // e.g. a quarter turn of a square; not a shape of no size for the data (one 1000 times too
   // small moves by less than the tolerance under any placement).
   const bool equivalent = result.displacement <= o.min_displacement && !result.size_mismatch;

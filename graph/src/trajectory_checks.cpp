@@ -234,6 +234,17 @@ void CheckSorted(const std::vector<Sample>& s, const std::string& stream, bool r
                               "time stamp written twice?",
                               stream.c_str(), i - 1, i, s[i].t - s[i - 1].t));
     }
+    if constexpr (std::is_same_v<Sample, push::PointSample>) {
+      // As the trajectory reader: the same contact twice at one time is a sample added twice.
+      for (std::size_t j = i; repeats && j-- > 0 && s[j].t == s[i].t;) {
+        if (s[j].point == s[i].point) {
+          throw GraphError(Format("trajectory: streams.%s samples %zu and %zu are the same contact point (%.17g, %.17g) at "
+                                  "t = %.17g: a sample added twice? (Samples at one time are several contacts, each at "
+                                  "its own point)",
+                                  stream.c_str(), j, i, s[i].point.x(), s[i].point.y(), s[i].t));
+        }
+      }
+    }
   }
 }
 
@@ -923,18 +934,21 @@ std::optional<std::string> TimeUnitNote(const push::Trajectory& traj) {
   const double speed =
       duration > 0.0 ? (m.finger_pose.back().pose.translation() - m.finger_pose.front().pose.translation()).norm() / duration
                      : 0.0;
-  const bool micro = finest >= 1e3 * kSlowestPeriod;
-  const double factor = micro ? 1e6 : 1e3;
+  // The unit that brings the fastest stream to 5 Hz or faster: a 250 Hz sensor stamped in
+  // nanoseconds (every 4e6) was asked "are the times in microseconds?", which reads 0.25 Hz.
+  double factor = 1e3;
+  const char* unit = "milliseconds";
+  if (finest / 1e3 > kSlowestPeriod) factor = 1e6, unit = "microseconds";
+  if (finest / 1e6 > kSlowestPeriod) factor = 1e9, unit = "nanoseconds";
   // Only where the other reading is a push: a sensor of at most 20 kHz, a finger of at most 2 m/s
   // (a 4 Hz recording in seconds would read 4000 Hz and 18 m/s in milliseconds).
-  if (factor / finest > 2e4 || speed * factor > 2.0) return std::nullopt;
+  if (finest / factor > kSlowestPeriod || factor / finest > 2e4 || speed * factor > 2.0) return std::nullopt;
   return Format("time stamps: the fastest stream is sampled every %.4g s (%.3g Hz) and the finger travels at %.3g mm/s: "
                 "are the times in %s? Trajectory times are in seconds; read as %s the streams would run at %.4g Hz and "
                 "the finger at %.3g mm/s. The noise model's per-second scales (accelerations, force random walk, D's "
                 "per-10-ms sigma) do not fit a clock this slow, and the estimate may be worse than the measurements: "
                 "divide the times by %g",
-                finest, 1.0 / finest, 1e3 * speed, micro ? "microseconds" : "milliseconds",
-                micro ? "microseconds" : "milliseconds", factor / finest, 1e3 * speed * factor, factor);
+                finest, 1.0 / finest, 1e3 * speed, unit, unit, factor / finest, 1e3 * speed * factor, factor);
 }
 
 std::optional<std::string> StreamOverlapNote(const push::Trajectory& traj) {

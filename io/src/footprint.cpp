@@ -10,13 +10,19 @@
 
 #include <tiny_obj_loader.h>
 
+#include <boost/geometry.hpp>
+#include <boost/geometry/index/rtree.hpp>
+
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <unordered_map>
 
 namespace pushgraph::io {
 namespace {
@@ -260,6 +266,117 @@ UpAxis ParseUpAxis(const std::string& text) {
 
 namespace {
 
+// Seams written with rounded coordinates, or parts modelled separately, leave the two sides of a
+// seam a rounding error apart: a ring of quads closed at angle 2 pi (sin 2 pi = -1.2e-17 against
+// 0), a U of five boxes turned by 37 degrees and written to 9 digits (a box's corner 1e-11 off its
+// neighbour's side). Their exact union keeps such a seam as a slit of that width: the ring lost its
+// hole to a slit open to the outside, and a point query then said 0 deep inside the material; the
+// U fell into 4 parts. So before the union, vertices within kSnapRelative of the footprint's size
+// of a vertex met before are moved onto it (the first of a cluster stays: every kept coordinate is
+// one the file gives), and such a vertex that close to a face's edge, strictly between its ends, is
+// inserted into that edge (a T-junction made conforming). Faces come back as vertex indices, the
+// welded ones replaced by their representatives; *snapped counts the vertices moved, or inserted
+// into an edge they were not exactly on.
+constexpr double kSnapRelative = 1e-7;
+
+template <class Project>
+std::vector<std::vector<int>> SnapSeams(const std::vector<std::vector<int>>& faces, int nv, const Project& project,
+                                        int* snapped) {
+  namespace bg = boost::geometry;
+  namespace bgi = boost::geometry::index;
+  using BPoint = bg::model::point<double, 2, bg::cs::cartesian>;
+  using BBox = bg::model::box<BPoint>;
+  *snapped = 0;
+  std::vector<std::array<double, 2>> uv(nv);
+  std::vector<char> used(nv, 0);
+  double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+  for (const auto& face : faces) {
+    for (int v : face) {
+      if (used[v]) continue;
+      used[v] = 1;
+      uv[v] = project(v);
+      for (int a = 0; a < 2; ++a) lo[a] = std::min(lo[a], uv[v][a]), hi[a] = std::max(hi[a], uv[v][a]);
+    }
+  }
+  const double tol = kSnapRelative * std::max(hi[0] - lo[0], hi[1] - lo[1]);
+  if (!(tol > 0.0) || !std::isfinite(tol)) return faces;
+  // Welding: a hash grid of cell size tol; a vertex goes to the first representative within tol.
+  std::vector<int> rep(nv, -1);
+  std::unordered_map<std::uint64_t, std::vector<int>> grid;
+  auto cell_key = [](std::int64_t i, std::int64_t j) {
+    return static_cast<std::uint64_t>(i) * 0x9E3779B97F4A7C15ull ^ static_cast<std::uint64_t>(j);
+  };
+  std::vector<int> representatives;
+  for (int v = 0; v < nv; ++v) {
+    if (!used[v]) continue;
+    const std::int64_t ci = static_cast<std::int64_t>(std::floor((uv[v][0] - lo[0]) / tol));
+    const std::int64_t cj = static_cast<std::int64_t>(std::floor((uv[v][1] - lo[1]) / tol));
+    int found = -1;
+    double best = INFINITY;
+    for (std::int64_t di = -1; di <= 1; ++di) {
+      for (std::int64_t dj = -1; dj <= 1; ++dj) {
+        const auto it = grid.find(cell_key(ci + di, cj + dj));
+        if (it == grid.end()) continue;
+        for (int r : it->second) {
+          const double d = std::hypot(uv[r][0] - uv[v][0], uv[r][1] - uv[v][1]);
+          if (d <= tol && d < best) best = d, found = r;
+        }
+      }
+    }
+    if (found >= 0) {
+      rep[v] = found;
+      if (best > 0.0) ++*snapped;
+    } else {
+      rep[v] = v;
+      grid[cell_key(ci, cj)].push_back(v);
+      representatives.push_back(v);
+    }
+  }
+  // T-junctions: the representatives (pairwise more than tol apart) near each edge.
+  std::vector<std::pair<BPoint, int>> points;
+  points.reserve(representatives.size());
+  for (int r : representatives) points.emplace_back(BPoint(uv[r][0], uv[r][1]), r);
+  const bgi::rtree<std::pair<BPoint, int>, bgi::rstar<16>> tree(points.begin(), points.end());
+  std::vector<char> inserted(nv, 0);
+  std::vector<std::vector<int>> out;
+  out.reserve(faces.size());
+  std::vector<std::pair<BPoint, int>> near;
+  std::vector<std::pair<double, int>> on_edge;
+  for (const auto& face : faces) {
+    std::vector<int> ring;
+    for (std::size_t k = 0; k < face.size(); ++k) {
+      const int a = rep[face[k]], b = rep[face[(k + 1) % face.size()]];
+      ring.push_back(a);
+      if (a == b) continue;
+      const double ax = uv[a][0], ay = uv[a][1], ex = uv[b][0] - ax, ey = uv[b][1] - ay;
+      const double length2 = ex * ex + ey * ey;
+      near.clear();
+      tree.query(bgi::intersects(BBox(BPoint(std::min(ax, uv[b][0]) - tol, std::min(ay, uv[b][1]) - tol),
+                                      BPoint(std::max(ax, uv[b][0]) + tol, std::max(ay, uv[b][1]) + tol))),
+                 std::back_inserter(near));
+      on_edge.clear();
+      for (const auto& [point, c] : near) {
+        if (c == a || c == b) continue;
+        const double px = uv[c][0] - ax, py = uv[c][1] - ay;
+        const double t = (px * ex + py * ey) / length2;
+        if (!(t > 0.0 && t < 1.0)) continue;
+        if (std::abs(px * ey - py * ex) > tol * std::sqrt(length2)) continue;
+        on_edge.emplace_back(t, c);
+      }
+      std::sort(on_edge.begin(), on_edge.end());
+      for (const auto& [t, c] : on_edge) {
+        ring.push_back(c);
+        // One exactly on the edge changes nothing (a box's corner on an axis-aligned side): not counted.
+        const bool off = CGAL::orientation(Point(ax, ay), Point(uv[b][0], uv[b][1]), Point(uv[c][0], uv[c][1])) !=
+                         CGAL::COLLINEAR;
+        if (off && !inserted[c]) inserted[c] = 1, ++*snapped;
+      }
+    }
+    out.push_back(std::move(ring));
+  }
+  return out;
+}
+
 // tinyobjloader reads any text and skips what it does not know: an STL file read as "the mesh
 // has no faces", with no word of the format.
 void RefuseOtherMeshFormats(const std::string& path) {
@@ -331,7 +448,7 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
                            found.first_unknown + "): is it an OBJ file, and complete?");
   }
   if (coordinates.empty()) coordinates.assign(attrib.vertices.begin(), attrib.vertices.end());
-  auto project = [&](int index) -> Point {
+  auto project = [&](int index) -> std::array<double, 2> {
     const double x = coordinates[3 * index] * options.scale, y = coordinates[3 * index + 1] * options.scale,
                  z = coordinates[3 * index + 2] * options.scale;
     switch (options.up) {
@@ -340,11 +457,7 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
       default: return {x, y};
     }
   };
-  // Each face's projection: a planar simple face seen along a direction not in its plane is a
-  // simple polygon, united as it is (exactly); a projection that is not simple (a face crossing
-  // itself, or a nearly vertical one folded by its vertices' rounding) is united as the fan of
-  // triangles from its first vertex, as a triangulating reader would.
-  std::vector<Polygon2> projected;
+  std::vector<std::vector<int>> faces;  // vertex indices, as the file lists them
   for (const tinyobj::shape_t& s : reader.GetShapes()) {
     if (!options.object.empty() && s.name != options.object) continue;
     const auto& idx = s.mesh.indices;
@@ -353,42 +466,65 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
       const std::size_t n = s.mesh.num_face_vertices[f];
       if (n < 3 || first + n > idx.size()) continue;
       ++rep.faces;
-      std::vector<Point> p;
+      std::vector<int> face;
       for (std::size_t k = 0; k < n; ++k) {
         const int vi = idx[first + k].vertex_index;
         if (vi < 0 || vi >= nv)
           throw IoError(path + ": object '" + s.name + "' face " + std::to_string(f) + " refers to missing vertex " +
                         std::to_string(vi + 1));
-        p.push_back(project(vi));
+        face.push_back(vi);
       }
-      bool used = false;
-      auto add = [&](Polygon2 polygon) {
-        const CGAL::Orientation o = polygon.orientation();
-        if (o == CGAL::COLLINEAR) return;
-        if (o == CGAL::CLOCKWISE) polygon.reverse_orientation();
-        projected.push_back(std::move(polygon));
-        used = true;
-      };
-      if (n == 3) {
-        if (CGAL::orientation(p[0], p[1], p[2]) != CGAL::COLLINEAR) add(Polygon2(p.begin(), p.end()));
-      } else {
-        std::vector<Point> ring;  // consecutive repeats dropped (a polygon's vertices must differ)
-        for (const Point& q : p)
-          if (ring.empty() || q != ring.back()) ring.push_back(q);
-        while (ring.size() > 1 && ring.front() == ring.back()) ring.pop_back();
-        Polygon2 polygon(ring.begin(), ring.end());
-        if (ring.size() >= 3 && polygon.is_simple()) {
-          if (polygon.area() != 0) add(std::move(polygon));
-        } else {
-          for (std::size_t k = 1; k + 1 < n; ++k)
-            if (CGAL::orientation(p[0], p[k], p[k + 1]) != CGAL::COLLINEAR) {
-              const Point tri[3] = {p[0], p[k], p[k + 1]};
-              add(Polygon2(tri, tri + 3));
-            }
-        }
-      }
-      rep.faces_used += used;
+      faces.push_back(std::move(face));
     }
+  }
+  const std::vector<std::vector<int>> snapped = SnapSeams(faces, nv, project, &rep.vertices_snapped);
+  if (rep.vertices_snapped > 0) {
+    rep.warnings.push_back(std::to_string(rep.vertices_snapped) +
+                           " vertex(es) within 1e-7 of the footprint's size of another vertex or of a face's edge were "
+                           "snapped to it (seams written with rounded coordinates or parts modelled separately; "
+                           "united as they are, they leave slits of that width)");
+  }
+  // Each face's projection: a planar simple face seen along a direction not in its plane is a
+  // simple polygon, united as it is (exactly); a projection that is not simple (a face crossing
+  // itself, or a nearly vertical one folded by its vertices' rounding) is united as the fan of
+  // triangles from its first vertex, as a triangulating reader would.
+  std::vector<Polygon2> projected;
+  for (const std::vector<int>& face : snapped) {
+    std::vector<Point> p;
+    for (int vi : face) {
+      const std::array<double, 2> uv = project(vi);
+      p.emplace_back(uv[0], uv[1]);
+    }
+    const std::size_t n = p.size();
+    bool used = false;
+    auto add = [&](Polygon2 polygon) {
+      const CGAL::Orientation o = polygon.orientation();
+      if (o == CGAL::COLLINEAR) return;
+      if (o == CGAL::CLOCKWISE) polygon.reverse_orientation();
+      projected.push_back(std::move(polygon));
+      used = true;
+    };
+    if (n < 3) {
+      // Snapped to a segment or a point: no area.
+    } else if (n == 3) {
+      if (CGAL::orientation(p[0], p[1], p[2]) != CGAL::COLLINEAR) add(Polygon2(p.begin(), p.end()));
+    } else {
+      std::vector<Point> ring;  // consecutive repeats dropped (a polygon's vertices must differ)
+      for (const Point& q : p)
+        if (ring.empty() || q != ring.back()) ring.push_back(q);
+      while (ring.size() > 1 && ring.front() == ring.back()) ring.pop_back();
+      Polygon2 polygon(ring.begin(), ring.end());
+      if (ring.size() >= 3 && polygon.is_simple()) {
+        if (polygon.area() != 0) add(std::move(polygon));
+      } else {
+        for (std::size_t k = 1; k + 1 < n; ++k)
+          if (CGAL::orientation(p[0], p[k], p[k + 1]) != CGAL::COLLINEAR) {
+            const Point tri[3] = {p[0], p[k], p[k + 1]};
+            add(Polygon2(tri, tri + 3));
+          }
+      }
+    }
+    rep.faces_used += used;
   }
   int flat_axis = -1;  // the axis across which every used vertex lies in one plane, if any
   {

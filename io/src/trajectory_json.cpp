@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <type_traits>
 
 namespace pushgraph::io {
 namespace {
@@ -216,6 +217,21 @@ class Reader {
             << rows[order[i]].t << "): less than 1 ns, the same time stamp written twice?";
         }
         Fail(path, o.str());
+      }
+      if constexpr (std::is_same_v<Sample, PointSample>) {
+        // Several contacts at one time are allowed; the same contact twice is a row written twice
+        // (duplicated rows became two contacts at one point, each with its own force).
+        for (std::size_t j = i; repeats && j-- > 0 && rows[order[i]].t - rows[order[j]].t < kSameTime;) {
+          if (rows[order[j]].point == rows[order[i]].point) {
+            std::ostringstream o;
+            o.precision(17);
+            o << "rows [" << row_of[order[j]] << "] and [" << row_of[order[i]] << "]" << whose
+              << " are the same contact point (" << rows[order[i]].point.x() << ", " << rows[order[i]].point.y()
+              << ") at t = " << rows[order[i]].t
+              << ": a row written twice? (Rows at one time are several contacts, each at its own point)";
+            Fail(path, o.str());
+          }
+        }
       }
       sorted.push_back(rows[order[i]]);
     }

@@ -128,7 +128,7 @@ TEST(Estimator, GroundTruthThatSharesNoTimeIsNamed) {
   EXPECT_TRUE(named) << (s.warnings.empty() ? "no warning" : s.warnings[0]);
 }
 
-// Time stamps in milliseconds (a 250 Hz push read as 0.25 Hz) are named at the top of the
+// Time stamps in milliseconds (a 250 Hz push read as 0.25 Hz), microseconds or nanoseconds are named at the top of the
 // warnings, with the rate and speed they would mean; seconds give no such warning.
 TEST(Estimator, TimeStampsInMillisecondsAreNamed) {
   const push::Trajectory seconds = GeneratePush(OffsetPush(3, 0.5));
@@ -139,7 +139,8 @@ TEST(Estimator, TimeStampsInMillisecondsAreNamed) {
   };
   const EstimationResult plain = Estimate(seconds, Model::kCp, Mode::kBatch);
   for (const std::string& w : plain.warnings) EXPECT_EQ(w.find("time stamps:"), std::string::npos) << w;
-  for (double factor : {1e3, 1e6}) {
+  // Nanoseconds too: a 250 Hz push stamped in ns was asked about microseconds (0.25 Hz).
+  for (double factor : {1e3, 1e6, 1e9}) {
     push::Trajectory scaled = seconds;
     auto scale = [factor](push::Streams* s) {
       for (auto& x : s->object_pose) x.t *= factor;
@@ -150,12 +151,14 @@ TEST(Estimator, TimeStampsInMillisecondsAreNamed) {
     scale(&scaled.measured);
     scaled.ground_truth.reset();
     const EstimationResult r = Estimate(scaled, Model::kCp, Mode::kBatch);
-    const std::string unit = factor == 1e3 ? "milliseconds" : "microseconds";
+    const std::string unit = factor == 1e3 ? "milliseconds" : factor == 1e6 ? "microseconds" : "nanoseconds";
     EXPECT_TRUE(has_clock_warning(r, unit)) << unit << ": " << (r.warnings.empty() ? "no warning" : r.warnings[0]);
     ASSERT_FALSE(r.warnings.empty());
     EXPECT_EQ(r.warnings[0].rfind("time stamps:", 0), 0u) << r.warnings[0];
     // The whole message, to its advice (messages were cut at 319 characters).
-    const std::string advice = factor == 1e3 ? "divide the times by 1000" : "divide the times by 1e+06";
+    const std::string advice = factor == 1e3   ? "divide the times by 1000"
+                               : factor == 1e6 ? "divide the times by 1e+06"
+                                               : "divide the times by 1e+09";
     EXPECT_NE(r.warnings[0].find(advice), std::string::npos) << r.warnings[0];
   }
 }
@@ -729,6 +732,13 @@ TEST(Estimator, BadTrajectoriesGetClearErrors) {
   for (auto& f : force_ms.measured.force) f.t *= 1000.0;
   EXPECT_NE(message(force_ms).find("trajectory: streams.force runs from 0 to"), std::string::npos) << message(force_ms);
   EXPECT_NE(message(force_ms).find("in another unit (milliseconds?)"), std::string::npos) << message(force_ms);
+  // The same contact twice at one time (a sample added twice; several contacts at one time are
+  // allowed): it was estimated as two contacts at one point.
+  auto twice = t;
+  ASSERT_GT(twice.measured.contact_point.size(), 10u);
+  twice.measured.contact_point.insert(twice.measured.contact_point.begin() + 10, twice.measured.contact_point[10]);
+  EXPECT_NE(message(twice).find("streams.contact_point samples 10 and 11 are the same contact point"), std::string::npos)
+      << message(twice);
   auto no_shape = t;
   no_shape.finger.shape = geometry::Shape();
   EXPECT_NE(message(no_shape).find("finger.shape"), std::string::npos);

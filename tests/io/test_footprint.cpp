@@ -227,6 +227,61 @@ TEST_F(Footprint, UnionOfOverlappingAndOpenNonManifoldMeshes) {
   EXPECT_DOUBLE_EQ(io::MeshFootprint(frame, mm).core_area(), 8.0e-6);
 }
 
+// Seams a rounding error wide. A ring of quads, each with its own vertices, closed at angle 2 pi
+// (sin 2 pi = -1.2e-17 where the first quad has 0), and a U of five boxes with T-junctions turned
+// by 37 degrees and written to 9 digits: the exact union kept each seam as a slit, the ring's hole
+// open to the outside through it (one polygon, no hole: a point deep in the material was on the
+// boundary) and the U in 4 parts. Vertices within 1e-7 of the size of another or of an edge are
+// snapped now, and the report says how many.
+TEST_F(Footprint, SeamsWrittenWithRoundedCoordinatesLeaveNoSlit) {
+  std::ostringstream ring;
+  ring.precision(9);
+  const int n = 48;
+  for (int i = 0; i < n; ++i) {
+    for (double r : {0.05, 0.02}) {
+      for (int j : {i, i + 1}) {
+        const double a = 2.0 * M_PI * j / n;
+        ring << "v " << r * std::cos(a) << " " << r * std::sin(a) << " 0\n";
+      }
+    }
+    ring << "f " << 4 * i + 1 << " " << 4 * i + 2 << " " << 4 * i + 4 << " " << 4 * i + 3 << "\n";
+  }
+  io::FootprintReport report;
+  const geometry::Shape r = io::MeshFootprint(Write("ring.obj", ring.str()), {}, &report);
+  EXPECT_EQ(r.polygons().size(), 1u);
+  EXPECT_EQ(Holes(r), 1);
+  EXPECT_GT(report.vertices_snapped, 0);
+  EXPECT_NE(report.warnings.size(), 0u);
+  // Deep in the material on the seam, 15 mm from the outer vertex and the inner one (a little
+  // less from the inner 48-gon's sides): inside, not on a slit.
+  const geometry::PointQuery q = geometry::QueryPoint(r, geometry::Vec2(0.035, 0.0));
+  EXPECT_EQ(q.containment, geometry::Containment::kInside);
+  EXPECT_LT(q.signed_distance, -0.0149);
+  EXPECT_EQ(geometry::QueryPoint(r, geometry::Vec2(0.0, 0.0)).containment, geometry::Containment::kOutside);
+
+  const double boxes[5][4] = {{-0.05, 0.0, -0.003, 0.02}, {0.003, 0.0, 0.05, 0.02}, {-0.003, 0.006, 0.003, 0.02},
+                              {-0.05, 0.02, -0.03, 0.06}, {0.03, 0.02, 0.05, 0.06}};
+  for (double degrees : {0.0, 37.0}) {
+    const double c = std::cos(degrees * M_PI / 180.0), s = std::sin(degrees * M_PI / 180.0);
+    std::ostringstream u;
+    u.precision(9);
+    int v = 0;
+    for (const auto& b : boxes) {
+      const double corners[4][2] = {{b[0], b[1]}, {b[2], b[1]}, {b[2], b[3]}, {b[0], b[3]}};
+      for (const auto& p : corners) u << "v " << c * p[0] - s * p[1] << " " << s * p[0] + c * p[1] << " 0\n";
+      u << "f " << v + 1 << " " << v + 2 << " " << v + 3 << " " << v + 4 << "\n";
+      v += 4;
+    }
+    io::FootprintReport u_report;
+    const geometry::Shape shape = io::MeshFootprint(Write("u.obj", u.str()), {}, &u_report);
+    EXPECT_EQ(shape.polygons().size(), 1u) << degrees << " degrees";
+    EXPECT_EQ(Holes(shape), 0) << degrees << " degrees";
+    EXPECT_NEAR(shape.core_area(), 0.003564, 1e-11) << degrees << " degrees";
+    // Axis-aligned, every T-junction lies exactly on its edge: nothing to snap or say.
+    if (degrees == 0.0) EXPECT_EQ(u_report.vertices_snapped, 0);
+  }
+}
+
 // A non-convex polygon face (a U, 8 vertices) gives its own area from whichever vertex it is
 // listed from, in either orientation: the OBJ reader's triangulation filled the notch when the
 // face started at the notch's corner (area 0.01 instead of 0.0072, no warning).

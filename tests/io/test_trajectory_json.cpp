@@ -257,6 +257,12 @@ TEST(TrajectoryJson, SeveralFingersBadInputNamesRowAndFinger) {
   // A single finger's contact_point may repeat a time (a finger wedged in a notch); other
   // streams may not.
   EXPECT_EQ(ParseTrajectoryJson(Doc(R"({"contact_point": [[0.1, 0, 0], [0.1, 1, 0]]})")).measured.contact_point.size(), 2u);
+  // The same contact twice is a row written twice, not two contacts (a file with every contact row
+  // duplicated was estimated with two contacts at each point); among other contacts at that time too.
+  ExpectError(Doc(R"({"contact_point": [[0.1, 0.02, 0.001], [0.1, 0.02, 0.001]]})"),
+              "streams.contact_point: rows [0] and [1] are the same contact point (0.02, 0.001) at t = 0.1");
+  ExpectError(Doc(R"({"contact_point": [[0.1, 0.02, 0.001], [0.1, 0.03, 0.0], [0.1, 0.02, 0.001]]})"),
+              "rows [0] and [2] are the same contact point");
 }
 
 }  // namespace

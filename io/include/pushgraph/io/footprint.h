@@ -35,6 +35,10 @@ struct FootprintReport {
   int faces = 0;                     ///< faces read (a polygon face counts once)
   int faces_used = 0;                ///< with non-zero projected area
   int vertices_removed = 0;          ///< collinear or duplicate vertices dropped from the outline
+  /// Vertices within 1e-7 of the footprint's size of another vertex, moved onto it, or of a face's
+  /// edge, inserted into it (seams with rounded coordinates, T-junctions): without it the exact
+  /// union keeps such a seam as a slit of that width.
+  int vertices_snapped = 0;
   /// What the footprint may not be what was meant: several objects united (tri3.obj holds two
   /// blocks), or a prism along another axis than `up` (its side view, e.g. tip.obj without
   /// --up y: every vertex on the two end planes of another axis).
