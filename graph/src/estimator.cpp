@@ -502,11 +502,22 @@ EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode 
   const std::optional<std::string> tracker_step = internal::TrackerStepNote(trajectory);
   // Nor a yaw in degrees: the correct shape was "aligned" by a turn of -99.9 degrees to fit it.
   const std::optional<std::string> yaw_unit = internal::YawUnitNote(trajectory);
-  const char* unit_doubt = time_unit      ? "time stamps that read as milliseconds"
-                           : length_unit  ? "lengths that read as centimetres or millimetres"
-                           : yaw_unit     ? "yaws that read as degrees"
-                           : tracker_step ? "a step of the object's tracker"
-                                          : nullptr;
+  // Nor a force stream whose direction or offset is off: a force with x and y swapped, or read
+  // 1 N high throughout, had the true shape "aligned" by 45 or 36 mm to explain it (a hostile
+  // user's session: 3.04 mm against 2.71 mm raw).
+  const std::optional<std::string> force_direction = internal::ForceDirectionNote(input);
+  const std::optional<std::string> force_bias = internal::ForceBiasNote(input);
+  std::string time_doubt = "time stamps that read as milliseconds";
+  for (const char* unit : {"microseconds", "nanoseconds"})
+    if (time_unit && time_unit->find(std::string("are the times in ") + unit) != std::string::npos)
+      time_doubt = std::string("time stamps that read as ") + unit;
+  const char* unit_doubt = time_unit         ? time_doubt.c_str()
+                           : length_unit     ? "lengths that read as centimetres or millimetres"
+                           : yaw_unit        ? "yaws that read as degrees"
+                           : tracker_step    ? "a step of the object's tracker"
+                           : force_direction ? "a force whose direction does not fit the finger's motion"
+                           : force_bias      ? "a force sensor that reads a force out of contact"
+                                             : nullptr;
   EstimationResult r = EstimateValidated(input, model, mode, config, unit_doubt);
   // A covariance failure was only in RESULT.json's solver.covariance (NEES NaN, nothing said).
   if (config.covariance && r.solver.covariance_status.find("failed") != std::string::npos)
@@ -542,7 +553,8 @@ EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode 
   add(length_unit);
   if (!note.empty()) front.push_back(note);
   if (!glitch_note.empty()) front.push_back(glitch_note);
-  add(internal::ForceDirectionNote(input));
+  add(force_direction);
+  add(force_bias);
   add(internal::ForceScaleNote(input, config.measurement.force));
   add(internal::MeasurementSigmaNote(input, config.measurement));
   r.warnings.insert(r.warnings.begin(), front.begin(), front.end());
@@ -1036,7 +1048,7 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
       }
       warnings.push_back(what + "; " + AlignedText(*registration, alignment) + also);
     } else if (misfit && unit_gate) {
-      warnings.push_back(what + "; not aligned on " + unit_doubt + " (the first warning): fix that, then estimate "
+      warnings.push_back(what + "; not aligned on " + unit_doubt + " (warned above): fix that, then estimate "
                                 "again (estimates may be worse than the raw measurements)");
     } else if (misfit && too_little) {
       warnings.push_back(what + internal::Format("; too little contact to place it by (%.2f s): not aligned, check the shape "
@@ -1107,7 +1119,7 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
     // among them, no proof (the true notched block, pushed and left resting, was aligned by
     // -117.6 degrees so): the warning says the recording does not settle it instead.
     const std::string advice =
-        unit_gate ? std::string("; not aligned on ") + unit_doubt + " (the first warning)"
+        unit_gate ? std::string("; not aligned on ") + unit_doubt + " (warned above)"
         : registration->ambiguous
             ? "; " + registration->ambiguity + ": this recording does not settle the placement, check the shape file's frame "
                                                "(pushes on several sides, registered together by pushgraph evaluate, fix more)"

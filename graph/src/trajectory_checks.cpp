@@ -622,6 +622,39 @@ std::optional<std::string> ForceDirectionNote(const push::Trajectory& traj) {
                 mean_cosine, used, 100.0 * static_cast<double>(against) / static_cast<double>(used));
 }
 
+std::optional<std::string> ForceBiasNote(const push::Trajectory& traj) {
+  const auto& forces = traj.measured.force;
+  const auto& contacts = traj.measured.contact_point;
+  if (forces.size() < 20 || contacts.size() < 10 || !traj.extra_fingers.empty()) return std::nullopt;
+  // Out of contact by the contact stream, with a margin for the sensors' own timing.
+  constexpr double kMargin = 0.05;  // s
+  const double first = contacts.front().t - kMargin, last = contacts.back().t + kMargin;
+  geometry::Vec2 sum = geometry::Vec2::Zero();
+  std::vector<geometry::Vec2> free;
+  std::vector<double> touching;
+  for (const auto& f : forces) {
+    if (f.t < first || f.t > last) {
+      free.push_back(f.force);
+      sum += f.force;
+    } else {
+      touching.push_back(f.force.norm());
+    }
+  }
+  if (free.size() < 10 || touching.empty()) return std::nullopt;
+  const double n = static_cast<double>(free.size());
+  const geometry::Vec2 mean = sum / n;
+  double spread = 0.0;
+  for (const geometry::Vec2& f : free) spread += (f - mean).squaredNorm();
+  // The mean's standard error (both axes), from the samples' own scatter.
+  const double standard_error = std::sqrt(spread / (n - 1.0) / n);
+  if (!(mean.norm() > 4.0 * standard_error) || !(mean.norm() > 0.05)) return std::nullopt;
+  std::nth_element(touching.begin(), touching.begin() + touching.size() / 2, touching.end());
+  return Format("force: the sensor reads a mean (%.3g, %.3g) N (%.1f standard errors) over the %zu samples before and after "
+                "the contact stream, where the finger does not touch (median %.3g N in contact): a bias? Tare the sensor, "
+                "or subtract it from the stream (a bias of a fifth of the push's force moved a true shape by 17 mm)",
+                mean.x(), mean.y(), mean.norm() / std::max(standard_error, 1e-300), free.size(), touching[touching.size() / 2]);
+}
+
 std::optional<std::string> ForceScaleNote(const push::Trajectory& traj, double force_sigma) {
   const auto& forces = traj.measured.force;
   const auto& object = traj.measured.object_pose;

@@ -624,6 +624,24 @@ std::optional<std::string> ShapeUnitsWarning(const geometry::Shape& shape, doubl
   const double across = std::max(box.max.x() - box.min.x(), box.max.y() - box.min.y());
   if (!(across > 2.0 || across < 1e-3)) return std::nullopt;
   char text[200];
+  // Several parts whose largest is within 1 cm to 1 m across but that together span over 10
+  // times it: a stray part far away, not other units (a block with a sliver 5 m off was asked
+  // "centimetres or inches?").
+  if (shape.polygons().size() > 1) {
+    double largest = 0.0;
+    for (const geometry::Polygon& p : shape.polygons()) {
+      Eigen::Vector2d lo = p.outer.front(), hi = p.outer.front();
+      for (const geometry::Vec2& v : p.outer) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+      largest = std::max(largest, (hi - lo).maxCoeff() + 2.0 * shape.radius());
+    }
+    if (largest >= 0.01 && largest <= 1.0 && across > 10.0 * largest) {
+      std::snprintf(text, sizeof text,
+                    "the shape's %zu parts span %.6g m, but the largest is %.3g m across: a stray part far from the others "
+                    "(a footprint unites every face of the file)?",
+                    shape.polygons().size(), across, largest);
+      return std::string(text);
+    }
+  }
   // The units that would make it 1 cm to 1 m across (a centimetre mesh was told "millimetres").
   std::string units;
   if (across > 2.0) {

@@ -292,6 +292,30 @@ TEST(Alignment, ASuspicionTheWholeGraphRejectsIsANoteNotAWarning) {
   EXPECT_GT(noted, 0);
 }
 
+// A force stream read 1 N high throughout (an untared sensor) or with its x and y exchanged: the
+// mechanics then "placed" the true notched block elsewhere, by 36 mm along the pushed side (the
+// frame check) or 45 mm, and offered to save the moved shape (a hostile user's session). The bias
+// is named from the samples before and after the contact stream, and neither is aligned on.
+TEST(Alignment, AForceStreamBiasedOrSwappedIsNamedAndNotAlignedOn) {
+  const push::Trajectory clean = DefaultPushOf(geometry::LoadShapeJson(kData + "notched_block.json"), 1);
+  EstimatorConfig cfg = ApplyMeasurementSigmas({}, *clean.measurement_sigmas);
+  cfg.covariance = false;
+  for (const char* fault : {"bias", "swapped"}) {
+    push::Trajectory t = clean;
+    for (auto& f : t.measured.force) {
+      if (std::string(fault) == "bias") f.force.x() += 1.0;
+      else std::swap(f.force.x(), f.force.y());
+    }
+    const EstimationResult r = Estimate(t, Model::kQs, Mode::kBatch, cfg);
+    ASSERT_TRUE(r.shape_alignment) << fault;
+    EXPECT_FALSE(r.shape_alignment->aligned) << fault << ": " << (r.warnings.empty() ? "" : r.warnings[0]);
+    EXPECT_TRUE(HasWarning(r, std::string(fault) == "bias" ? "force: the sensor reads a mean (1.0" : "x and y swapped")) << fault;
+    EXPECT_FALSE(HasWarning(r, "places it elsewhere")) << fault;
+  }
+  // The clean stream: no bias named.
+  EXPECT_FALSE(HasWarning(Estimate(clean, Model::kQs, Mode::kBatch, cfg), "force: the sensor reads"));
+}
+
 // align_scale on a true shape: the continuous scale comes back near 1 (0.9987), not at it, and
 // that alone once made the shape "not fit as given" and aligned it by a turn of 180 degrees.
 TEST(Alignment, AlignScaleKeepsATrueShape) {

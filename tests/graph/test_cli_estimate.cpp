@@ -432,6 +432,22 @@ TEST_F(EstimateCli, MeshFilesAreReadDirectly) {
     }
   }
   EXPECT_LT(largest, 2e-5);
+  // What reading a mesh warns of is in RESULT.json too (it was on stderr alone): rect1.obj with a
+  // second object holding one of its own faces (the same footprint, two objects united).
+  {
+    std::ifstream in(Mit() + "obj/rect1.obj");
+    std::ofstream out(dir() + "/two_objects.obj");
+    out << in.rdbuf() << "o second\nf 1 2 3\n";
+  }
+  ASSERT_EQ(Tool("estimate '" + h5 + "' --object " + dir() + "/two_objects.obj --finger " + dir() + "/tip.json" + mass +
+                 "-o " + dir() + "/two.json")
+                .status,
+            0);
+  const nlohmann::json two = Load(dir() + "/two.json");
+  bool said = false;
+  for (const auto& w : two["warnings"])
+    said = said || w.get<std::string>().find("two_objects.obj: the file holds 2 objects or groups") != std::string::npos;
+  EXPECT_TRUE(said) << two["warnings"].dump();
   std::ofstream(dir() + "/probe.stl") << "solid probe\nendsolid probe\n";
   const pushgraph::testing::ToolRun stl =
       Tool("estimate '" + h5 + "' --object " + dir() + "/probe.stl --finger " + dir() + "/tip.json" + mass + "-o " + dir() + "/x.json");

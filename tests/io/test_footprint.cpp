@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 namespace {
@@ -280,6 +281,23 @@ TEST_F(Footprint, SeamsWrittenWithRoundedCoordinatesLeaveNoSlit) {
     // Axis-aligned, every T-junction lies exactly on its edge: nothing to snap or say.
     if (degrees == 0.0) EXPECT_EQ(u_report.vertices_snapped, 0);
   }
+}
+
+// A shape of several parts, one far from the others (a sliver 5 m off a 9 cm block): named as a
+// stray part; it was asked "is the file in centimetres or inches?". One part 5 m across is still
+// a units question.
+TEST_F(Footprint, AStrayPartFarAwayIsNamedAsSuch) {
+  const geometry::Shape block = geometry::Shape::Box(0.09, 0.09);
+  const geometry::Shape stray = geometry::Shape::FromPolygons(
+      {{{{-0.045, -0.045}, {0.045, -0.045}, {0.045, 0.045}, {-0.045, 0.045}}, {}},
+       {{{5.0, 0.0}, {5.001, 0.0}, {5.001, 0.001}, {5.0, 0.001}}, {}}});
+  EXPECT_FALSE(io::ShapeUnitsWarning(block).has_value());
+  const std::optional<std::string> w = io::ShapeUnitsWarning(stray);
+  ASSERT_TRUE(w.has_value());
+  EXPECT_NE(w->find("the shape's 2 parts span 5.046 m, but the largest is 0.09 m across: a stray part"), std::string::npos) << *w;
+  const std::optional<std::string> big = io::ShapeUnitsWarning(geometry::Shape::Box(5.0, 5.0));
+  ASSERT_TRUE(big.has_value());
+  EXPECT_NE(big->find("is the file in"), std::string::npos) << *big;
 }
 
 // A non-convex polygon face (a U, 8 vertices) gives its own area from whichever vertex it is

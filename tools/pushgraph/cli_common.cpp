@@ -208,7 +208,7 @@ std::optional<geometry::Shape> TessellatedDisk(const geometry::Shape& shape) {
 // or y only (a probe's cylinder lying along y, as the MIT tip.obj) is meant by its cross-section:
 // seen along z it would be its side view (footprint reports the prism axes after its union, so
 // such a file is read twice).
-geometry::Shape LoadMeshArgument(const std::string& path, const std::string& what) {
+geometry::Shape LoadMeshArgument(const std::string& path, const std::string& what, std::vector<std::string>* warnings) {
   io::FootprintOptions options;
   io::FootprintReport report;
   geometry::Shape shape = io::MeshFootprint(path, options, &report);
@@ -238,6 +238,7 @@ geometry::Shape LoadMeshArgument(const std::string& path, const std::string& wha
         w.replace(at, flag.size(), "pushgraph footprint " + path + " " + flag + " -o SHAPE.json");
     }
     std::fprintf(stderr, "pushgraph: warning: %s %s: %s\n", what.c_str(), path.c_str(), w.c_str());
+    if (warnings) warnings->push_back(what + " " + path + ": " + w);
   }
   if (finger) {
     if (const std::optional<geometry::Shape> disk = TessellatedDisk(shape)) {
@@ -262,11 +263,11 @@ void WarnShapeUnits(const geometry::Shape& shape, const std::string& what, const
     std::fprintf(stderr, "pushgraph: warning: %s %s: %s\n", what.c_str(), path.c_str(), units->c_str());
 }
 
-geometry::Shape LoadShapeArgument(const std::string& path, const std::string& what) {
+geometry::Shape LoadShapeArgument(const std::string& path, const std::string& what, std::vector<std::string>* warnings) {
   std::string extension = std::filesystem::path(path).extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return std::tolower(c); });
   try {
-    if (extension == ".obj") return LoadMeshArgument(path, what);
+    if (extension == ".obj") return LoadMeshArgument(path, what, warnings);
     return geometry::LoadShapeJson(path);
   } catch (const std::exception& e) {
     std::string hint;

@@ -54,7 +54,8 @@ void AddAlignShapeOption(CLI::App* sub, std::string* value);
 graph::EstimatorConfig::AlignShape ParseAlignShape(const std::string& value);
 /// A shape file named by a flag or argument (`what`, e.g. "--object"): geometry::LoadShapeJson,
 /// its errors prefixed with the flag.
-geometry::Shape LoadShapeArgument(const std::string& path, const std::string& what);
+geometry::Shape LoadShapeArgument(const std::string& path, const std::string& what,
+                                  std::vector<std::string>* warnings = nullptr);
 /// Says on stderr when a shape is outside 1 mm to 2 m across (io::ShapeUnitsWarning), for the
 /// commands that take a shape's size as given (limit-surface, simulate); estimate's shape check
 /// finds the units itself.

@@ -34,10 +34,12 @@ struct EstimateOptions {
   bool trim = true;         // an MIT recording: its contact phase only
 };
 
-push::Trajectory LoadInput(const EstimateOptions& o, std::string* source) {
+// `mesh_warnings`: what reading the --object and --finger meshes warned of (a side view, several
+// objects united), for RESULT.json too: on stderr alone, a reader of the result never saw them.
+push::Trajectory LoadInput(const EstimateOptions& o, std::string* source, std::vector<std::string>* mesh_warnings) {
   evaluation::InputOverrides given;
-  if (!o.object.empty()) given.object_shape = LoadShapeArgument(o.object, "--object");
-  if (!o.finger.empty()) given.finger_shape = LoadShapeArgument(o.finger, "--finger");
+  if (!o.object.empty()) given.object_shape = LoadShapeArgument(o.object, "--object", mesh_warnings);
+  if (!o.finger.empty()) given.finger_shape = LoadShapeArgument(o.finger, "--finger", mesh_warnings);
   if (o.mass > 0.0) given.mass = o.mass;
   if (o.mu >= 0.0) given.mu_surface = o.mu;
   given.trim_to_contact = o.trim;
@@ -59,7 +61,8 @@ void RunEstimate(const EstimateOptions& o) {
   // A bad configuration file is reported before any input is read.
   if (!o.config.empty()) graph::LoadEstimatorConfig(o.config);
   std::string source;
-  push::Trajectory traj = LoadInput(o, &source);
+  std::vector<std::string> mesh_warnings;
+  push::Trajectory traj = LoadInput(o, &source, &mesh_warnings);
   if (!o.add_noise.empty()) {
     // The paper's Sec. IV noise on the clean streams (the recording, or the file's ground truth);
     // the clean streams stay as ground truth, so metrics are computed.
@@ -100,6 +103,7 @@ void RunEstimate(const EstimateOptions& o) {
     }
   }
   for (const std::string& w : result.warnings) std::cerr << "estimate: warning: " << w << "\n";
+  result.warnings.insert(result.warnings.begin(), mesh_warnings.begin(), mesh_warnings.end());
   evaluation::SaveResultJson(result, o.output);
   if (!o.svg.empty()) {
     evaluation::TrajectoryPlotOptions plot;
