@@ -589,6 +589,9 @@ EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode 
 
 namespace {
 
+// A solve whose final cost ranks it: neither stalled at a residual that jumps nor stopped at its limit.
+bool Converged(const SolverStats& s) { return !s.stalled && !s.at_iteration_limit; }
+
 EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model model, Mode mode,
                                    const EstimatorConfig& config, const char* unit_doubt) {
   using Align = EstimatorConfig::AlignShape;
@@ -611,6 +614,8 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
     alignment.notes.push_back(std::string("shape not checked: ") + e.what());
     if (config.align_shape == Align::kOn) throw GraphError(std::string("align_shape \"on\": ") + e.what());
   }
+  // The contacts' best placement as the registration found it (the graph may refine it below).
+  const std::string contacts_best = registration ? registration->Describe() : std::string();
   // A misfit has several explanations: the registration's best placement, its alternatives
   // (other rotations the contacts of one push leave open), or a wrong finger size (the shape as
   // given with the finger size_offset larger). Contacts alone cannot always tell them apart;
@@ -729,12 +734,13 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
     // frame, a shape 20 mm off along a two-finger push tied with the best placement, the frame
     // absorbing the offset, and the estimate as given was then 7 times worse than the raw data).
     {
-      const double cost = EstimateBatch(judged, model, quick).solver.final_cost;
+      const SolverStats given = EstimateBatch(judged, model, quick).solver;
+      const double cost = given.final_cost;
       char text[200];
       std::snprintf(text, sizeof text, "the shape as given: graph cost %.1f against %.1f for the best placement", cost, best_cost);
       alignment.notes.push_back(text);
-      // The whole graph's verdict on the contacts' best placement, where its solve converged.
-      if (!first.stalled) graph_rejects_contacts_best = cost + kFrameMargin < first.final_cost;
+      // The whole graph's verdict on the contacts' best placement, where both solves converged.
+      graph_rejects_contacts_best = Converged(first) && Converged(given) && cost + kFrameMargin < first.final_cost;
       // Ties between placements the data cannot tell apart keep the shape as given: a placement
       // must do better by more than 2 in cost (a log-likelihood).
       if (cost <= best_cost + kTieMargin) {
@@ -1091,27 +1097,30 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
   // Where the contacts leave several placements open, the same verdict from the whole graph (QS:
   // the CP and SDF graphs have no mechanics to place the support by): true L-shaped plates
   // "fit better turned by 108.7 to 152 degrees" on 5 of 6 simulated pushes, each warned.
-  if (registration && registration->fits_as_given && registration->better_elsewhere && registration->ambiguous &&
-      !alignment.aligned && config.align_shape == Align::kAuto && model == Model::kQs && !unit_gate && !too_little) {
+  // Only a suspicion (the shape as given within the tolerance; a misfit is warned as one), and
+  // only where the placement comparisons above did not run.
+  const bool ambiguous_suspicion = registration && !misfit && registration->better_elsewhere && registration->ambiguous &&
+                                   !alignment.aligned && config.align_shape == Align::kAuto && !unit_gate && !too_little;
+  if (ambiguous_suspicion && model == Model::kQs) {
     try {
       const push::Trajectory judged = WithoutFinalRest(trajectory);
       ShapeTransform refined;
       const SolverStats placed = framed_cost(judged, registration->transform, &refined, quick);
-      const double given = EstimateBatch(judged, model, quick).solver.final_cost;
+      const SolverStats given = EstimateBatch(judged, model, quick).solver;
+      const bool compared = Converged(placed) && Converged(given);
       alignment.notes.push_back(internal::Format("the contacts' best placement: graph cost %.1f against %.1f as given%s",
-                                                 placed.final_cost, given,
-                                                 placed.stalled ? " (its solve stalled: no comparison)" : ""));
-      graph_rejects_contacts_best = !placed.stalled && given + kFrameMargin < placed.final_cost;
-      identity_wins = identity_wins || graph_rejects_contacts_best;
+                                                 placed.final_cost, given.final_cost,
+                                                 compared ? "" : " (a solve stalled or stopped at its limit: no comparison)"));
+      graph_rejects_contacts_best = compared && given.final_cost + kFrameMargin < placed.final_cost;
     } catch (const std::exception& e) {
       alignment.notes.push_back(std::string("the contacts' best placement not compared in the graph: ") + e.what());
     }
   }
-  if ((suspect || (registration && registration->ambiguous)) && identity_wins && graph_rejects_contacts_best && !unit_gate) {
+  if (((suspect && identity_wins) || ambiguous_suspicion) && graph_rejects_contacts_best && !alignment.aligned && !unit_gate) {
     alignment.notes.push_back(internal::Format(
         "the contacts fit the shape better %s (log-likelihood +%.1f), but the whole graph rejects that placement "
         "(by more than %.0f in cost): the shape as given is used",
-        registration->Describe().c_str(), registration->identity_cost - registration->aligned_cost, kFrameMargin));
+        contacts_best.c_str(), registration->identity_cost - registration->aligned_cost, kFrameMargin));
   } else if (registration && registration->fits_as_given && registration->better_elsewhere && !alignment.aligned) {
     // The gaps are within tolerance, but a different placement explains the contacts clearly
     // better: say so; aligning on this alone misfired on pushes that break the model.

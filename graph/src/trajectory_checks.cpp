@@ -649,10 +649,14 @@ std::optional<std::string> ForceBiasNote(const push::Trajectory& traj) {
   const double standard_error = std::sqrt(spread / (n - 1.0) / n);
   if (!(mean.norm() > 4.0 * standard_error) || !(mean.norm() > 0.05)) return std::nullopt;
   std::nth_element(touching.begin(), touching.begin() + touching.size() / 2, touching.end());
-  return Format("force: the sensor reads a mean (%.3g, %.3g) N (%.1f standard errors) over the %zu samples before and after "
-                "the contact stream, where the finger does not touch (median %.3g N in contact): a bias? Tare the sensor, "
-                "or subtract it from the stream (a bias of a fifth of the push's force moved a true shape by 17 mm)",
-                mean.x(), mean.y(), mean.norm() / std::max(standard_error, 1e-300), free.size(), touching[touching.size() / 2]);
+  // A stream that does not scatter there (a sensor stuck at a value, or quantized) has no standard error to count in.
+  const std::string how_clear =
+      standard_error > 0.0 ? Format("%.3g standard errors", mean.norm() / standard_error) : std::string("without scatter");
+  return Format("force: the sensor reads a mean (%.3g, %.3g) N (%s) over the %zu samples before and after the contact "
+                "stream, where the finger does not touch (median %.3g N in contact): a bias, or a sensor stuck at a value? "
+                "Tare the sensor, or subtract the bias from the stream (a bias of a fifth of the push's force moved a true "
+                "shape by 17 mm)",
+                mean.x(), mean.y(), how_clear.c_str(), free.size(), touching[touching.size() / 2]);
 }
 
 std::optional<std::string> ForceScaleNote(const push::Trajectory& traj, double force_sigma) {

@@ -300,6 +300,8 @@ std::vector<std::vector<int>> SnapSeams(const std::vector<std::vector<int>>& fac
   }
   const double tol = kSnapRelative * std::max(hi[0] - lo[0], hi[1] - lo[1]);
   if (!(tol > 0.0) || !std::isfinite(tol)) return faces;
+  for (int v = 0; v < nv; ++v)
+    if (used[v] && !(std::isfinite(uv[v][0]) && std::isfinite(uv[v][1]))) return faces;  // nothing to snap by
   // Welding: a hash grid of cell size tol; a vertex goes to the first representative within tol.
   std::vector<int> rep(nv, -1);
   std::unordered_map<std::uint64_t, std::vector<int>> grid;
@@ -487,15 +489,31 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
   // Each face's projection: a planar simple face seen along a direction not in its plane is a
   // simple polygon, united as it is (exactly); a projection that is not simple (a face crossing
   // itself, or a nearly vertical one folded by its vertices' rounding) is united as the fan of
-  // triangles from its first vertex, as a triangulating reader would.
-  std::vector<Polygon2> projected;
-  for (const std::vector<int>& face : snapped) {
+  // triangles from its first vertex, as a triangulating reader would. A face that snapping made
+  // not simple (two of its own vertices welded, a slit narrower than the tolerance) is united as
+  // the file gives it: its fan would fill a notch.
+  auto points_of = [&](const std::vector<int>& face) {
     std::vector<Point> p;
     for (int vi : face) {
       const std::array<double, 2> uv = project(vi);
       p.emplace_back(uv[0], uv[1]);
     }
-    const std::size_t n = p.size();
+    return p;
+  };
+  // The face's outline without consecutive repeats, when it is simple (a polygon's vertices must differ).
+  auto simple_polygon = [](const std::vector<Point>& p, Polygon2* out) {
+    std::vector<Point> ring;
+    for (const Point& q : p)
+      if (ring.empty() || q != ring.back()) ring.push_back(q);
+    while (ring.size() > 1 && ring.front() == ring.back()) ring.pop_back();
+    if (ring.size() < 3) return false;
+    Polygon2 polygon(ring.begin(), ring.end());
+    if (!polygon.is_simple()) return false;
+    *out = std::move(polygon);
+    return true;
+  };
+  std::vector<Polygon2> projected;
+  for (std::size_t f = 0; f < faces.size(); ++f) {
     bool used = false;
     auto add = [&](Polygon2 polygon) {
       const CGAL::Orientation o = polygon.orientation();
@@ -504,20 +522,15 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
       projected.push_back(std::move(polygon));
       used = true;
     };
-    if (n < 3) {
-      // Snapped to a segment or a point: no area.
-    } else if (n == 3) {
-      if (CGAL::orientation(p[0], p[1], p[2]) != CGAL::COLLINEAR) add(Polygon2(p.begin(), p.end()));
+    Polygon2 polygon;
+    if (simple_polygon(points_of(snapped[f]), &polygon)) {
+      if (polygon.area() != 0) add(std::move(polygon));
     } else {
-      std::vector<Point> ring;  // consecutive repeats dropped (a polygon's vertices must differ)
-      for (const Point& q : p)
-        if (ring.empty() || q != ring.back()) ring.push_back(q);
-      while (ring.size() > 1 && ring.front() == ring.back()) ring.pop_back();
-      Polygon2 polygon(ring.begin(), ring.end());
-      if (ring.size() >= 3 && polygon.is_simple()) {
+      const std::vector<Point> p = points_of(faces[f]);
+      if (simple_polygon(p, &polygon)) {
         if (polygon.area() != 0) add(std::move(polygon));
       } else {
-        for (std::size_t k = 1; k + 1 < n; ++k)
+        for (std::size_t k = 1; k + 1 < p.size(); ++k)
           if (CGAL::orientation(p[0], p[k], p[k + 1]) != CGAL::COLLINEAR) {
             const Point tri[3] = {p[0], p[k], p[k + 1]};
             add(Polygon2(tri, tri + 3));

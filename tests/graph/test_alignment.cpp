@@ -276,7 +276,6 @@ TEST(Alignment, AUShapeWhoseOriginIsOnItsEdgeIsEstimatedInMetresAndMillimetres) 
 TEST(Alignment, ASuspicionTheWholeGraphRejectsIsANoteNotAWarning) {
   const Shape l = Shape::FromPolygons({{{{0.0, 0.0}, {0.08, 0.0}, {0.08, 0.03}, {0.03, 0.03}, {0.03, 0.08}, {0.0, 0.08}},
                                         {{{0.02, 0.03}, {0.02, 0.01}, {0.01, 0.01}, {0.01, 0.03}}}}});
-  int noted = 0;
   for (unsigned seed : {1u, 4u, 6u}) {
     const push::Trajectory truth = DefaultPushOf(l, seed);
     EstimatorConfig cfg = ApplyMeasurementSigmas({}, *truth.measurement_sigmas);
@@ -285,11 +284,13 @@ TEST(Alignment, ASuspicionTheWholeGraphRejectsIsANoteNotAWarning) {
     ASSERT_TRUE(r.shape_alignment) << seed;
     EXPECT_FALSE(r.shape_alignment->aligned) << seed;
     EXPECT_FALSE(HasWarning(r, "fit it better")) << seed << ": " << (r.warnings.empty() ? "" : r.warnings[0]);
-    for (const std::string& n : r.shape_alignment->notes) noted += n.find("but the whole graph rejects that placement") != std::string::npos;
+    bool noted = false;
+    for (const std::string& n : r.shape_alignment->notes)
+      noted = noted || n.find("but the whole graph rejects that placement") != std::string::npos;
+    EXPECT_TRUE(noted) << seed;
     std::printf("[alignment] L plate, seed %u: object RMS %.3f mm (raw %.3f mm)\n", seed,
                 r.metrics.at("object_position_rms") * 1e3, r.metrics.at("measured_object_position_rms") * 1e3);
   }
-  EXPECT_GT(noted, 0);
 }
 
 // A force stream read 1 N high throughout (an untared sensor) or with its x and y exchanged: the
@@ -309,7 +310,7 @@ TEST(Alignment, AForceStreamBiasedOrSwappedIsNamedAndNotAlignedOn) {
     const EstimationResult r = Estimate(t, Model::kQs, Mode::kBatch, cfg);
     ASSERT_TRUE(r.shape_alignment) << fault;
     EXPECT_FALSE(r.shape_alignment->aligned) << fault << ": " << (r.warnings.empty() ? "" : r.warnings[0]);
-    EXPECT_TRUE(HasWarning(r, std::string(fault) == "bias" ? "force: the sensor reads a mean (1.0" : "x and y swapped")) << fault;
+    EXPECT_TRUE(HasWarning(r, std::string(fault) == "bias" ? "force: the sensor reads a mean (" : "x and y swapped")) << fault;
     EXPECT_FALSE(HasWarning(r, "places it elsewhere")) << fault;
   }
   // The clean stream: no bias named.

@@ -257,9 +257,8 @@ TEST(Registration, DatasetMeshesAsShippedAreRegisteredOnSimulatedPushes) {
 // An origin on the outline (a U-shaped block whose origin is the middle of its outer edge, pushed
 // 10 mm beside it) put the contacts 10 mm from it against the shape's 60 mm radius: no unit was
 // within 4 times, and the true shape, in metres or in millimetres, was refused as "no unit makes
-// it fit" (2 of 5 simulated pushes in metres by `pushgraph simulate`, the millimetre file every time). Now the file's own unit
-// stands where the shape as given lies on the contacts, and a unit within 30 times where none is
-// within 4.
+// it fit" (2 of 5 simulated pushes in metres by `pushgraph simulate`, the millimetre file every time). Now a
+// unit 4 to 30 times the path is plausible too where the shape in it, as given, lies on the contacts.
 TEST(Registration, AnOriginOnTheOutlineIsNoSizeMismatch) {
   const Shape u = Shape::FromPolygons({{{{0.003, 0.0}, {0.05, 0.0}, {0.05, 0.06}, {0.03, 0.06}, {0.03, 0.02},
                                          {-0.03, 0.02}, {-0.03, 0.06}, {-0.05, 0.06}, {-0.05, 0.0}, {-0.003, 0.0},

@@ -279,7 +279,9 @@ TEST_F(Footprint, SeamsWrittenWithRoundedCoordinatesLeaveNoSlit) {
     EXPECT_EQ(Holes(shape), 0) << degrees << " degrees";
     EXPECT_NEAR(shape.core_area(), 0.003564, 1e-11) << degrees << " degrees";
     // Axis-aligned, every T-junction lies exactly on its edge: nothing to snap or say.
-    if (degrees == 0.0) EXPECT_EQ(u_report.vertices_snapped, 0);
+    if (degrees == 0.0) {
+      EXPECT_EQ(u_report.vertices_snapped, 0);
+    }
   }
 }
 

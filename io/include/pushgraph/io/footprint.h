@@ -57,7 +57,9 @@ geometry::Shape MeshFootprint(const std::string& obj_path, const FootprintOption
 /// warning naming the units that would bring it to 1 cm to 1 m ("the shape is 90 m across: ...
 /// is the file in millimetres (--scale 0.001: 0.09 m across)?"), else nullopt. `scale_given`:
 /// a scale already applied (the suggested --scale is relative to the file); `scale_is`: how the
-/// caller's user gives a scale ("--scale " for footprint, "scale=" in Python).
+/// caller's user gives a scale ("--scale " for footprint, "scale=" in Python). A shape of several
+/// parts whose largest is 1 cm to 1 m across while they span over 2 m and 10 times it is asked
+/// about a stray part far from the others instead.
 std::optional<std::string> ShapeUnitsWarning(const geometry::Shape& shape, double scale_given = 1.0,
                                              const std::string& scale_is = "--scale ");
 
