@@ -39,6 +39,9 @@ inline double RestRadius(double path_noise, const RegistrationOptions& o) {
 
 /// p turned by `angle` about the origin.
 Vec2 Rotate(const Vec2& p, double angle);
+/// The scales a shape file is tried at: metres, centimetres, millimetres, inches, and 100 and 1000
+/// (a file converted to metres twice).
+inline constexpr double kUnitScales[] = {1.0, 0.01, 0.001, 0.0254, 100.0, 1000.0};
 /// "millimetres", "centimetres", "inches" or "metres" for a unit scale.
 const char* UnitName(double scale);
 // "the file is in millimetres", or for scales 100 and 1000 "the file is 1000 times too small

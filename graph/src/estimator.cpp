@@ -397,7 +397,7 @@ std::string SizeMismatchText(const RegistrationResult& r) {
   // Within a unit's reach, the units may be right and the frame not: an origin on the object's
   // edge, where the finger pushes, puts the path inside a few times the shape's radius (a turned
   // U-shaped block whose origin is on its outer edge was "6.61 times the size" and refused).
-  for (double unit : {1.0, 0.01, 0.001, 0.0254, 100.0, 1000.0}) {
+  for (double unit : internal::registration::kUnitScales) {
     const double ratio = r.size_ratio * unit;
     if (ratio > 4.0 && ratio <= 30.0) {
       text += internal::Format(
@@ -495,7 +495,8 @@ EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode 
   const push::Trajectory* before_glitches = repaired ? &*repaired : &trajectory;
   std::optional<push::Trajectory> cleaned = internal::DropObjectPoseGlitches(*before_glitches, &glitch_note);
   const push::Trajectory& input = cleaned ? *cleaned : *before_glitches;
-  const std::optional<std::string> time_unit = internal::TimeUnitNote(trajectory);
+  const char* clock_unit = "";
+  const std::optional<std::string> time_unit = internal::TimeUnitNote(trajectory, &clock_unit);
   const std::optional<std::string> length_unit = internal::ShapeSizeNote(trajectory);
   // A step of the object's tracker is no placement evidence either: a hostile user's rect1 with a
   // 50 mm step had its true mesh "aligned" by a turn of 18.4 degrees to explain it.
@@ -507,10 +508,7 @@ EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode 
   // user's session: 3.04 mm against 2.71 mm raw).
   const std::optional<std::string> force_direction = internal::ForceDirectionNote(input);
   const std::optional<std::string> force_bias = internal::ForceBiasNote(input);
-  std::string time_doubt = "time stamps that read as milliseconds";
-  for (const char* unit : {"microseconds", "nanoseconds"})
-    if (time_unit && time_unit->find(std::string("are the times in ") + unit) != std::string::npos)
-      time_doubt = std::string("time stamps that read as ") + unit;
+  const std::string time_doubt = std::string("time stamps that read as ") + clock_unit;
   const char* unit_doubt = time_unit         ? time_doubt.c_str()
                            : length_unit     ? "lengths that read as centimetres or millimetres"
                            : yaw_unit        ? "yaws that read as degrees"

@@ -486,10 +486,11 @@ void CheckFingerReachesObject(const push::Trajectory& trajectory);
 std::optional<std::string> FingerFarFromObject(const push::Trajectory& trajectory, int finger, double t,
                                                const push::PointSample* contact);
 /// A warning when every stream is sampled at 0.2 s or slower (5 Hz) and the streams read in
-/// milliseconds or microseconds are a push (at most 20 kHz, a finger at most 2 m/s): a 250 Hz
+/// milliseconds, microseconds or nanoseconds are a push (at most 20 kHz, a finger at most 2 m/s): a 250 Hz
 /// sensor in milliseconds reads 4 s apart, and the noise model's per-second scales then no longer
 /// fit the data. Empty otherwise.
-std::optional<std::string> TimeUnitNote(const push::Trajectory& trajectory);
+/// `unit`, when given and a note is returned: the unit asked about ("milliseconds", ...).
+std::optional<std::string> TimeUnitNote(const push::Trajectory& trajectory, const char** unit = nullptr);
 /// Two of the trajectory's streams whose time spans do not overlap at all (a clock offset, a
 /// stream from another recording), named with their spans.
 std::optional<std::string> StreamOverlapNote(const push::Trajectory& trajectory);

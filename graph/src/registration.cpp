@@ -19,6 +19,7 @@
 #include <Eigen/LU>
 
 #include <algorithm>
+#include <iterator>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -294,7 +295,7 @@ RegistrationResult RegisterShape(const std::vector<const push::Trajectory*>& rec
   std::vector<double> scales{1.0};
   // 100 and 1000: a file converted to metres twice (--scale 0.001 on a file already in metres
   // gave a rect2 footprint 1000 times too small; it "fit", being smaller than the fit tolerance).
-  if (o.detect_units) scales = {1.0, 0.01, 0.001, 0.0254, 100.0, 1000.0};
+  if (o.detect_units) scales.assign(std::begin(kUnitScales), std::end(kUnitScales));
   const Vec2 file_centroid = geometry::CoreCentroid(file_shape);
   const double file_radius = geometry::RadiusAbout(file_shape, file_centroid);
   std::vector<double> plausible;

@@ -957,7 +957,7 @@ std::optional<std::string> MeasurementSigmaNote(const push::Trajectory& traj, co
          "in other units (metres, radians, newtons)?";
 }
 
-std::optional<std::string> TimeUnitNote(const push::Trajectory& traj) {
+std::optional<std::string> TimeUnitNote(const push::Trajectory& traj, const char** unit_out) {
   const auto& m = traj.measured;
   double finest = INFINITY;
   for (double p : {MedianPeriod(m.object_pose), MedianPeriod(m.finger_pose), MedianPeriod(m.contact_point), MedianPeriod(m.force)})
@@ -980,6 +980,7 @@ std::optional<std::string> TimeUnitNote(const push::Trajectory& traj) {
   // Only where the other reading is a push: a sensor of at most 20 kHz, a finger of at most 2 m/s
   // (a 4 Hz recording in seconds would read 4000 Hz and 18 m/s in milliseconds).
   if (finest / factor > kSlowestPeriod || factor / finest > 2e4 || speed * factor > 2.0) return std::nullopt;
+  if (unit_out) *unit_out = unit;
   return Format("time stamps: the fastest stream is sampled every %.4g s (%.3g Hz) and the finger travels at %.3g mm/s: "
                 "are the times in %s? Trajectory times are in seconds; read as %s the streams would run at %.4g Hz and "
                 "the finger at %.3g mm/s. The noise model's per-second scales (accelerations, force random walk, D's "
