@@ -617,6 +617,11 @@ ChainSolverSummary ChainSolver::Solve(const ChainSolverOptions& options) {
       } else if (gradient_converged(x, s.gradient)) {
         summary.converged = true;
         summary.termination = "gradient tolerance";
+      } else if (options.soft_iteration_limit > 0 && summary.iterations >= options.soft_iteration_limit &&
+                 change <= options.soft_function_tolerance * cost) {
+        summary.termination = "soft limit (" + std::to_string(options.soft_iteration_limit) + " iterations, change below " +
+                              FormatNumber(options.soft_function_tolerance) + " of the cost)";
+        break;
       }
     } else {
       ++summary.unsuccessful_steps;

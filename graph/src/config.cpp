@@ -64,7 +64,6 @@ std::map<std::string, DoubleField> DoubleFields() {
 std::map<std::string, int EstimatorConfig::*> IntFields() {
   return {
       {"max_iterations", &EstimatorConfig::max_iterations},
-      {"incremental_window", &EstimatorConfig::incremental_window},
       {"incremental_update_every", &EstimatorConfig::incremental_update_every},
       {"incremental_max_iterations", &EstimatorConfig::incremental_max_iterations},
   };
@@ -178,6 +177,9 @@ EstimatorConfig ParseEstimatorConfig(const std::string& json_text, const std::st
     } else if (key == "incremental_update_every_steps") {
       cfg.incremental_update_every_steps = GetInt(*it, source, key);
       if (cfg.incremental_update_every_steps < 1) Fail(source, key, "must be >= 1");
+    } else if (key == "incremental_window") {
+      cfg.incremental_window = GetInt(*it, source, key);
+      if (cfg.incremental_window < 1) Fail(source, key, "must be >= 1 (leave it out for the default)");
     } else if (key == "incremental_window_steps") {
       cfg.incremental_window_steps = GetInt(*it, source, key);
       if (cfg.incremental_window_steps < 3) Fail(source, key, "must be >= 3 (the V factors span three steps)");
@@ -291,13 +293,14 @@ void ValidateConfig(const EstimatorConfig& cfg) {
   if (cfg.incremental_window_steps != 0 && cfg.incremental_window_steps < 3) {
     throw GraphError("config key 'incremental_window_steps' must be >= 3 (0: unset)");
   }
-  if (cfg.incremental_window < cfg.incremental_update_every) {
+  if (cfg.incremental_window < 0) throw GraphError("config key 'incremental_window' must be >= 1 (0: unset)");
+  if (cfg.incremental_window > 0 && cfg.incremental_window < cfg.incremental_update_every) {
     // Name both values: the user may have set only one (incremental_window 2 against the default
     // update every 5 was refused naming a key that was not in the file).
     throw GraphError("config: incremental_window (" + std::to_string(cfg.incremental_window) +
                      " object periods) must be >= incremental_update_every (" + std::to_string(cfg.incremental_update_every) +
                      "; its default is 5): the window must hold the samples of one update; lower incremental_update_every "
-                     "with it");
+                     "with it, or leave incremental_window unset");
   }
 }
 

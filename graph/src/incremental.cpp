@@ -361,19 +361,27 @@ struct FixedLagSmoother {
   }
   static constexpr int kDefaultWindowStepsAtSensorRate = 15;
 
-  // Iterations of an update's window solve after the first (which starts cold and converges).
-  // Unset: 3 where a step spends ten or more updates in the window (the sensor rate with its
-  // default window): each refines it, and Finish re-solves the last window (the result as
-  // uncapped on three simulated pushes, the worst update 2.3-3.0 -> 0.7-1.1 ms). Otherwise to
-  // convergence: every 5 object samples a step sees one or two updates, and a leaving step's
-  // marginal prior keeps the linearization point it had (a cap of 3 there: ellip1's QS
-  // incremental object RMS 1.25 -> 1.81 mm on docs/results.md's set).
+  // Iterations of an update's window solve after the first (which starts cold and converges):
+  // incremental_window_iterations, a hard cap, when set; else incremental_max_iterations.
   int WindowIterations() const {
-    if (cfg.incremental_window_iterations > 0) return cfg.incremental_window_iterations;
+    return cfg.incremental_window_iterations > 0 ? cfg.incremental_window_iterations : cfg.incremental_max_iterations;
+  }
+  // The soft iteration limit of those solves (0: none; ChainSolverOptions::soft_iteration_limit).
+  // Unset incremental_window_iterations: 3 where a step spends ten or more updates in the window
+  // (the sensor rate with its default window), each of which refines it, and Finish re-solves the
+  // last window (the worst update 2.3-3.0 -> 0.7-1.1 ms on three simulated pushes). Soft, not a
+  // hard cap: a cap of 3 left the first windows of a slow real push (ellip1 at 20 mm/s, 100 Hz)
+  // far from their minimum, the marginal priors kept that, and the estimate diverged (object RMS
+  // 8 to 16 mm against about 1 mm uncapped). None every 5 object samples: a step sees one or two
+  // updates there and leaves with the linearization point it had (a cap of 3: ellip1's QS
+  // incremental object RMS 1.25 -> 1.81 mm on docs/results.md's set).
+  int WindowSoftLimit() const {
     const int every = cfg.incremental_update_every_steps;
-    return every > 0 && WindowSteps() >= 10 * every ? kDefaultWindowIterationsAtSensorRate : cfg.incremental_max_iterations;
+    if (cfg.incremental_window_iterations > 0 || every <= 0) return 0;
+    return WindowSteps() >= 10 * every ? kDefaultWindowIterationsAtSensorRate : 0;
   }
   static constexpr int kDefaultWindowIterationsAtSensorRate = 3;
+  static constexpr double kWindowEdgeTolerance = 1e-6;  // s
 
   // Adds the steps up to `target` (every remaining one when take_all) and solves the window.
   double Update(double target, bool take_all) {
@@ -394,8 +402,8 @@ struct FixedLagSmoother {
     const auto solve_start = std::chrono::steady_clock::now();
     // A bounded relinearization per update (as iSAM2's one Gauss-Newton step), WindowIterations.
     const int window_iterations = first_new == 0 ? cfg.incremental_max_iterations : WindowIterations();
-    const internal::SolveOutcome summary =
-        builder.Solve(*problem, window_iterations, cfg.function_tolerance, "incremental update, window");
+    const internal::SolveOutcome summary = builder.Solve(*problem, window_iterations, cfg.function_tolerance,
+                                                         "incremental update, window", first_new == 0 ? 0 : WindowSoftLimit());
     stats.iterations += summary.iterations;
     last_cost = summary.final_cost;
     window_converged = summary.converged;
@@ -409,7 +417,10 @@ struct FixedLagSmoother {
     if (window_steps > 0) {
       while (s < next_step - window_steps) leaving.push_back(s++);
     } else {
-      while (s < next_step - 3 && builder.steps()[s].t < t_now - window_duration) leaving.push_back(s++);
+      // The window's edge falls on a step (a whole number of object periods back from an update);
+      // within 1 us of it the step stays, so that the online front end, whose period estimate
+      // differs from the replay's in its last bits, keeps the same steps.
+      while (s < next_step - 3 && builder.steps()[s].t < t_now - window_duration - kWindowEdgeTolerance) leaving.push_back(s++);
     }
     const auto record_start = std::chrono::steady_clock::now();
     Record(leaving, summary.chain.get());
@@ -572,7 +583,7 @@ struct IncrementalEstimator::Impl {
       period = steps.size() > 1 ? 10.0 * (steps.back().t - steps.front().t) / double(steps.size() - 1) : 1.0;
     }
     const int k = cfg.incremental_update_every;
-    smoother.window_duration = cfg.incremental_window * period;
+    smoother.window_duration = cfg.IncrementalWindowPeriods() * period;
     if (cfg.incremental_update_every_steps >= 1) {
       // An update every k estimator steps (1: at the sensor rate).
       // The first update takes at least three steps: one step alone has no motion prior, and
@@ -936,7 +947,7 @@ double OnlineEstimator::Update(double until) {
   m.last_update_t = until;  // later samples must come more than 1e-9 s after it (Accept)
   until += 1e-9;
   m.smoother.builder.AppendSteps(until);
-  if (m.object_period > 0.0) m.smoother.window_duration = m.smoother.cfg.incremental_window * m.object_period;
+  if (m.object_period > 0.0) m.smoother.window_duration = m.smoother.cfg.IncrementalWindowPeriods() * m.object_period;
   return m.smoother.Update(until, false);
 }
 

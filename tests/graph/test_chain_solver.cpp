@@ -113,6 +113,27 @@ TEST(ChainSolver, SameMinimumAsCeresOnRandomChainsWithLosses) {
   }
 }
 
+// The soft iteration limit: from that iteration on, a step that changes the cost by less than
+// soft_function_tolerance of it ends the solve, unconverged; a larger change goes on.
+TEST(ChainSolver, ASoftIterationLimitEndsOnlyWhereTheCostSettles) {
+  RandomChain full(200, 4, 1.0), loose(200, 4, 1.0), tight(200, 4, 1.0);
+  const ChainSolverSummary reference = ChainSolver(full.problem).Solve(TightChain());
+  ASSERT_TRUE(reference.converged) << reference.termination;
+  ChainSolverOptions o = TightChain();
+  o.soft_iteration_limit = 2;
+  o.soft_function_tolerance = 1.0;  // any successful step is small enough
+  const ChainSolverSummary a = ChainSolver(loose.problem).Solve(o);
+  EXPECT_FALSE(a.converged);
+  EXPECT_NE(a.termination.find("soft limit (2 iterations"), std::string::npos) << a.termination;
+  EXPECT_GE(a.iterations, 2);
+  EXPECT_LT(a.iterations, reference.iterations);
+  o.soft_function_tolerance = 0.0;  // no step is: the solve goes on to the tight tolerance
+  const ChainSolverSummary b = ChainSolver(tight.problem).Solve(o);
+  EXPECT_TRUE(b.converged) << b.termination;
+  EXPECT_EQ(b.iterations, reference.iterations);
+  EXPECT_EQ(b.final_cost, reference.final_cost);
+}
+
 // With the bound active: the Karush-Kuhn-Tucker conditions (zero gradient in every free
 // unknown, the bounded one on its bound with the gradient pushing outward). Ceres' projected
 // LM stops early on this problem (its cost 2e-8 relative above ours, gradient not zero), so
@@ -301,25 +322,36 @@ TEST(ChainSolver, SameMinimumAsCeresOnSimulatedPushes) {
   ExpectSameMinimum(push::Simulate(testing::NotchedBlockPushPlan(0.7, 3)).trajectory, Model::kQs, "notched block, QS");
 }
 
-TEST(ChainSolver, SameMinimumAsCeresOnARealRecording) {
-  const std::string file = std::string(PUSHGRAPH_SHARED_DIR) +
-                           "/data/mit-push/abs/rect1/motion_surface=abs_shape=rect1_a=0_v=75_i=2.000_s=0.800_t=0.349.h5";
-  if (!std::filesystem::exists(file)) GTEST_SKIP() << "no MIT data at " << file;
+// An MIT recording's contact phase with the paper's tracker noise (5 mm, 0.05 rad on the object,
+// 5 mm on the finger; 0.5 N on the force when `force_noise`).
+push::Trajectory NoisyMitPush(const std::string& file, const geometry::Shape& shape, double mass, double finger_radius,
+                              double mu_contact, unsigned seed, bool force_noise) {
   io::MitReadOptions options;
   options.trim_to_contact = true;
   const io::MitRecording rec = io::ReadMitPush(file, options);
   push::ObjectDescription object;
-  object.shape = geometry::Shape::Box(0.09, 0.09);
-  object.mass = 0.8374;
+  object.shape = shape;
+  object.mass = mass;
   object.mu_surface = 0.35;
   push::FingerDescription finger;
-  finger.shape = geometry::Shape::Disk(0.00235);
-  finger.mu_contact = 0.2;
+  finger.shape = geometry::Shape::Disk(finger_radius);
+  finger.mu_contact = mu_contact;
   push::Trajectory t = io::MitToTrajectory(rec, object, finger);
-  std::mt19937_64 rng(5);
+  std::mt19937_64 rng(seed);
   std::normal_distribution<double> n(0.0, 1.0);
   for (auto& s : t.measured.object_pose) s.pose = {s.pose.x + 0.005 * n(rng), s.pose.y + 0.005 * n(rng), s.pose.theta + 0.05 * n(rng)};
   for (auto& s : t.measured.finger_pose) s.pose = {s.pose.x + 0.005 * n(rng), s.pose.y + 0.005 * n(rng), s.pose.theta};
+  if (force_noise) {
+    for (auto& s : t.measured.force) s.force += Vec2(0.5 * n(rng), 0.5 * n(rng));
+  }
+  return t;
+}
+
+TEST(ChainSolver, SameMinimumAsCeresOnARealRecording) {
+  const std::string file = std::string(PUSHGRAPH_SHARED_DIR) +
+                           "/data/mit-push/abs/rect1/motion_surface=abs_shape=rect1_a=0_v=75_i=2.000_s=0.800_t=0.349.h5";
+  if (!std::filesystem::exists(file)) GTEST_SKIP() << "no MIT data at " << file;
+  const push::Trajectory t = NoisyMitPush(file, geometry::Shape::Box(0.09, 0.09), 0.8374, 0.00235, 0.2, 5, false);
   ExpectSameMinimum(t, Model::kQs, "MIT rect1, QS");
 }
 
@@ -442,11 +474,10 @@ TEST(ChainSolver, BoundedWindowSolvesAtTheSensorRateKeepTheResult) {
   EXPECT_LT(worst_last, 2e-5);
   EXPECT_LT(worst, 1e-4);
   EXPECT_LT(i, 1.05 * b);
-  // Unset is 3 there: the same bits as 3 set.
+  // Unset is a soft limit of 3 there; 3 set is a hard cap: never more iterations than the soft limit's.
   cfg.incremental_window_iterations = 3;
   const EstimationResult three = Estimate(c.traj, Model::kQs, Mode::kIncremental, cfg);
-  EXPECT_EQ(three.solver.iterations, capped.solver.iterations);
-  for (std::size_t k = 0; k < n; ++k) ASSERT_EQ(three.states[k].object_pose.vector(), capped.states[k].object_pose.vector()) << k;
+  EXPECT_LE(three.solver.iterations, capped.solver.iterations);
   // Where a step spends fewer than ten updates in the window (every 5 steps, a 15-step window)
   // unset means uncapped: the same bits as incremental_max_iterations set.
   cfg.incremental_update_every_steps = 5;
@@ -471,6 +502,33 @@ TEST(ChainSolver, BoundedWindowSolvesAtTheSensorRateKeepTheResult) {
   bool warned_before = false;
   for (const std::string& w : capped.warnings) warned_before = warned_before || w.find("the last window's solve") != std::string::npos;
   EXPECT_FALSE(warned_before);
+}
+
+// A slow real push (ellip1 at 20 mm/s, 1456 steps of 250 Hz) with the tracker noise of the
+// paper's protocol, an update at every step. With a hard cap of 3 iterations per window solve its
+// first windows stopped far from their minimum, the marginal priors kept that and the estimate
+// diverged (object RMS 22.5 mm, rotation 0.6 rad, against 0.62 mm uncapped); the soft limit goes
+// on where a step still changes the cost by more than 3e-4 of it.
+TEST(ChainSolver, WindowSolvesAtTheSensorRateDoNotDivergeOnASlowRealPush) {
+  const std::string file = std::string(PUSHGRAPH_SHARED_DIR) +
+                           "/data/mit-push/abs/ellip1/motion_surface=abs_shape=ellip1_a=0_v=20_i=0.000_s=0.675_t=1.047.h5";
+  if (!std::filesystem::exists(file)) GTEST_SKIP() << "no MIT data at " << file;
+  const push::Trajectory t = NoisyMitPush(file, geometry::Shape::Disk(0.0525), 0.8937, 0.0047, 0.25, 1, true);
+  EstimatorConfig cfg;
+  cfg.diagnostics = false;
+  const EstimationResult batch = Estimate(t, Model::kQs, Mode::kBatch, cfg);
+  cfg.incremental_update_every_steps = 1;
+  const EstimationResult inc = Estimate(t, Model::kQs, Mode::kIncremental, cfg);
+  cfg.incremental_window_iterations = 3;  // the hard cap the default was until 2026-11-28
+  const EstimationResult capped = Estimate(t, Model::kQs, Mode::kIncremental, cfg);
+  const double b = batch.metrics.at("object_position_rms"), i = inc.metrics.at("object_position_rms");
+  std::printf("[slow real push, an update per step] %zu steps, object RMS %.3f mm (batch %.3f, hard cap of 3: %.3f, "
+              "raw %.3f), rotation %.4f rad (batch %.4f), %d iterations (hard cap %d)\n",
+              inc.states.size(), 1e3 * i, 1e3 * b, 1e3 * capped.metrics.at("object_position_rms"),
+              1e3 * inc.metrics.at("measured_object_position_rms"), inc.metrics.at("object_rotation_rms"),
+              batch.metrics.at("object_rotation_rms"), inc.solver.iterations, capped.solver.iterations);
+  EXPECT_LT(i, 1.2 * b);
+  EXPECT_LT(inc.metrics.at("object_rotation_rms"), 1.2 * batch.metrics.at("object_rotation_rms"));
 }
 
 TEST(ChainSolver, ConfigSelectsTheSolverAndTheUpdateRate) {
@@ -514,6 +572,11 @@ TEST(ChainSolver, ConfigIntegersOutOfRangeAreErrors) {
       }
     }
   }
+  // Unset, the window is the larger of 5 and the update interval; set, it must hold one update.
+  EXPECT_EQ(ParseEstimatorConfig("{}").IncrementalWindowPeriods(), 5);
+  EXPECT_EQ(ParseEstimatorConfig(R"({"incremental_update_every": 8})").IncrementalWindowPeriods(), 8);
+  EXPECT_EQ(ParseEstimatorConfig(R"({"incremental_window": 9})").IncrementalWindowPeriods(), 9);
+  EXPECT_THROW(ParseEstimatorConfig(R"({"incremental_window": 0})"), GraphError);
   // A window shorter than the default update interval names both values (it named only the key
   // the user had not set).
   try {

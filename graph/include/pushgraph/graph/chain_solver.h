@@ -38,6 +38,13 @@ struct ChainSolverOptions {
   /// cost is flat).
   double function_tolerance = 1e-6;
   bool model_confirms_convergence = true;
+  /// A soft iteration budget (0: none). From this iteration on, a successful step that changes
+  /// the cost by less than soft_function_tolerance of it ends the solve, unconverged ("soft
+  /// limit"): the fixed-lag smoother's windows at the sensor rate, which later updates refine,
+  /// stop there once they are near their minimum, and go on where they are not (a hard cap of 3
+  /// left a slow real push's first windows far from it, and the estimate diverged).
+  int soft_iteration_limit = 0;
+  double soft_function_tolerance = 3e-4;
   /// Converged when max_i |x_i - Project(x_i - g_i)| is below this (g the gradient).
   double gradient_tolerance = 1e-12;
   /// Converged when |dx| <= parameter_tolerance (|x| + parameter_tolerance).
