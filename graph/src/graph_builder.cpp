@@ -57,11 +57,6 @@ double NearestGap(const std::vector<Sample>& s, double t, int* index = nullptr) 
 // is not held still by more than that.
 constexpr double kRestWalkTrans = 2e-3;  // m / sqrt(s)
 constexpr double kRestWalkRot = 2e-2;    // rad / sqrt(s)
-// A window solve past its soft iteration limit ends at the first step that changes the cost by
-// less than this fraction of it (GraphBuilder::Solve). 1e-3 left one rect1 recording's finger
-// NEES at 9.9 on docs/results.md's set at the sensor rate; 3e-4 and 1e-4 gave 2.05, as with no
-// limit, and 3e-4 costs 8 % more time per update than 1e-3 on a slow ellip1 push, 1e-4 27 %.
-constexpr double kSoftFunctionTolerance = 3e-4;
 
 bool ObjectSeenMoving(const std::vector<push::PoseSample>& poses, double sigma, std::size_t* scanned) {
   if (poses.size() < 10) return false;
@@ -411,21 +406,30 @@ SolveOutcome GraphBuilder::Solve(ceres::Problem& problem, int max_iterations, do
                                  const char* what, int soft_iteration_limit) const {
   SolveOutcome out;
   const bool soft = soft_iteration_limit > 0 && soft_iteration_limit < max_iterations;
+  const double soft_tolerance = ChainSolverOptions().soft_function_tolerance;
   if (cfg_.solver == EstimatorConfig::Solver::kCeres) {
+    // The soft limit as two solves: soft_iteration_limit - 1 iterations at the tolerance, then
+    // the rest at soft_tolerance, so that iteration soft_iteration_limit is the first that can
+    // stop on it. Ceres tests the cost change of a step before it accepts it, so a rejected step
+    // that changes the cost that little ends the second solve too; and any end of the second
+    // solve counts as unconverged (Finish() then re-solves the last window once).
+    const int first_iterations = soft ? soft_iteration_limit - 1 : max_iterations;
     ceres::Solver::Summary summary;
-    ceres::Solve(SolverOptions(soft ? soft_iteration_limit : max_iterations, function_tolerance), &problem, &summary);
-    LogSummary(what, summary);
-    if (summary.termination_type == ceres::FAILURE) throw GraphError(std::string(what) + " failed: " + summary.message);
-    out.iterations = summary.num_successful_steps + summary.num_unsuccessful_steps;
+    if (first_iterations > 0) {
+      ceres::Solve(SolverOptions(first_iterations, function_tolerance), &problem, &summary);
+      LogSummary(what, summary);
+      if (summary.termination_type == ceres::FAILURE) throw GraphError(std::string(what) + " failed: " + summary.message);
+      out.iterations = summary.num_successful_steps + summary.num_unsuccessful_steps;
+    }
     bool soft_stop = false;
-    if (soft && summary.termination_type == ceres::NO_CONVERGENCE) {
-      // Past the soft limit: on until a step changes the cost by less than kSoftFunctionTolerance.
+    if (soft && (first_iterations == 0 || summary.termination_type == ceres::NO_CONVERGENCE)) {
       ceres::Solver::Summary rest;
-      ceres::Solve(SolverOptions(max_iterations - out.iterations, kSoftFunctionTolerance), &problem, &rest);
+      ceres::Solve(SolverOptions(max_iterations - first_iterations, soft_tolerance), &problem, &rest);
       LogSummary(what, rest);
       if (rest.termination_type == ceres::FAILURE) throw GraphError(std::string(what) + " failed: " + rest.message);
-      out.iterations += rest.num_successful_steps + rest.num_unsuccessful_steps;
-      soft_stop = true;  // converged at the soft tolerance only
+      // Both summaries count Ceres' iteration 0 (the evaluation at the start) as a step.
+      out.iterations += rest.num_successful_steps + rest.num_unsuccessful_steps - (first_iterations > 0 ? 1 : 0);
+      soft_stop = true;
       summary = rest;
     }
     out.final_cost = summary.final_cost;
@@ -436,10 +440,7 @@ SolveOutcome GraphBuilder::Solve(ceres::Problem& problem, int max_iterations, do
   ChainSolverOptions options;
   options.max_iterations = max_iterations;
   options.function_tolerance = function_tolerance;
-  if (soft) {
-    options.soft_iteration_limit = soft_iteration_limit;
-    options.soft_function_tolerance = kSoftFunctionTolerance;
-  }
+  if (soft) options.soft_iteration_limit = soft_iteration_limit;
   options.describe = [this](ceres::ResidualBlockId id) { return Describe(id); };
   options.log_iterations = SolverLogLevel() >= 2;
   options.model_confirms_convergence = !incremental_;

@@ -128,8 +128,9 @@ class GraphBuilder {
   /// Solves `problem` (built by this builder) with config.solver; `what` names the stage in
   /// logs. Throws GraphError when the solve fails (naming the factor and step when known).
   /// soft_iteration_limit > 0: from that iteration on the solve ends once a step changes the cost
-  /// by less than 3e-4 of it (ChainSolverOptions::soft_iteration_limit; Ceres: a second solve at
-  /// that tolerance after the first soft_iteration_limit iterations).
+  /// by less than ChainSolverOptions::soft_function_tolerance of it, unconverged
+  /// (ChainSolverOptions::soft_iteration_limit; Ceres: a second solve at that tolerance after the
+  /// first soft_iteration_limit - 1 iterations).
   SolveOutcome Solve(ceres::Problem& problem, int max_iterations, double function_tolerance, const char* what,
                      int soft_iteration_limit = 0) const;
   /// The fixed-lag smoother's solves (its windows are refined by later updates and the final

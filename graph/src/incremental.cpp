@@ -370,9 +370,10 @@ struct FixedLagSmoother {
   // Unset incremental_window_iterations: 3 where a step spends ten or more updates in the window
   // (the sensor rate with its default window), each of which refines it, and Finish re-solves the
   // last window (the worst update 2.3-3.0 -> 0.7-1.1 ms on three simulated pushes). Soft, not a
-  // hard cap: a cap of 3 left the first windows of a slow real push (ellip1 at 20 mm/s, 100 Hz)
-  // far from their minimum, the marginal priors kept that, and the estimate diverged (object RMS
-  // 8 to 16 mm against about 1 mm uncapped). None every 5 object samples: a step sees one or two
+  // hard cap: a cap of 3 left the first windows of slow real pushes (ellip1 at 20 mm/s) far
+  // from their minimum, the marginal priors kept that, and the estimates diverged (8 to 16 mm at
+  // 100 Hz on docs/results.md's set, 22.5 mm at 250 Hz on one recording, against about 1 mm
+  // without a limit). None every 5 object samples: a step sees one or two
   // updates there and leaves with the linearization point it had (a cap of 3: ellip1's QS
   // incremental object RMS 1.25 -> 1.81 mm on docs/results.md's set).
   int WindowSoftLimit() const {

@@ -11,6 +11,7 @@
 #include <pushgraph/push/simulator.h>
 
 #include "graph/push_generator.h"
+#include "test_scale.h"
 
 #include <ceres/ceres.h>
 #include <ceres/normal_prior.h>
@@ -443,15 +444,16 @@ TEST(ChainSolver, SmoothingPassBringsAShortWindowToTheBatchEstimate) {
   }
 }
 
-// At the sensor rate an update relinearizes its window a bounded number of times (unset
-// incremental_window_iterations: 3, as iSAM2's one step per update bounds an update's time); a
-// step is refined by the ten or more updates it spends in the window, and Finish re-solves the
-// last window, which no later update refines. The result stays with the uncapped smoother's,
-// the newest steps included.
+// At the sensor rate an update's window solve has a soft limit (unset
+// incremental_window_iterations: from the third iteration on it ends at a step that changes the
+// cost by less than 3e-4 of it, a bounded relinearization per update as iSAM2's); a step is
+// refined by the ten or more updates it spends in the window, and Finish re-solves the last
+// window, which no later update refines. The result stays with the unlimited smoother's, the
+// newest steps included.
 TEST(ChainSolver, BoundedWindowSolvesAtTheSensorRateKeepTheResult) {
   PerStepCase c = MakePerStepCase(0.015, 1.0, 5);
   EstimatorConfig cfg = c.cfg;
-  ASSERT_EQ(cfg.incremental_window_iterations, 0);  // unset: 3 at the sensor rate
+  ASSERT_EQ(cfg.incremental_window_iterations, 0);  // unset: a soft limit of 3 at the sensor rate
   const EstimationResult capped = Estimate(c.traj, Model::kQs, Mode::kIncremental, cfg);
   cfg.incremental_window_iterations = cfg.incremental_max_iterations;
   const EstimationResult full = Estimate(c.traj, Model::kQs, Mode::kIncremental, cfg);
@@ -468,16 +470,33 @@ TEST(ChainSolver, BoundedWindowSolvesAtTheSensorRateKeepTheResult) {
               "last 15 steps %.4f mm; object RMS %.3f mm (uncapped %.3f, batch %.3f)\n",
               capped.solver.iterations, full.solver.iterations, capped.solver.updates, 1e3 * worst, 1e3 * worst_last,
               1e3 * i, 1e3 * full.metrics.at("object_position_rms"), 1e3 * b);
-  // Measured: 2073 against 2612 iterations, worst 0.009 mm, last 15 steps 0.004 mm (0.07 mm when
-  // Finish does not converge the last window).
+  // Measured: 2147 against 2612 iterations, worst and last 15 steps 0.004 mm (the hard cap of 3
+  // before 2026-11-28: 2073 iterations, 0.009 mm; 0.07 mm when Finish did not converge the last
+  // window).
   EXPECT_LT(capped.solver.iterations, full.solver.iterations);
   EXPECT_LT(worst_last, 2e-5);
   EXPECT_LT(worst, 1e-4);
   EXPECT_LT(i, 1.05 * b);
-  // Unset is a soft limit of 3 there; 3 set is a hard cap: never more iterations than the soft limit's.
+  // Unset is a soft limit of 3 there, which goes on where a window is far from its minimum; 3 set
+  // is a hard cap, which does not.
   cfg.incremental_window_iterations = 3;
   const EstimationResult three = Estimate(c.traj, Model::kQs, Mode::kIncremental, cfg);
-  EXPECT_LE(three.solver.iterations, capped.solver.iterations);
+  std::printf("[bounded window solves] a hard cap of 3: %d iterations\n", three.solver.iterations);
+  EXPECT_LT(three.solver.iterations, capped.solver.iterations);
+  // The Ceres path runs the soft limit as two solves (GraphBuilder::Solve): the same estimate
+  // within the solves' tolerances.
+  EstimatorConfig by_ceres_cfg = c.cfg;
+  by_ceres_cfg.solver = EstimatorConfig::Solver::kCeres;
+  const EstimationResult by_ceres = Estimate(c.traj, Model::kQs, Mode::kIncremental, by_ceres_cfg);
+  ASSERT_EQ(by_ceres.states.size(), n);
+  double ceres_gap = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    ceres_gap = std::max(ceres_gap, (by_ceres.states[k].object_pose.translation() - capped.states[k].object_pose.translation()).norm());
+  }
+  std::printf("[bounded window solves] Ceres: %d iterations, |Ceres - chain| worst %.4f mm, object RMS %.3f mm\n",
+              by_ceres.solver.iterations, 1e3 * ceres_gap, 1e3 * by_ceres.metrics.at("object_position_rms"));
+  EXPECT_LT(ceres_gap, 1e-4);
+  EXPECT_LT(by_ceres.metrics.at("object_position_rms"), 1.05 * b);
   // Where a step spends fewer than ten updates in the window (every 5 steps, a 15-step window)
   // unset means uncapped: the same bits as incremental_max_iterations set.
   cfg.incremental_update_every_steps = 5;
@@ -519,16 +538,21 @@ TEST(ChainSolver, WindowSolvesAtTheSensorRateDoNotDivergeOnASlowRealPush) {
   const EstimationResult batch = Estimate(t, Model::kQs, Mode::kBatch, cfg);
   cfg.incremental_update_every_steps = 1;
   const EstimationResult inc = Estimate(t, Model::kQs, Mode::kIncremental, cfg);
-  cfg.incremental_window_iterations = 3;  // the hard cap the default was until 2026-11-28
-  const EstimationResult capped = Estimate(t, Model::kQs, Mode::kIncremental, cfg);
   const double b = batch.metrics.at("object_position_rms"), i = inc.metrics.at("object_position_rms");
-  std::printf("[slow real push, an update per step] %zu steps, object RMS %.3f mm (batch %.3f, hard cap of 3: %.3f, "
-              "raw %.3f), rotation %.4f rad (batch %.4f), %d iterations (hard cap %d)\n",
-              inc.states.size(), 1e3 * i, 1e3 * b, 1e3 * capped.metrics.at("object_position_rms"),
-              1e3 * inc.metrics.at("measured_object_position_rms"), inc.metrics.at("object_rotation_rms"),
-              batch.metrics.at("object_rotation_rms"), inc.solver.iterations, capped.solver.iterations);
+  std::printf("[slow real push, an update per step] %zu steps, object RMS %.3f mm (batch %.3f, raw %.3f), rotation "
+              "%.4f rad (batch %.4f), %d iterations\n",
+              inc.states.size(), 1e3 * i, 1e3 * b, 1e3 * inc.metrics.at("measured_object_position_rms"),
+              inc.metrics.at("object_rotation_rms"), batch.metrics.at("object_rotation_rms"), inc.solver.iterations);
   EXPECT_LT(i, 1.2 * b);
   EXPECT_LT(inc.metrics.at("object_rotation_rms"), 1.2 * batch.metrics.at("object_rotation_rms"));
+  if (pushgraph::testing::TestScale() < 1.0) return;  // the sanitizer stage: the comparison below is a third estimate
+  // The push still shows what the soft limit is for: the hard cap of 3, the default until
+  // 2026-11-28, diverges on it (11.5 mm).
+  cfg.incremental_window_iterations = 3;
+  const EstimationResult capped = Estimate(t, Model::kQs, Mode::kIncremental, cfg);
+  std::printf("[slow real push] a hard cap of 3: object RMS %.3f mm, %d iterations\n",
+              1e3 * capped.metrics.at("object_position_rms"), capped.solver.iterations);
+  EXPECT_GT(capped.metrics.at("object_position_rms"), 3.0 * i);
 }
 
 TEST(ChainSolver, ConfigSelectsTheSolverAndTheUpdateRate) {

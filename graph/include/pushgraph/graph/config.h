@@ -148,9 +148,11 @@ struct EstimatorConfig {
   /// when set). 0: unset, which means the larger of 5 and incremental_update_every: the window
   /// then holds the last update's samples, and an update solves them with the new ones. 7 until
   /// 2026-11-28 (20 until 2026-11-26): the final smoothing pass (incremental_smoothing) brings the
-  /// older states to the batch estimate, so the shorter window costs no accuracy on
-  /// docs/results.md's set (object RMS within -3.9 %..+0.8 % of the 7-period window's, NEES
-  /// nearer the dimension) and an update every 5 samples 10 % fewer instructions. With
+  /// older states to the batch estimate, so the shorter window costs little accuracy on
+  /// docs/results.md's set (object RMS within -3.9 %..+2.1 % of the 7-period window's; most NEES
+  /// nearer their dimension, sim-multi's object-pose NEES up to 10 % higher) and an update every
+  /// 5 samples takes 10 % fewer instructions. Updates further apart than the window (a late
+  /// sample, an occlusion) marginalize their oldest new steps after one window solve. With
   /// incremental_smoothing off, states keep the estimate of the window they left: a longer
   /// window is then better.
   int incremental_window = 0;
@@ -170,16 +172,20 @@ struct EstimatorConfig {
   /// older states to the batch estimate's accuracy.
   int incremental_window_steps = 0;
   /// Iteration limit of the new steps' staging and of every window solve (the first update's,
-  /// Finish's re-solve of a last window that stopped at its cap, and every update's unless
+  /// Finish's re-solve of a last window that stopped at a limit, and every update's unless
   /// incremental_window_iterations applies).
   int incremental_max_iterations = 50;
-  /// Levenberg-Marquardt iterations of each update's window solve after the first (>= 1, in
-  /// every mode when set): a bounded relinearization per update, as iSAM2's, which bounds an
-  /// update's time; Finish re-solves the last window when its solve stopped at the cap. 0: unset,
-  /// which means 3 where a step spends ten or more updates in the window (incremental_update_every_steps
-  /// set with the default window) and incremental_max_iterations otherwise (a step that spends
-  /// one or two updates in the window leaves with the linearization point it had: a cap there
-  /// costs accuracy, docs/estimation.md).
+  /// A hard cap on the Levenberg-Marquardt iterations of each update's window solve after the
+  /// first (>= 1, in every mode when set); Finish re-solves the last window when its solve stopped
+  /// at the cap. 0: unset, which means a soft limit of 3 where a step spends ten or more updates
+  /// in the window (incremental_update_every_steps set with the default window): from the third
+  /// iteration on, the solve ends at a step that changes the cost by less than 3e-4 of it
+  /// (ChainSolverOptions::soft_iteration_limit), a bounded relinearization per update as
+  /// iSAM2's, which goes on where a window is still far from its minimum; and
+  /// incremental_max_iterations otherwise (a step that spends one or two updates in the window
+  /// leaves with the linearization point it had: a limit there costs accuracy,
+  /// docs/estimation.md). A hard cap of 3 at the sensor rate, the default until 2026-11-28, made
+  /// slow real pushes diverge.
   int incremental_window_iterations = 0;
   /// The final result of the incremental mode (Finish()): true (the default) smooths the whole
   /// trajectory backwards through the Gaussian conditionals its steps left when they were
