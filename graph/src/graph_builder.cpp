@@ -925,7 +925,7 @@ int GraphBuilder::SmoothInitialMotion(int max_iterations, double function_tolera
 }
 
 int GraphBuilder::StageSteps(ceres::Problem& problem, int first, int last, int max_iterations,
-                             double function_tolerance, const std::string& what) {
+                             double function_tolerance, const std::string& what, int kinematic_iterations) {
   int iterations = SmoothInitialMotion(10, 1e-3, first, last);
   DetectSecondContacts(first, last);
   if (ModelHasForce(model_)) {
@@ -939,7 +939,9 @@ int GraphBuilder::StageSteps(ceres::Problem& problem, int first, int last, int m
         if (warm.HasParameterBlock(b)) warm.SetParameterBlockConstant(b);
       }
     }
-    iterations += Solve(warm, max_iterations, function_tolerance, (what + ", kinematics first").c_str()).iterations;
+    iterations += Solve(warm, kinematic_iterations > 0 ? kinematic_iterations : max_iterations, function_tolerance,
+                        (what + ", kinematics first").c_str())
+                      .iterations;
     warm_origin_.clear();
   }
   for (int i = first; i < last; ++i) AddFactors(problem, i, kAll);

@@ -235,9 +235,10 @@ class GraphBuilder {
   /// shape frame, the two steps before `first` held fixed (incremental: only the new steps need
   /// a start); then their full factors go into `problem`. Interpolated measurements are far from
   /// satisfying D's per-step velocity directions: starting D from them costs the full solve tens
-  /// of iterations. Returns the iterations used.
+  /// of iterations. `kinematic_iterations` caps the kinematic stage (0: max_iterations). Returns
+  /// the iterations used.
   int StageSteps(ceres::Problem& problem, int first, int last, int max_iterations, double function_tolerance,
-                 const std::string& what);
+                 const std::string& what, int kinematic_iterations = 0);
   /// The object features the two-contact steps' contact factors were fixed to
   /// (FeatureWitnessFactor), re-derived at the current values: the number of steps whose choice
   /// changed. The batch solve rebuilds its problem and

@@ -382,6 +382,14 @@ struct FixedLagSmoother {
     return WindowSteps() >= 10 * every ? kDefaultWindowIterationsAtSensorRate : 0;
   }
   static constexpr int kDefaultWindowIterationsAtSensorRate = 3;
+  // Iterations of the new QS steps' kinematic stage after the first update. The stage lowers the
+  // cost to within 1e-3 of its minimum in two (5 in all every 5 object samples), and the window
+  // solve then moves those steps anyway: 2 took 7.7 % of the instructions of an update every 5
+  // object samples (callgrind, BM_IncrementalQs/500/0/0: 0.932e9 -> 0.860e9), with docs/results.md's
+  // QS incremental rows within -0.7..+1.7 % (object RMS) and NEES within -10.1..+8.3 % (ellip1's
+  // force 2.04 -> 1.83). Not for the baseline: its two-finger rows (sim-multi) went 2.84 -> 2.96 mm
+  // and its force NEES 8.2 -> 17.8. CP and SDF have no such stage.
+  static constexpr int kNewStepKinematicIterations = 2;
   static constexpr double kWindowEdgeTolerance = 1e-6;  // s
 
   // Adds the steps up to `target` (every remaining one when take_all) and solves the window.
@@ -397,9 +405,11 @@ struct FixedLagSmoother {
     }
     if (next_step == first_new) return 0.0;
     const auto stage_start = std::chrono::steady_clock::now();
-    // The new steps staged as in the batch solver (the window's older steps held fixed).
+    // The new steps staged as in the batch solver (the window's older steps held fixed); after
+    // the first update their kinematic stage is only the window solve's start, kNewStepKinematicIterations.
     stats.iterations += builder.StageSteps(*problem, first_new, next_step, cfg.incremental_max_iterations,
-                                           cfg.function_tolerance, "incremental update, new steps");
+                                           cfg.function_tolerance, "incremental update, new steps",
+                                           first_new == 0 || builder.model() != Model::kQs ? 0 : kNewStepKinematicIterations);
     const auto solve_start = std::chrono::steady_clock::now();
     // A bounded relinearization per update (as iSAM2's one Gauss-Newton step), WindowIterations.
     const int window_iterations = first_new == 0 ? cfg.incremental_max_iterations : WindowIterations();
