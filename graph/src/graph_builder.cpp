@@ -403,10 +403,10 @@ std::string GraphBuilder::Describe(ceres::ResidualBlockId id) const {
 }
 
 SolveOutcome GraphBuilder::Solve(ceres::Problem& problem, int max_iterations, double function_tolerance,
-                                 const char* what, int soft_iteration_limit) const {
+                                 const char* what, int soft_iteration_limit, double soft_tolerance) const {
   SolveOutcome out;
   const bool soft = soft_iteration_limit > 0 && soft_iteration_limit < max_iterations;
-  const double soft_tolerance = ChainSolverOptions().soft_function_tolerance;
+  if (!(soft_tolerance > 0.0)) soft_tolerance = ChainSolverOptions().soft_function_tolerance;
   if (cfg_.solver == EstimatorConfig::Solver::kCeres) {
     // The soft limit as two solves: soft_iteration_limit - 1 iterations at the tolerance, then
     // the rest at soft_tolerance, so that iteration soft_iteration_limit is the first that can
@@ -440,7 +440,10 @@ SolveOutcome GraphBuilder::Solve(ceres::Problem& problem, int max_iterations, do
   ChainSolverOptions options;
   options.max_iterations = max_iterations;
   options.function_tolerance = function_tolerance;
-  if (soft) options.soft_iteration_limit = soft_iteration_limit;
+  if (soft) {
+    options.soft_iteration_limit = soft_iteration_limit;
+    options.soft_function_tolerance = soft_tolerance;
+  }
   options.describe = [this](ceres::ResidualBlockId id) { return Describe(id); };
   options.log_iterations = SolverLogLevel() >= 2;
   options.model_confirms_convergence = !incremental_;

@@ -128,11 +128,11 @@ class GraphBuilder {
   /// Solves `problem` (built by this builder) with config.solver; `what` names the stage in
   /// logs. Throws GraphError when the solve fails (naming the factor and step when known).
   /// soft_iteration_limit > 0: from that iteration on the solve ends once a step changes the cost
-  /// by less than ChainSolverOptions::soft_function_tolerance of it, unconverged
-  /// (ChainSolverOptions::soft_iteration_limit; Ceres: a second solve at that tolerance after the
-  /// first soft_iteration_limit - 1 iterations).
+  /// by less than soft_tolerance of it (0: ChainSolverOptions::soft_function_tolerance),
+  /// unconverged (ChainSolverOptions::soft_iteration_limit; Ceres: a second solve at that
+  /// tolerance after the first soft_iteration_limit - 1 iterations).
   SolveOutcome Solve(ceres::Problem& problem, int max_iterations, double function_tolerance, const char* what,
-                     int soft_iteration_limit = 0) const;
+                     int soft_iteration_limit = 0, double soft_tolerance = 0.0) const;
   /// The fixed-lag smoother's solves (its windows are refined by later updates and the final
   /// smoothing pass) stop on the function tolerance alone, as they did; batch solves also need
   /// the step's model to agree the change is small (ChainSolverOptions::model_confirms_convergence).

@@ -181,11 +181,11 @@ struct EstimatorConfig {
   /// in the window (incremental_update_every_steps set with the default window): from the third
   /// iteration on, the solve ends at a step that changes the cost by less than 3e-4 of it
   /// (ChainSolverOptions::soft_iteration_limit), a bounded relinearization per update as
-  /// iSAM2's, which goes on where a window is still far from its minimum; and
-  /// incremental_max_iterations otherwise (a step that spends one or two updates in the window
-  /// leaves with the linearization point it had: a limit there costs accuracy,
-  /// docs/estimation.md). A hard cap of 3 at the sensor rate, the default until 2026-11-28, made
-  /// slow real pushes diverge.
+  /// iSAM2's, which goes on where a window is still far from its minimum; every k object samples
+  /// (incremental_update_every_steps unset) the same limit at 3e-5, since a step spends only one
+  /// or two updates in the window and leaves with the linearization point it had (3e-4 there
+  /// cost accuracy, docs/estimation.md); and incremental_max_iterations otherwise. A hard cap of
+  /// 3 at the sensor rate, the default until 2026-11-28, made slow real pushes diverge.
   int incremental_window_iterations = 0;
   /// The final result of the incremental mode (Finish()): true (the default) smooths the whole
   /// trajectory backwards through the Gaussian conditionals its steps left when they were
