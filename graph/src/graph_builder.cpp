@@ -424,7 +424,8 @@ SolveOutcome GraphBuilder::Solve(ceres::Problem& problem, int max_iterations, do
     bool soft_stop = false;
     if (soft && (first_iterations == 0 || summary.termination_type == ceres::NO_CONVERGENCE)) {
       ceres::Solver::Summary rest;
-      ceres::Solve(SolverOptions(max_iterations - first_iterations, soft_tolerance), &problem, &rest);
+      // Never tighter than the ordinary tolerance, on which the chain solver stops first.
+      ceres::Solve(SolverOptions(max_iterations - first_iterations, std::max(soft_tolerance, function_tolerance)), &problem, &rest);
       LogSummary(what, rest);
       if (rest.termination_type == ceres::FAILURE) throw GraphError(std::string(what) + " failed: " + rest.message);
       // Both summaries count Ceres' iteration 0 (the evaluation at the start) as a step.

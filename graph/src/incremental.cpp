@@ -394,10 +394,10 @@ struct FixedLagSmoother {
   // 3.87 and ellip1's QS force NEES 1.83 -> 2.21.
   double WindowSoftTolerance() const { return cfg.incremental_update_every_steps <= 0 ? kWindowSoftToleranceEveryK : 0.0; }
   static constexpr double kWindowSoftToleranceEveryK = 3e-5;
-  // Iterations of the new QS steps' kinematic stage after the first update. The stage lowers the
-  // cost to within 1e-3 of its minimum in two (5 in all every 5 object samples), and the window
-  // solve then moves those steps anyway: 2 took 7.7 % of the instructions of an update every 5
-  // object samples (callgrind, BM_IncrementalQs/500/0/0: 0.932e9 -> 0.860e9), with docs/results.md's
+  // Iterations of the new QS steps' kinematic stage after the first update. Its iterations 3 to 5
+  // (5 in all every 5 object samples) each changed the cost by less than 1e-3 of it, and the window
+  // solve then moves those steps anyway: capping at 2 cut an update's instructions every 5
+  // object samples by 7.7 % (callgrind, BM_IncrementalQs/500/0/0: 0.932e9 -> 0.860e9), with docs/results.md's
   // QS incremental rows within -0.7..+1.7 % (object RMS) and NEES within -10.1..+8.3 % (ellip1's
   // force 2.04 -> 1.83). Not for the baseline: its two-finger rows (sim-multi) went 2.84 -> 2.96 mm
   // and its force NEES 8.2 -> 17.8. CP and SDF have no such stage.
@@ -418,7 +418,8 @@ struct FixedLagSmoother {
     if (next_step == first_new) return 0.0;
     const auto stage_start = std::chrono::steady_clock::now();
     // The new steps staged as in the batch solver (the window's older steps held fixed); after
-    // the first update their kinematic stage is only the window solve's start, kNewStepKinematicIterations.
+    // the first update a QS step's kinematic stage is only the window solve's start
+    // (kNewStepKinematicIterations; the baseline keeps its full stage).
     stats.iterations += builder.StageSteps(*problem, first_new, next_step, cfg.incremental_max_iterations,
                                            cfg.function_tolerance, "incremental update, new steps",
                                            first_new == 0 || builder.model() != Model::kQs ? 0 : kNewStepKinematicIterations);

@@ -171,7 +171,8 @@ struct EstimatorConfig {
   /// re-solves a short window, and the final smoothing pass (incremental_smoothing) brings the
   /// older states to the batch estimate's accuracy.
   int incremental_window_steps = 0;
-  /// Iteration limit of the new steps' staging and of every window solve (the first update's,
+  /// Iteration limit of the new steps' staging (but the new QS steps' kinematic stage after the
+  /// first update: 2) and of every window solve (the first update's,
   /// Finish's re-solve of a last window that stopped at a limit, and every update's unless
   /// incremental_window_iterations applies).
   int incremental_max_iterations = 50;
