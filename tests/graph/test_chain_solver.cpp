@@ -356,6 +356,15 @@ TEST(ChainSolver, SameMinimumAsCeresOnARealRecording) {
   ExpectSameMinimum(t, Model::kQs, "MIT rect1, QS");
 }
 
+// The largest distance between two estimates' object positions, step by step.
+double WorstObjectGap(const EstimationResult& a, const EstimationResult& b) {
+  double worst = 0.0;
+  for (std::size_t k = 0; k < a.states.size() && k < b.states.size(); ++k) {
+    worst = std::max(worst, (a.states[k].object_pose.translation() - b.states[k].object_pose.translation()).norm());
+  }
+  return worst;
+}
+
 // A generated push, its batch QS estimate with the chain solver, and the config of an
 // incremental update at every step.
 struct PerStepCase {
@@ -490,10 +499,7 @@ TEST(ChainSolver, BoundedWindowSolvesAtTheSensorRateKeepTheResult) {
   by_ceres_cfg.solver = EstimatorConfig::Solver::kCeres;
   const EstimationResult by_ceres = Estimate(c.traj, Model::kQs, Mode::kIncremental, by_ceres_cfg);
   ASSERT_EQ(by_ceres.states.size(), n);
-  double ceres_gap = 0.0;
-  for (std::size_t k = 0; k < n; ++k) {
-    ceres_gap = std::max(ceres_gap, (by_ceres.states[k].object_pose.translation() - capped.states[k].object_pose.translation()).norm());
-  }
+  const double ceres_gap = WorstObjectGap(by_ceres, capped);
   std::printf("[bounded window solves] Ceres: %d iterations, |Ceres - chain| worst %.4f mm, object RMS %.3f mm\n",
               by_ceres.solver.iterations, 1e3 * ceres_gap, 1e3 * by_ceres.metrics.at("object_position_rms"));
   EXPECT_LT(ceres_gap, 1e-4);
@@ -538,10 +544,7 @@ TEST(ChainSolver, WindowSolvesEveryFewObjectSamplesStopWhereTheCostSettles) {
   cfg.incremental_window_iterations = cfg.incremental_max_iterations;
   const EstimationResult full = Estimate(traj, Model::kQs, Mode::kIncremental, cfg);
   ASSERT_EQ(soft.states.size(), full.states.size());
-  double worst = 0.0;
-  for (std::size_t k = 0; k < soft.states.size(); ++k) {
-    worst = std::max(worst, (soft.states[k].object_pose.translation() - full.states[k].object_pose.translation()).norm());
-  }
+  const double worst = WorstObjectGap(soft, full);
   const double s = soft.metrics.at("object_position_rms"), f = full.metrics.at("object_position_rms");
   std::printf("[window solves every 5 samples] %d against %d iterations over %d updates; |soft - full| worst %.4f mm; "
               "object RMS %.3f mm against %.3f\n",
@@ -559,10 +562,7 @@ TEST(ChainSolver, WindowSolvesEveryFewObjectSamplesStopWhereTheCostSettles) {
   by_ceres_cfg.solver = EstimatorConfig::Solver::kCeres;
   const EstimationResult by_ceres = Estimate(traj, Model::kQs, Mode::kIncremental, by_ceres_cfg);
   ASSERT_EQ(by_ceres.states.size(), soft.states.size());
-  double ceres_gap = 0.0;
-  for (std::size_t k = 0; k < soft.states.size(); ++k) {
-    ceres_gap = std::max(ceres_gap, (by_ceres.states[k].object_pose.translation() - soft.states[k].object_pose.translation()).norm());
-  }
+  const double ceres_gap = WorstObjectGap(by_ceres, soft);
   std::printf("[window solves every 5 samples] Ceres: %d iterations, |Ceres - chain| worst %.4f mm\n",
               by_ceres.solver.iterations, 1e3 * ceres_gap);
   EXPECT_LT(ceres_gap, 1e-4);
