@@ -514,7 +514,9 @@ EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode 
                            : yaw_unit        ? "yaws that read as degrees"
                            : tracker_step    ? "a step of the object's tracker"
                            : force_direction ? "a force whose direction does not fit the finger's motion"
-                           : force_bias      ? "a force sensor that reads a force out of contact"
+                           : force_bias      ? (force_bias->find("force stream looks") != std::string::npos
+                                                    ? "a force stream out of step with the contact stream"
+                                                    : "a force sensor that reads a force out of contact")
                                              : nullptr;
   EstimationResult r = EstimateValidated(input, model, mode, config, unit_doubt);
   // A covariance failure was only in RESULT.json's solver.covariance (NEES NaN, nothing said).
