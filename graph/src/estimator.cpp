@@ -507,16 +507,15 @@ EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode 
   // 1 N high throughout, had the true shape "aligned" by 45 or 36 mm to explain it (a hostile
   // user's session: 3.04 mm against 2.71 mm raw).
   const std::optional<std::string> force_direction = internal::ForceDirectionNote(input);
-  const std::optional<std::string> force_bias = internal::ForceBiasNote(input);
+  const std::optional<internal::ForceOutOfContactNote> force_bias = internal::ForceBiasNote(input);
   const std::string time_doubt = std::string("time stamps that read as ") + clock_unit;
   const char* unit_doubt = time_unit         ? time_doubt.c_str()
                            : length_unit     ? "lengths that read as centimetres or millimetres"
                            : yaw_unit        ? "yaws that read as degrees"
                            : tracker_step    ? "a step of the object's tracker"
                            : force_direction ? "a force whose direction does not fit the finger's motion"
-                           : force_bias      ? (force_bias->find("force stream looks") != std::string::npos
-                                                    ? "a force stream out of step with the contact stream"
-                                                    : "a force sensor that reads a force out of contact")
+                           : force_bias      ? (force_bias->clock_offset ? "a force stream out of step with the contact stream"
+                                                                             : "a force sensor that reads a force out of contact")
                                              : nullptr;
   EstimationResult r = EstimateValidated(input, model, mode, config, unit_doubt);
   // A covariance failure was only in RESULT.json's solver.covariance (NEES NaN, nothing said).
@@ -554,7 +553,7 @@ EstimationResult Estimate(const push::Trajectory& trajectory, Model model, Mode 
   if (!note.empty()) front.push_back(note);
   if (!glitch_note.empty()) front.push_back(glitch_note);
   add(force_direction);
-  add(force_bias);
+  if (force_bias) front.push_back(force_bias->text);
   add(internal::ForceScaleNote(input, config.measurement.force));
   add(internal::MeasurementSigmaNote(input, config.measurement));
   r.warnings.insert(r.warnings.begin(), front.begin(), front.end());

@@ -516,8 +516,13 @@ std::optional<std::string> ForceDirectionNote(const push::Trajectory& trajectory
 /// least 10), whose mean is over 4 standard errors and over 0.05 N: a bias (an untared sensor).
 /// Null without a contact stream to tell contact by. Where shifting the force stream's time
 /// stamps by more than that margin (within +-1 s) makes its magnitude follow the contact rows
-/// and leaves no clear force out of contact, the warning names the clock offset instead.
-std::optional<std::string> ForceBiasNote(const push::Trajectory& trajectory);
+/// and leaves no clear force out of contact, the warning names the clock offset instead
+/// (`clock_offset`).
+struct ForceOutOfContactNote {
+  std::string text;
+  bool clock_offset = false;  // the force and contact streams' clocks disagree, rather than a bias
+};
+std::optional<ForceOutOfContactNote> ForceBiasNote(const push::Trajectory& trajectory);
 /// A warning when the measured forces' 95th percentile is over 20 times the object's friction load
 /// mu m g (and 5 force sigmas), or their fifth largest under 1/20 of it while the object moves over
 /// 1 cm (a quasi-static push needs about that load): another force unit, or a wrong mass or mu.

@@ -717,7 +717,7 @@ std::optional<double> ForceStreamLag(const std::vector<push::ForceSample>& force
 
 }  // namespace
 
-std::optional<std::string> ForceBiasNote(const push::Trajectory& traj) {
+std::optional<ForceOutOfContactNote> ForceBiasNote(const push::Trajectory& traj) {
   const auto& forces = traj.measured.force;
   const auto& contacts = traj.measured.contact_point;
   if (forces.size() < 20 || contacts.size() < 10 || !traj.extra_fingers.empty()) return std::nullopt;
@@ -733,28 +733,31 @@ std::optional<std::string> ForceBiasNote(const push::Trajectory& traj) {
   if (const std::optional<double> lag = ForceStreamLag(forces, contacts); lag && std::abs(*lag) > kMargin) {
     const OutOfContactForce shifted = ForceOutOfContact(forces, first, last, *lag);
     if (shifted.count >= kFewestOutOfContact && !shifted.Clear()) {
-      return Format("force: the force stream looks about %.2f s %s against the contact stream: shifted by %+.2f s its force "
+      return ForceOutOfContactNote{
+          Format("force: the force stream looks about %.2f s %s against the contact stream: shifted by %+.2f s its force "
                     "rises and falls with the contact rows, and out of contact it reads %.3g N (%zu samples) instead of "
                     "%.3g N as stamped (%zu samples): are the two sensors' clocks offset? Shift the force stream's time "
                     "stamps by %+.2f s, or the contact stream's by %+.2f s if its clock is the one off (a simulated "
                     "push's force stamped 0.2 s late: force estimate 0.95 N RMS against 0.50 N raw)",
                     std::abs(*lag), *lag > 0.0 ? "late" : "early", -*lag, shifted.mean.norm(), shifted.count,
-                    as_stamped.mean.norm(), as_stamped.count, -*lag, *lag);
+                    as_stamped.mean.norm(), as_stamped.count, -*lag, *lag),
+          true};
     }
   }
   std::vector<double>& touching = as_stamped.touching;
   const geometry::Vec2 mean = as_stamped.mean;
   const double standard_error = as_stamped.standard_error;
-  const std::size_t free_count = as_stamped.count;
   std::nth_element(touching.begin(), touching.begin() + touching.size() / 2, touching.end());
   // A stream that does not scatter there (a sensor stuck at a value, or quantized) has no standard error to count in.
   const std::string how_clear =
       standard_error > 0.0 ? Format("%.3g standard errors", mean.norm() / standard_error) : std::string("without scatter");
-  return Format("force: the sensor reads a mean (%.3g, %.3g) N (%s) over the %zu samples before and after the contact "
+  return ForceOutOfContactNote{
+      Format("force: the sensor reads a mean (%.3g, %.3g) N (%s) over the %zu samples before and after the contact "
                 "stream, where the finger does not touch (median %.3g N in contact): a bias, or a sensor stuck at a value? "
                 "Tare the sensor, or subtract the bias from the stream (a bias of a fifth of the push's force moved a true "
                 "shape by 17 mm)",
-                mean.x(), mean.y(), how_clear.c_str(), free_count, touching[touching.size() / 2]);
+                mean.x(), mean.y(), how_clear.c_str(), as_stamped.count, touching[touching.size() / 2]),
+      false};
 }
 
 std::optional<std::string> ForceScaleNote(const push::Trajectory& traj, double force_sigma) {
