@@ -579,6 +579,17 @@ TEST_F(EstimateCli, TheGraphsShapeFrameIsFreedOnlyFromAConvergedEstimate) {
   EXPECT_LT(moved, 5e-3) << r.err;
   EXPECT_LT(rms, given_rms + 1e-4) << r.err;
   EXPECT_EQ(r.err.find("iteration limit"), std::string::npos) << r.err;
+  // A solve stopped at its iteration limit is short of a minimum: its curvature is no sigma.
+  const std::string capped = dir() + "/capped.json", config = dir() + "/capped_config.json";
+  std::ofstream(config) << R"({"max_iterations": 3})";
+  const pushgraph::testing::ToolRun c =
+      EstimateMit(h5, "ellip1.obj", "", kProbe, kEllip1Mass, capped, "--model cp --align-shape on --config " + config);
+  ASSERT_EQ(c.status, 0) << c.err;
+  const nlohmann::json cj = Load(capped);
+  ASSERT_TRUE(cj["shape"]["aligned"].get<bool>()) << c.err;
+  EXPECT_FALSE(cj["shape"]["placement_settled"].get<bool>()) << c.err;
+  EXPECT_TRUE(cj["parameters"]["shape_transform_sigma"].is_null()) << c.err;
+  EXPECT_NE(c.err.find("the solve with the frame free stopped at its iteration limit"), std::string::npos) << c.err;
   // A recording whose contacts leave the shift across them open: the mesh shifted by 36 mm is
   // aligned back, and estimated as with the true mesh.
   const std::string h5b = Mit() + "abs/ellip1/motion_surface=abs_shape=ellip1_a=0_v=100_i=0.000_s=0.075_t=0.698.h5";
