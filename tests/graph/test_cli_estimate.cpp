@@ -605,6 +605,20 @@ TEST_F(EstimateCli, TheGraphsShapeFrameIsFreedOnlyFromAConvergedEstimate) {
   std::printf("[registration] ellip1 mesh shifted 36 mm, CP: object RMS %.2f mm (true mesh %.2f)\n", shifted_rms * 1e3,
               true_rms * 1e3);
   EXPECT_LT(shifted_rms, true_rms + 2e-4) << s.err;
+  // The transform it offers to save puts the circle back on its centre (the ranking's own frame
+  // put it 47 mm off, "sigma 5.2 and 1.4 mm").
+  const auto& fix = k["parameters"]["shape_transform"];
+  char transform[160];
+  std::snprintf(transform, sizeof transform, " --transform %.9g,%.9g,%.9g", fix[0].get<double>(), fix[1].get<double>(),
+                fix[2].get<double>());
+  const std::string fixed = dir() + "/fixed.json";
+  ASSERT_EQ(Tool("footprint " + dir() + "/user_shape.json" + transform + " -o " + fixed + " -q").status, 0);
+  double cx = 0.0, cy = 0.0;
+  const nlohmann::json fixed_shape = Load(fixed);
+  const auto& outer = fixed_shape["polygons"][0]["outer"];
+  for (const auto& v : outer) cx += v[0].get<double>() / outer.size(), cy += v[1].get<double>() / outer.size();
+  std::printf("[registration] the saved transform puts the circle's centre at (%.1f, %.1f) mm\n", cx * 1e3, cy * 1e3);
+  EXPECT_LT(std::hypot(cx, cy), 3e-3) << s.err;
 }
 
 // A mesh in millimetres and otherwise right: the units alone compete in the whole graph with the
