@@ -731,6 +731,7 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
     }
     ShapeTransform best, refined;
     ShapeTransform best_candidate = registration->transform;  // the winner before the graph's frame
+    std::size_t best_rank = 0;                                  // the winner's entry in `ranked`
     const SolverStats first = framed_cost(judged, registration->transform, &best, quick);
     double best_cost = first.final_cost;
     best_stalled = first.stalled;
@@ -778,6 +779,7 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
         best_cost = cost;
         best = refined;
         best_candidate = alt;
+        best_rank = ranked.size() - 1;
         best_stalled = solve.stalled;
         best_label = label;
         identity_wins = false;
@@ -828,8 +830,13 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
     // The ranking's solves free the frame from the staged start (their costs and margins decide
     // which placement wins), where it can drift: on a real ellip1 push with its mesh shifted 36 mm,
     // CP, the winner's frame ended 47 mm from the truth "(sigma 1.4 mm)". The winner's frame is
-    // refined again from its placement, held until the rest has converged.
-    if (!identity_wins && !units_win) framed_cost(judged, best_candidate, &best, quick, nullptr, /*hold_first=*/true);
+    // refined again from its placement, held until the rest has converged: by the final batch
+    // solve, which starts from the placement; for the incremental mode, which keeps the frame
+    // fixed, by one more solve here.
+    if (!identity_wins && !units_win) {
+      if (mode == Mode::kBatch) best = best_candidate;
+      else framed_cost(judged, best_candidate, &best, quick, nullptr, /*hold_first=*/true);
+    }
     // The graph-refined placement: the start of the final batch solve, or (incremental) the
     // frame kept fixed while smoothing (from a converged solve: with a capped one the frame
     // depended on where it stopped, and Alignment.IncrementalModeUsesTheAlignedShape's estimate
@@ -846,7 +853,9 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
       }
     } else {
       const double winner = best_cost;
-      for (const auto& [t, cost] : ranked) {
+      for (std::size_t k = 0; k < ranked.size(); ++k) {
+        if (k == best_rank && !units_win) continue;  // the winner's own ranking solve
+        const auto& [t, cost] = ranked[k];
         const ShapeTransform c = CanonicalTransform(t, trajectory.object.shape, registration->symmetry_order);
         const double turn = std::abs(geometry::WrapAngle(c.pose.theta - registration->transform.pose.theta));
         const double shift = std::hypot(c.pose.x - registration->transform.pose.x, c.pose.y - registration->transform.pose.y);
