@@ -832,7 +832,7 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
     // CP, the winner's frame ended 47 mm from the truth "(sigma 1.4 mm)". The winner's frame is
     // refined again from its placement, held until the rest has converged, by one more solve.
     // (Starting the final batch solve from the placement itself instead saves that solve, 10.2
-    // -> 4.9 s on a 3000-step ellip1 recording, but F's prior is centred where a solve starts,
+    // -> 4.9 s on a 590-step ellip1 recording, but F's prior is centred where a solve starts,
     // and one refinement from the contacts' placement left simulated ellip2 pushes with turned
     // meshes at 0.77 to 0.98 mm against 0.60 to 0.70 with this one and 0.59 as given.)
     if (!identity_wins && !units_win) framed_cost(judged, best_candidate, &best, quick, nullptr, /*hold_first=*/true);
