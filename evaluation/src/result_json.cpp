@@ -112,6 +112,8 @@ Json ResultJson(const graph::EstimationResult& r, bool with_states) {
     if (r.mu_sigma) parameters["mu_sigma"] = *r.mu_sigma;
     if (r.mu_at_bound) parameters["mu_at_bound"] = true;
   }
+  if (r.finger_scale != 1.0) parameters["finger_scale"] = r.finger_scale;
+  if (!r.finger_shift.isZero(0.0)) parameters["finger_transform"] = {r.finger_shift.x(), r.finger_shift.y(), 0.0};
   if (r.shape_alignment) {
     const graph::ShapeAlignment& a = *r.shape_alignment;
     // The shape check and, when aligned, the transform used (shape file -> object frame).

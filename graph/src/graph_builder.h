@@ -540,6 +540,11 @@ std::optional<std::string> TrackerStepNote(const push::Trajectory& trajectory);
 /// A warning when the object's shape reaches more than 1 m from its centroid: a file in
 /// centimetres or millimetres throughout (shapes and positions agree, so nothing else sees it).
 std::optional<std::string> ShapeSizeNote(const push::Trajectory& trajectory);
+/// Finger shape files in millimetres (align_shape auto and on): a finger whose origin lies deeper
+/// inside it than the whole push reaches (ValidateTrajectory refuses it), and that scaled by 0.001
+/// is a tabletop probe (0.5 to 100 mm about its origin) the push fits, is scaled. Returns the
+/// trajectory with every such finger scaled and sets `note`; nullopt when none is.
+std::optional<push::Trajectory> FingersInMillimetres(const push::Trajectory& trajectory, std::string* note);
 /// A warning naming every measurement sigma above ten times the range of its stream's values
 /// (and above 1 cm, 1 N; rotation above 10 rad): such a stream carries no weight.
 std::optional<std::string> MeasurementSigmaNote(const push::Trajectory& trajectory, const push::MeasurementSigmas& sigmas);

@@ -5,6 +5,7 @@
 #include "text.h"
 
 #include <pushgraph/geometry/point_query.h>
+#include <pushgraph/geometry/pose.h>
 #include <pushgraph/geometry/shape.h>
 #include <pushgraph/geometry/shape_pair.h>
 #include <pushgraph/limit_surface/support.h>
@@ -308,25 +309,45 @@ void CheckNoClockJump(const std::vector<Sample>& s, const std::string& stream, d
 // other units (a probe of radius 4.7 given in millimetres was read as 4.7 m, and the shape check
 // then "aligned" the object 4 m away; a 32-gon probe in millimetres ran for 51 s to an object
 // 2.5 m off the tracker's, exit 0). The object's own units the registration detects.
-void CheckFingerSize(const geometry::Shape& finger, const std::vector<push::PoseSample>& finger_pose,
-                     const std::vector<push::PoseSample>& object_pose, const geometry::Shape& object, const std::string& who) {
-  if (finger.empty() || finger_pose.empty() || object_pose.empty()) return;
-  double farthest = 0.0;
+// How deep the finger's origin lies inside it (a disk's: its radius), rounded or polygonal alike,
+// against how far the push reaches: the finger's farthest distance from the object's origin and
+// the object's reach about it. Deeper than both together, the finger would hold the whole object
+// inside it at every sample.
+struct FingerDepth {
+  double depth = 0.0, farthest = 0.0, object_reach = 0.0;
+  bool HoldsWholePush() const { return depth > farthest + object_reach; }
+};
+
+std::optional<FingerDepth> MeasureFingerDepth(const geometry::Shape& finger, const std::vector<push::PoseSample>& finger_pose,
+                                              const std::vector<push::PoseSample>& object_pose, const geometry::Shape& object) {
+  if (finger.empty() || finger_pose.empty() || object_pose.empty()) return std::nullopt;
+  FingerDepth d;
   std::size_t k = 0;
   for (const push::PoseSample& f : finger_pose) {
     while (k + 1 < object_pose.size() && std::abs(object_pose[k + 1].t - f.t) <= std::abs(object_pose[k].t - f.t)) ++k;
-    farthest = std::max(farthest, (f.pose.translation() - object_pose[k].pose.translation()).norm());
+    d.farthest = std::max(d.farthest, (f.pose.translation() - object_pose[k].pose.translation()).norm());
   }
-  const double object_reach = geometry::RadiusAbout(object, geometry::Vec2::Zero());
-  // How deep the finger's origin lies inside it (a disk's: its radius), rounded or polygonal alike.
-  const double depth = -geometry::QueryPoint(finger, geometry::Vec2::Zero()).signed_distance;
-  if (!(depth > farthest + object_reach)) return;
+  d.object_reach = geometry::RadiusAbout(object, geometry::Vec2::Zero());
+  d.depth = -geometry::QueryPoint(finger, geometry::Vec2::Zero()).signed_distance;
+  return d;
+}
+
+// A finger whose origin lies deeper inside it than every finger-object distance of the recording
+// plus the object's reach: its file is in other units (a probe of radius 4.7 given in millimetres
+// was read as 4.7 m, and the shape check then "aligned" the object 4 m away; a 32-gon probe in
+// millimetres ran for 51 s to an object 2.5 m off the tracker's, exit 0). The object's own units
+// the registration detects; a finger in millimetres FingersInMillimetres scales (align_shape auto
+// and on) before this check.
+void CheckFingerSize(const geometry::Shape& finger, const std::vector<push::PoseSample>& finger_pose,
+                     const std::vector<push::PoseSample>& object_pose, const geometry::Shape& object, const std::string& who) {
+  const std::optional<FingerDepth> d = MeasureFingerDepth(finger, finger_pose, object_pose, object);
+  if (!d || !d->HoldsWholePush()) return;
   throw GraphError(Format("trajectory: %sthe finger's shape covers %.6g m about its origin (its rounding radius %.6g m), "
                           "more than the whole push: the finger stays within %.3g m of the object's origin and the object "
                           "within %.3g m of it, so at every sample the finger would hold the whole object inside it. Is the "
                           "finger's shape file in millimetres? Shape files are in metres (pushgraph footprint FILE --scale "
                           "0.001 converts one)",
-                          who.c_str(), depth, finger.radius(), farthest, object_reach));
+                          who.c_str(), d->depth, finger.radius(), d->farthest, d->object_reach));
 }
 
 }  // namespace
@@ -1023,6 +1044,43 @@ std::optional<std::string> ShapeSizeNote(const push::Trajectory& traj) {
                 "worse than the measurements: divide every length by %d",
                 reach, 2.0 * reach, traj.finger.shape.radius(), milli ? "millimetres" : "centimetres",
                 milli ? "millimetres" : "centimetres", 2.0 * reach * (milli ? 0.1 : 1.0), milli ? 1000 : 100);
+}
+
+std::optional<push::Trajectory> FingersInMillimetres(const push::Trajectory& traj, std::string* note) {
+  // The object's reach as it would be in metres: a whole set of files in millimetres (object and
+  // finger alike, a CAD export) has the object 1000 times too large as well, which would hide
+  // the finger's units from the check (the registration finds the object's; ShapeSizeNote
+  // covers a trajectory file in millimetres throughout, positions included, which this leaves).
+  geometry::Shape object = traj.object.shape;
+  if (!object.empty() && geometry::RadiusAbout(object, geometry::CoreCentroid(object)) > 1.0)
+    object = geometry::TransformShape(object, geometry::Pose2(), 1e-3);
+  std::optional<push::Trajectory> scaled;
+  std::vector<std::string> said;
+  auto consider = [&](const geometry::Shape& finger, const std::vector<push::PoseSample>& poses, int index) {
+    const std::optional<FingerDepth> as_given = MeasureFingerDepth(finger, poses, traj.measured.object_pose, object);
+    if (!as_given || !as_given->HoldsWholePush()) return;
+    const geometry::Shape milli = geometry::TransformShape(finger, geometry::Pose2(), 1e-3);
+    const std::optional<FingerDepth> in_metres = MeasureFingerDepth(milli, poses, traj.measured.object_pose, object);
+    // Read as millimetres, a tabletop probe is 0.5 to 100 mm deep about its origin (a wrist-held
+    // paddle is no finger file in millimetres that the check refused).
+    if (!in_metres || in_metres->HoldsWholePush() || !(in_metres->depth >= 5e-4 && in_metres->depth <= 0.1)) return;
+    if (!scaled) scaled = traj;
+    (index == 0 ? scaled->finger.shape : scaled->extra_fingers[index - 1].finger.shape) = milli;
+    said.push_back(Format("%s covers %.4g m about its origin, more than the whole push (the finger stays within %.3g m "
+                          "of the object's origin), so it is read as millimetres: %.4g mm (rounding radius %.4g mm)",
+                          index == 0 ? "the finger's shape" : ("fingers[" + std::to_string(index) + "]'s shape").c_str(),
+                          as_given->depth, as_given->farthest, in_metres->depth * 1e3, milli.radius() * 1e3));
+  };
+  consider(traj.finger.shape, traj.measured.finger_pose, 0);
+  for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k)
+    consider(traj.extra_fingers[k].finger.shape, traj.extra_fingers[k].measured.finger_pose, static_cast<int>(k) + 1);
+  if (scaled && note) {
+    std::string text;
+    for (const std::string& s : said) text += (text.empty() ? "" : "; ") + s;
+    *note = text + ". Shape files are in metres: to save the finger so, pushgraph footprint FILE --scale 0.001 -o "
+                   "finger.json (align_shape \"off\" refuses such a finger instead)";
+  }
+  return scaled;
 }
 
 std::optional<std::string> MeasurementSigmaNote(const push::Trajectory& traj, const push::MeasurementSigmas& sigma) {

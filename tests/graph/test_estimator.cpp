@@ -163,21 +163,99 @@ TEST(Estimator, TimeStampsInMillisecondsAreNamed) {
   }
 }
 
-// A finger file in millimetres read as metres holds the whole push inside it: refused, naming the
-// units, whether it is a rounded disk or a polygon (a 32-gon probe in mm ran 51 s to 2.5 m off).
-TEST(Estimator, AFingerInMillimetresIsRefused) {
+bool HasWarning(const EstimationResult& r, const std::string& text) {
+  for (const std::string& w : r.warnings)
+    if (w.find(text) != std::string::npos) return true;
+  return false;
+}
+
+// A finger file in millimetres read as metres holds the whole push inside it (a 32-gon probe in
+// mm ran 51 s to 2.5 m off). align_shape "off" refuses it, naming the units, whether it is a
+// rounded disk or a polygon; "auto" and "on" read it as millimetres, as the shape check does the
+// object's file, say so and estimate as with the probe in metres. A finger that scaled by 0.001
+// is no probe (under 0.5 mm) is refused under auto too.
+TEST(Estimator, AFingerInMillimetresIsReadAsSuchOrRefused) {
   push::Trajectory t = GeneratePush(OffsetPush(3, 0.5));
+  const geometry::Shape given = t.finger.shape;
+  ASSERT_NEAR(given.radius(), 0.005, 1e-12);
+  EstimatorConfig off;
+  off.align_shape = EstimatorConfig::AlignShape::kOff;
   for (const geometry::Shape& finger : {geometry::Shape::Disk(4.7), geometry::Shape::RegularPolygon(32, 4.7)}) {
     t.finger.shape = finger;
     try {
-      Estimate(t, Model::kQs, Mode::kBatch);
+      Estimate(t, Model::kQs, Mode::kBatch, off);
       ADD_FAILURE() << "a finger of " << finger.num_vertices() << " vertices, 4.7 m, was accepted";
     } catch (const GraphError& e) {
       EXPECT_NE(std::string(e.what()).find("Is the finger's shape file in millimetres?"), std::string::npos) << e.what();
     }
   }
+  t.finger.shape = given;
+  const EstimationResult in_metres = Estimate(t, Model::kQs, Mode::kBatch);
+  EXPECT_EQ(in_metres.finger_scale, 1.0);
+  for (const EstimatorConfig::AlignShape align : {EstimatorConfig::AlignShape::kAuto, EstimatorConfig::AlignShape::kOn}) {
+    EstimatorConfig config;
+    config.align_shape = align;
+    t.finger.shape = geometry::TransformShape(given, geometry::Pose2(), 1000.0);  // the probe in millimetres
+    const EstimationResult r = Estimate(t, Model::kQs, Mode::kBatch, config);
+    EXPECT_EQ(r.finger_scale, 1e-3);
+    EXPECT_TRUE(HasWarning(r, "so it is read as millimetres: 5 mm")) << ::testing::PrintToString(r.warnings);
+    EXPECT_TRUE(HasWarning(r, "pushgraph footprint FILE --scale 0.001")) << ::testing::PrintToString(r.warnings);
+    if (align == EstimatorConfig::AlignShape::kAuto) {
+      ASSERT_EQ(r.states.size(), in_metres.states.size());
+      for (std::size_t i = 0; i < r.states.size(); ++i)
+        EXPECT_LT((r.states[i].object_pose.translation() - in_metres.states[i].object_pose.translation()).norm(), 1e-6) << i;
+    }
+  }
+  // 400 "m" read as millimetres would be a 0.4 m finger, no probe: refused under auto as well.
+  t.finger.shape = geometry::Shape::Disk(400.0);
+  try {
+    Estimate(t, Model::kCp, Mode::kBatch);
+    ADD_FAILURE() << "a finger of radius 400 m was accepted";
+  } catch (const GraphError& e) {
+    EXPECT_NE(std::string(e.what()).find("Is the finger's shape file in millimetres?"), std::string::npos) << e.what();
+  }
   t.finger.shape = geometry::Shape::RegularPolygon(32, 0.0047);  // the probe in metres
   EXPECT_NO_THROW(Estimate(t, Model::kCp, Mode::kBatch));
+}
+
+// A finger file drawn off its pose origin (the probe's disk 10 mm beside it): the contacts fit it
+// centred on the tracked point and not as given, so "auto" estimates with it centred and says
+// so; the same file with poses that really are a marker's 10 mm beside the tip fits as given and
+// is only noted; "off" keeps the file's frame.
+TEST(Estimator, AFingerFileOffItsOriginIsCentredWhenTheContactsSaySo) {
+  const push::Trajectory t = GeneratePush(OffsetPush(2, 0.8));
+  const geometry::Vec2 offset(0.010, 0.0);
+  const EstimationResult truth = Estimate(t, Model::kCp, Mode::kBatch);
+  auto off_axis = t;
+  off_axis.finger.shape = geometry::TransformShape(t.finger.shape, geometry::Pose2{offset.x(), offset.y(), 0.0});
+  const EstimationResult r = Estimate(off_axis, Model::kCp, Mode::kBatch);
+  EXPECT_TRUE(HasWarning(r, "its shape lies 5.0 mm outside its pose origin")) << ::testing::PrintToString(r.warnings);
+  EXPECT_TRUE(HasWarning(r, "estimated with it centred")) << ::testing::PrintToString(r.warnings);
+  EXPECT_TRUE(HasWarning(r, "--transform -0.01,0,0")) << ::testing::PrintToString(r.warnings);
+  EXPECT_NEAR(r.finger_shift.x(), -offset.x(), 1e-15);
+  EXPECT_NEAR(r.finger_shift.y(), -offset.y(), 1e-15);
+  ASSERT_EQ(r.states.size(), truth.states.size());
+  for (std::size_t i = 0; i < r.states.size(); ++i)
+    EXPECT_LT((r.states[i].object_pose.translation() - truth.states[i].object_pose.translation()).norm(), 1e-9) << i;
+  EstimatorConfig off;
+  off.align_shape = EstimatorConfig::AlignShape::kOff;
+  const EstimationResult kept = Estimate(off_axis, Model::kCp, Mode::kBatch, off);
+  EXPECT_TRUE(kept.finger_shift.isZero(0.0));
+  EXPECT_FALSE(HasWarning(kept, "outside its pose origin"));
+  // Poses that are a marker's beside the tip: the file's frame is right.
+  auto marker = off_axis;
+  auto move = [&](std::vector<push::PoseSample>& poses) {
+    for (push::PoseSample& p : poses) {
+      const geometry::Vec2 o = p.pose.rotation() * offset;
+      p.pose.x -= o.x(), p.pose.y -= o.y();
+    }
+  };
+  move(marker.measured.finger_pose);
+  move(marker.ground_truth->finger_pose);
+  const EstimationResult as_marker = Estimate(marker, Model::kCp, Mode::kBatch);
+  EXPECT_TRUE(as_marker.finger_shift.isZero(0.0));
+  EXPECT_TRUE(HasWarning(as_marker, "as given the contacts fit it")) << ::testing::PrintToString(as_marker.warnings);
+  EXPECT_LT(as_marker.metrics.at("object_position_rms"), 1.2 * truth.metrics.at("object_position_rms"));
 }
 
 // A friction load below a millinewton (1e-30 kg, or 1e-5 kg: a mass in the wrong unit) is refused by the
@@ -199,12 +277,6 @@ TEST(Estimator, AFrictionLoadBelowAMillinewtonIsRefused) {
   }
   t.object.mass = 2e-3;  // 2 g at mu 0.25: 4.9 mN, supported
   EXPECT_NO_THROW(Estimate(t, Model::kQs, Mode::kBatch));
-}
-
-bool HasWarning(const EstimationResult& r, const std::string& text) {
-  for (const std::string& w : r.warnings)
-    if (w.find(text) != std::string::npos) return true;
-  return false;
 }
 
 // A force stream with its sign flipped (the force on the sensor) or its axes swapped does
@@ -791,7 +863,14 @@ TEST(Estimator, BadTrajectoriesGetClearErrors) {
   for (const double radius : {5.0, 0.005, 0.1}) {
     auto sized = t;
     sized.finger.shape = geometry::Shape::Disk(radius);
-    const std::string m = message(sized);
+    std::string m = "no error";
+    EstimatorConfig off;  // "auto" reads the 5 "m" probe as millimetres (AFingerInMillimetresIsReadAsSuchOrRefused)
+    off.align_shape = EstimatorConfig::AlignShape::kOff;
+    try {
+      Estimate(sized, Model::kQs, Mode::kBatch, off);
+    } catch (const GraphError& e) {
+      m = e.what();
+    }
     EXPECT_EQ(m.find("Is the finger's shape file in millimetres?") != std::string::npos, radius == 5.0) << radius << ": " << m;
   }
   // Clock jumps (a corrupted time stamp 1e9 s ahead) are refused at once in batch and

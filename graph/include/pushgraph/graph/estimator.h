@@ -160,6 +160,17 @@ struct EstimationResult {
   /// force_rms (N); the same of the raw measurements as measured_*; and the mean normalized
   /// estimation error squared object_pose_nees (dimension 3) etc. where covariances exist.
   std::map<std::string, double> metrics;
+  /// The scale applied to the finger shape files (1; 0.001 when a finger's file read as metres
+  /// would hold the whole push inside it and, read as millimetres, is a tabletop probe:
+  /// align_shape auto and on, said in the warnings; "off" refuses such a finger). RESULT.json
+  /// parameters.finger_scale, written when not 1.
+  double finger_scale = 1.0;
+  /// The shift (m, in the finger's frame) applied to finger 0's shape (after finger_scale): zero;
+  /// with align_shape auto, when its pose origin lies over 1 mm outside the shape (or a disk's
+  /// centre over 1 mm off it) and the contacts (graph::CheckShapeFit) fit the finger centred on
+  /// it and not as given, or clearly closer, minus the shape's centroid (said in the warnings).
+  /// RESULT.json parameters.finger_transform [x, y, 0], written when not zero.
+  geometry::Vec2 finger_shift = geometry::Vec2::Zero();
   /// The shape check and alignment (RESULT.json parameters.shape_transform and "shape").
   std::optional<ShapeAlignment> shape_alignment;
   /// Self-diagnosis (config.diagnostics; RESULT.json "diagnostics"); its causes are also in
