@@ -540,11 +540,19 @@ std::optional<std::string> TrackerStepNote(const push::Trajectory& trajectory);
 /// A warning when the object's shape reaches more than 1 m from its centroid: a file in
 /// centimetres or millimetres throughout (shapes and positions agree, so nothing else sees it).
 std::optional<std::string> ShapeSizeNote(const push::Trajectory& trajectory);
-/// Finger shape files in millimetres (align_shape auto and on): a finger whose origin lies deeper
-/// inside it than the whole push reaches (ValidateTrajectory refuses it), and that scaled by 0.001
-/// is a tabletop probe (0.5 to 100 mm about its origin) the push fits, is scaled. Returns the
-/// trajectory with every such finger scaled and sets `note`; nullopt when none is.
-std::optional<push::Trajectory> FingersInMillimetres(const push::Trajectory& trajectory, std::string* note);
+/// The trajectory with its object's shape read as millimetres when it reaches over 1 m from its
+/// centroid (a CAD export): what the finger's own checks (FingerUnits, the finger's origin) judge
+/// the finger against, before the registration finds the object's units.
+push::Trajectory WithObjectInMetres(const push::Trajectory& trajectory);
+/// Finger shape files in other units (align_shape auto and on): a finger whose origin lies
+/// deeper inside it than the whole push reaches (ValidateTrajectory refuses it), or whose file
+/// reaches over 1 m from its origin, is read in the unit (millimetres, centimetres, inches) that
+/// makes it a tabletop probe (0.5 to 100 mm from its origin) whose contacts fit the object
+/// (CheckShapeFit, the smallest median gap); when none fits, millimetres if that is a probe.
+/// Returns the trajectory with every such finger scaled, sets `note` and `finger_scale` (the
+/// last scale applied); nullopt when none is.
+std::optional<push::Trajectory> FingerUnits(const push::Trajectory& trajectory, const RegistrationOptions& options,
+                                            std::string* note, double* finger_scale);
 /// A warning naming every measurement sigma above ten times the range of its stream's values
 /// (and above 1 cm, 1 N; rotation above 10 rad): such a stream carries no weight.
 std::optional<std::string> MeasurementSigmaNote(const push::Trajectory& trajectory, const push::MeasurementSigmas& sigmas);

@@ -332,22 +332,52 @@ std::optional<FingerDepth> MeasureFingerDepth(const geometry::Shape& finger, con
   return d;
 }
 
+// The units a finger file read as metres may be in: those that make it a tabletop probe, 0.5 to
+// 100 mm from its origin to its farthest point, that does not hold the push inside it.
+struct FingerReading {
+  double scale;
+  const char* unit;
+  double reach;  // m, from its origin, so read
+};
+std::vector<FingerReading> FingerReadings(const geometry::Shape& finger, const std::vector<push::PoseSample>& finger_pose,
+                                          const std::vector<push::PoseSample>& object_pose, const geometry::Shape& object) {
+  std::vector<FingerReading> readings;
+  if (finger.empty()) return readings;
+  const double reach = geometry::RadiusAbout(finger, geometry::Vec2::Zero());
+  for (const auto& [scale, unit] : {std::pair{1e-3, "millimetres"}, {1e-2, "centimetres"}, {0.0254, "inches"}}) {
+    if (!(scale * reach >= 5e-4 && scale * reach <= 0.1)) continue;
+    const std::optional<FingerDepth> d =
+        MeasureFingerDepth(geometry::TransformShape(finger, geometry::Pose2(), scale), finger_pose, object_pose, object);
+    if (d && !d->HoldsWholePush()) readings.push_back({scale, unit, scale * reach});
+  }
+  return readings;
+}
+
 // A finger whose origin lies deeper inside it than every finger-object distance of the recording
 // plus the object's reach: its file is in other units (a probe of radius 4.7 given in millimetres
 // was read as 4.7 m, and the shape check then "aligned" the object 4 m away; a 32-gon probe in
 // millimetres ran for 51 s to an object 2.5 m off the tracker's, exit 0). The object's own units
-// the registration detects; a finger in millimetres FingersInMillimetres scales (align_shape auto
-// and on) before this check.
+// the registration detects; a finger in other units FingerUnits scales (align_shape auto and on)
+// before this check.
 void CheckFingerSize(const geometry::Shape& finger, const std::vector<push::PoseSample>& finger_pose,
                      const std::vector<push::PoseSample>& object_pose, const geometry::Shape& object, const std::string& who) {
   const std::optional<FingerDepth> d = MeasureFingerDepth(finger, finger_pose, object_pose, object);
   if (!d || !d->HoldsWholePush()) return;
+  // Which units make it a probe: a file in centimetres or inches was asked "in millimetres?", and
+  // --scale 0.001 made a 4.7 mm probe 0.47 mm.
+  std::string units, readings;
+  for (const FingerReading& r : FingerReadings(finger, finger_pose, object_pose, object)) {
+    units += std::string(units.empty() ? "" : " or ") + r.unit;
+    readings += Format("%sin %s it reaches %.3g mm from its origin (pushgraph footprint FILE --scale %g)",
+                       readings.empty() ? "" : ", ", r.unit, r.reach * 1e3, r.scale);
+  }
+  if (units.empty()) units = "millimetres", readings = "pushgraph footprint FILE --scale 0.001 converts one from millimetres";
   throw GraphError(Format("trajectory: %sthe finger's shape covers %.6g m about its origin (its rounding radius %.6g m), "
                           "more than the whole push: the finger stays within %.3g m of the object's origin and the object "
                           "within %.3g m of it, so at every sample the finger would hold the whole object inside it. Is the "
-                          "finger's shape file in millimetres? Shape files are in metres (pushgraph footprint FILE --scale "
-                          "0.001 converts one)",
-                          who.c_str(), d->depth, finger.radius(), d->farthest, d->object_reach));
+                          "finger's shape file in %s? Shape files are in metres: %s",
+                          who.c_str(), d->depth, finger.radius(), d->farthest, d->object_reach, units.c_str(),
+                          readings.c_str()));
 }
 
 }  // namespace
@@ -1046,41 +1076,98 @@ std::optional<std::string> ShapeSizeNote(const push::Trajectory& traj) {
                 milli ? "millimetres" : "centimetres", 2.0 * reach * (milli ? 0.1 : 1.0), milli ? 1000 : 100);
 }
 
-std::optional<push::Trajectory> FingersInMillimetres(const push::Trajectory& traj, std::string* note) {
-  // The object's reach as it would be in metres: a whole set of files in millimetres (object and
-  // finger alike, a CAD export) has the object 1000 times too large as well, which would hide
-  // the finger's units from the check (the registration finds the object's; ShapeSizeNote
-  // covers a trajectory file in millimetres throughout, positions included, which this leaves).
-  geometry::Shape object = traj.object.shape;
+push::Trajectory WithObjectInMetres(const push::Trajectory& traj) {
+  // A whole set of files in millimetres (object and finger alike, a CAD export) has the object
+  // 1000 times too large as well, which would hide the finger's units and frame from its checks
+  // (the registration finds the object's units later; ShapeSizeNote covers a trajectory file in
+  // millimetres throughout, positions included, which this leaves).
+  push::Trajectory judged = traj;
+  geometry::Shape& object = judged.object.shape;
   if (!object.empty() && geometry::RadiusAbout(object, geometry::CoreCentroid(object)) > 1.0)
     object = geometry::TransformShape(object, geometry::Pose2(), 1e-3);
-  std::optional<push::Trajectory> scaled;
+  return judged;
+}
+
+std::optional<push::Trajectory> FingerUnits(const push::Trajectory& traj, const RegistrationOptions& options,
+                                            std::string* note, double* finger_scale) {
+  push::Trajectory judged = WithObjectInMetres(traj);
+  const geometry::Shape& object = judged.object.shape;
   std::vector<std::string> said;
-  auto consider = [&](const geometry::Shape& finger, const std::vector<push::PoseSample>& poses, int index) {
-    const std::optional<FingerDepth> as_given = MeasureFingerDepth(finger, poses, traj.measured.object_pose, object);
-    if (!as_given || !as_given->HoldsWholePush()) return;
-    const geometry::Shape milli = geometry::TransformShape(finger, geometry::Pose2(), 1e-3);
-    const std::optional<FingerDepth> in_metres = MeasureFingerDepth(milli, poses, traj.measured.object_pose, object);
-    // Read as millimetres, a tabletop probe is 0.5 to 100 mm deep about its origin (a wrist-held
-    // paddle is no finger file in millimetres that the check refused).
-    if (!in_metres || in_metres->HoldsWholePush() || !(in_metres->depth >= 5e-4 && in_metres->depth <= 0.1)) return;
-    if (!scaled) scaled = traj;
-    (index == 0 ? scaled->finger.shape : scaled->extra_fingers[index - 1].finger.shape) = milli;
-    said.push_back(Format("%s covers %.4g m about its origin, more than the whole push (the finger stays within %.3g m "
-                          "of the object's origin), so it is read as millimetres: %.4g mm (rounding radius %.4g mm)",
-                          index == 0 ? "the finger's shape" : ("fingers[" + std::to_string(index) + "]'s shape").c_str(),
-                          as_given->depth, as_given->farthest, in_metres->depth * 1e3, milli.radius() * 1e3));
+  bool scaled = false;
+  // No tabletop finger's file reaches 1 m from its tracked origin: a probe in millimetres drawn
+  // 10 mm off its origin does not hold the push (its origin outside it) but reaches 14.7 "m"; the
+  // shape check then called the object's file "6.36 times the size of the finger's path".
+  constexpr double kFingerReach = 1.0;  // m
+  auto consider = [&](int index) {
+    geometry::Shape& finger = index == 0 ? judged.finger.shape : judged.extra_fingers[index - 1].finger.shape;
+    const auto& poses = index == 0 ? judged.measured.finger_pose : judged.extra_fingers[index - 1].measured.finger_pose;
+    const std::optional<FingerDepth> as_given = MeasureFingerDepth(finger, poses, judged.measured.object_pose, object);
+    if (!as_given) return;
+    const double reach = geometry::RadiusAbout(finger, geometry::Vec2::Zero());
+    if (!as_given->HoldsWholePush() && !(reach > kFingerReach)) return;
+    const std::vector<FingerReading> readings = FingerReadings(finger, poses, judged.measured.object_pose, object);
+    if (readings.empty()) return;  // refused by ValidateTrajectory, or left to the shape check
+    // Which reading the contacts fit (CheckShapeFit: the finger at its radius from the object): a
+    // 5 mm probe in centimetres read as a 0.5 mm one in millimetres was estimated 2.99 mm off,
+    // "a finger radius 3.4 mm larger would touch". None fits (the object's own frame is off, or
+    // too few contacts): millimetres, a CAD export's unit, when it is one of them.
+    const geometry::Shape given = finger;
+    std::optional<std::size_t> chosen;
+    double best_gap = INFINITY;
+    std::vector<std::string> gaps;
+    for (std::size_t k = 0; k < readings.size(); ++k) {
+      finger = geometry::TransformShape(given, geometry::Pose2(), readings[k].scale);
+      try {
+        const ShapeFitCheck check = CheckShapeFit(judged, options);
+        gaps.push_back(Format("in %s %s (%s)", readings[k].unit, check.fits ? "it fits" : "it does not", check.Describe().c_str()));
+        if (check.fits && check.gap_median < best_gap) best_gap = check.gap_median, chosen = k;
+      } catch (const std::exception&) {
+      }
+    }
+    const bool by_contacts = chosen.has_value();
+    if (!chosen && readings.front().scale == 1e-3) chosen = 0;
+    if (!chosen) {
+      finger = given;
+      return;
+    }
+    const FingerReading& r = readings[*chosen];
+    finger = geometry::TransformShape(given, geometry::Pose2(), r.scale);
+    *finger_scale = r.scale;
+    scaled = true;
+    const std::string who = index == 0 ? "the finger's shape" : "fingers[" + std::to_string(index) + "]'s shape";
+    std::string text =
+        as_given->HoldsWholePush()
+            ? Format("%s covers %.4g m about its origin, more than the whole push (the finger stays within %.3g m of the "
+                     "object's origin)", who.c_str(), as_given->depth, as_given->farthest)
+            : Format("%s reaches %.4g m from its origin, more than any finger's %.3g m", who.c_str(), reach, kFingerReach);
+    text += Format(", so it is read as %s: it reaches %.4g mm from its origin (rounding radius %.4g mm)", r.unit,
+                   r.reach * 1e3, finger.radius() * 1e3);
+    if (readings.size() > 1) {
+      if (by_contacts) {
+        std::string all;
+        for (const std::string& g : gaps) all += (all.empty() ? "" : "; ") + g;
+        text += " (the contacts decide: " + all + ")";
+      } else {
+        for (std::size_t k = 1; k < readings.size(); ++k)
+          text += Format(" (in %s it would reach %.3g mm: if so, pushgraph footprint FILE --scale %g)", readings[k].unit,
+                         readings[k].reach * 1e3, readings[k].scale);
+      }
+    }
+    said.push_back(text + Format(". Shape files are in metres: to save it so, pushgraph footprint FILE --scale %g -o "
+                                 "finger.json (align_shape \"off\" refuses such a finger instead)", r.scale));
   };
-  consider(traj.finger.shape, traj.measured.finger_pose, 0);
-  for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k)
-    consider(traj.extra_fingers[k].finger.shape, traj.extra_fingers[k].measured.finger_pose, static_cast<int>(k) + 1);
-  if (scaled && note) {
-    std::string text;
-    for (const std::string& s : said) text += (text.empty() ? "" : "; ") + s;
-    *note = text + ". Shape files are in metres: to save the finger so, pushgraph footprint FILE --scale 0.001 -o "
-                   "finger.json (align_shape \"off\" refuses such a finger instead)";
+  consider(0);
+  for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k) consider(static_cast<int>(k) + 1);
+  if (!scaled) return std::nullopt;
+  if (note) {
+    note->clear();
+    for (const std::string& s : said) *note += (note->empty() ? "" : "; ") + s;
   }
-  return scaled;
+  push::Trajectory out = traj;
+  out.finger.shape = judged.finger.shape;
+  for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k)
+    out.extra_fingers[k].finger.shape = judged.extra_fingers[k].finger.shape;
+  return out;
 }
 
 std::optional<std::string> MeasurementSigmaNote(const push::Trajectory& traj, const push::MeasurementSigmas& sigma) {

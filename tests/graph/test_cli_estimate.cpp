@@ -680,7 +680,7 @@ TEST_F(EstimateCli, ACadExportInMillimetresIsReadAsSuchFingerIncluded) {
   const std::string rest = " --model cp --mass 0.8374 --mu 0.35 -o ";
   const pushgraph::testing::ToolRun mm = Tool("estimate '" + h5 + "' --object " + object + " --finger " + finger + rest + dir() + "/mm.json");
   ASSERT_EQ(mm.status, 0) << mm.err;
-  EXPECT_NE(mm.err.find("so it is read as millimetres: 4.7 mm"), std::string::npos) << mm.err;
+  EXPECT_NE(mm.err.find("so it is read as millimetres: it reaches 4.7 mm"), std::string::npos) << mm.err;
   const pushgraph::testing::ToolRun metres =
       Tool("estimate '" + h5 + "' --object " + object + " --finger " + Mit() + "obj/tip.obj" + rest + dir() + "/m.json");
   ASSERT_EQ(metres.status, 0) << metres.err;
@@ -695,11 +695,29 @@ TEST_F(EstimateCli, ACadExportInMillimetresIsReadAsSuchFingerIncluded) {
       largest = std::max(largest, std::abs(a["states"][i]["object_pose"][k].get<double>() -
                                            b["states"][i]["object_pose"][k].get<double>()));
   EXPECT_LT(largest, 1e-6);
+  // Drawn 10 mm off its axis as well: it holds nothing (its origin outside it) but reaches 14.7 "m"
+  // from it; read as millimetres, then centred (the shape check had called the object's file "6.36
+  // times the size of the finger's path").
+  const std::string off_axis = EditedMesh("tip.obj", 1000.0, 10.0, "mm_tip_off.obj");
+  const pushgraph::testing::ToolRun both =
+      Tool("estimate '" + h5 + "' --object " + object + " --finger " + off_axis + rest + dir() + "/off_axis.json");
+  ASSERT_EQ(both.status, 0) << both.err;
+  const nlohmann::json c = Load(dir() + "/off_axis.json");
+  EXPECT_EQ(c["parameters"]["finger_scale"].get<double>(), 1e-3);
+  ASSERT_TRUE(c["parameters"].contains("finger_transform")) << c["parameters"].dump();
+  EXPECT_NEAR(c["parameters"]["finger_transform"][0].get<double>(), -0.01, 1e-9);
+  ASSERT_EQ(c["states"].size(), b["states"].size());
+  largest = 0.0;
+  for (std::size_t i = 0; i < c["states"].size(); ++i)
+    for (int k = 0; k < 2; ++k)
+      largest = std::max(largest, std::abs(c["states"][i]["object_pose"][k].get<double>() -
+                                           b["states"][i]["object_pose"][k].get<double>()));
+  EXPECT_LT(largest, 1e-6);
   // --align-shape off keeps the refusal, naming the units.
   const pushgraph::testing::ToolRun off =
       Tool("estimate '" + h5 + "' --object " + object + " --finger " + finger + " --align-shape off" + rest + dir() + "/off.json");
   EXPECT_EQ(off.status, 1);
-  EXPECT_NE(off.err.find("Is the finger's shape file in millimetres?"), std::string::npos) << off.err;
+  EXPECT_NE(off.err.find("Is the finger's shape file in millimetres"), std::string::npos) << off.err;
 }
 
 // The dataset's probe mesh drawn 10 mm off its axis (every vertex moved), with the tracker on the

@@ -19,6 +19,7 @@
 #include <memory>
 #include <cstdio>
 #include <map>
+#include <tuple>
 
 namespace pushgraph::graph {
 namespace {
@@ -186,7 +187,7 @@ TEST(Estimator, AFingerInMillimetresIsReadAsSuchOrRefused) {
       Estimate(t, Model::kQs, Mode::kBatch, off);
       ADD_FAILURE() << "a finger of " << finger.num_vertices() << " vertices, 4.7 m, was accepted";
     } catch (const GraphError& e) {
-      EXPECT_NE(std::string(e.what()).find("Is the finger's shape file in millimetres?"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("Is the finger's shape file in millimetres"), std::string::npos) << e.what();
     }
   }
   t.finger.shape = given;
@@ -198,7 +199,7 @@ TEST(Estimator, AFingerInMillimetresIsReadAsSuchOrRefused) {
     t.finger.shape = geometry::TransformShape(given, geometry::Pose2(), 1000.0);  // the probe in millimetres
     const EstimationResult r = Estimate(t, Model::kQs, Mode::kBatch, config);
     EXPECT_EQ(r.finger_scale, 1e-3);
-    EXPECT_TRUE(HasWarning(r, "so it is read as millimetres: 5 mm")) << ::testing::PrintToString(r.warnings);
+    EXPECT_TRUE(HasWarning(r, "so it is read as millimetres: it reaches 5 mm")) << ::testing::PrintToString(r.warnings);
     EXPECT_TRUE(HasWarning(r, "pushgraph footprint FILE --scale 0.001")) << ::testing::PrintToString(r.warnings);
     if (align == EstimatorConfig::AlignShape::kAuto) {
       ASSERT_EQ(r.states.size(), in_metres.states.size());
@@ -212,8 +213,32 @@ TEST(Estimator, AFingerInMillimetresIsReadAsSuchOrRefused) {
     Estimate(t, Model::kCp, Mode::kBatch);
     ADD_FAILURE() << "a finger of radius 400 m was accepted";
   } catch (const GraphError& e) {
-    EXPECT_NE(std::string(e.what()).find("Is the finger's shape file in millimetres?"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("Is the finger's shape file in millimetres"), std::string::npos) << e.what();
   }
+  // In centimetres (0.5 "m") or inches (0.197 "m"): read as millimetres the first is a 0.5 mm
+  // needle (estimated 2.99 mm off, "a finger radius 3.4 mm larger would touch"), the second
+  // under 0.5 mm; the contacts decide between the readings that make it a probe.
+  for (const auto& [unit, scale] : {std::pair{"centimetres", 0.01}, std::pair{"inches", 0.0254}}) {
+    t.finger.shape = geometry::TransformShape(given, geometry::Pose2(), 1.0 / scale);
+    const EstimationResult r = Estimate(t, Model::kQs, Mode::kBatch);
+    EXPECT_EQ(r.finger_scale, scale);
+    EXPECT_TRUE(HasWarning(r, std::string("so it is read as ") + unit + ": it reaches 5 mm"))
+        << ::testing::PrintToString(r.warnings);
+    EXPECT_TRUE(HasWarning(r, "the contacts decide")) << ::testing::PrintToString(r.warnings);
+    EXPECT_NEAR(r.metrics.at("object_position_rms"), in_metres.metrics.at("object_position_rms"), 1e-6) << unit;
+  }
+  // In millimetres and drawn 10 mm beside its origin: it holds nothing (its origin lies outside
+  // it), but reaches 15 "m" from it; read as millimetres, then centred on its tracked point.
+  t.finger.shape = geometry::TransformShape(given, geometry::Pose2{10.0, 0.0, 0.0}, 1000.0);
+  const EstimationResult off_axis = Estimate(t, Model::kQs, Mode::kBatch);
+  EXPECT_EQ(off_axis.finger_scale, 1e-3);
+  EXPECT_TRUE(HasWarning(off_axis, "reaches 15 m from its origin, more than any finger's 1 m"))
+      << ::testing::PrintToString(off_axis.warnings);
+  EXPECT_NEAR(off_axis.finger_shift.x(), -0.010, 1e-12);
+  ASSERT_EQ(off_axis.states.size(), in_metres.states.size());
+  for (std::size_t i = 0; i < off_axis.states.size(); ++i)
+    EXPECT_LT((off_axis.states[i].object_pose.translation() - in_metres.states[i].object_pose.translation()).norm(), 1e-6)
+        << i;
   t.finger.shape = geometry::Shape::RegularPolygon(32, 0.0047);  // the probe in metres
   EXPECT_NO_THROW(Estimate(t, Model::kCp, Mode::kBatch));
 }
@@ -871,7 +896,7 @@ TEST(Estimator, BadTrajectoriesGetClearErrors) {
     } catch (const GraphError& e) {
       m = e.what();
     }
-    EXPECT_EQ(m.find("Is the finger's shape file in millimetres?") != std::string::npos, radius == 5.0) << radius << ": " << m;
+    EXPECT_EQ(m.find("Is the finger's shape file in millimetres") != std::string::npos, radius == 5.0) << radius << ": " << m;
   }
   // Clock jumps (a corrupted time stamp 1e9 s ahead) are refused at once in batch and
   // incremental alike, naming the stream and sample, instead of costing memory and time in

@@ -160,10 +160,11 @@ struct EstimationResult {
   /// force_rms (N); the same of the raw measurements as measured_*; and the mean normalized
   /// estimation error squared object_pose_nees (dimension 3) etc. where covariances exist.
   std::map<std::string, double> metrics;
-  /// The scale applied to the finger shape files (1; 0.001 when a finger's file read as metres
-  /// would hold the whole push inside it and, read as millimetres, is a tabletop probe:
-  /// align_shape auto and on, said in the warnings; "off" refuses such a finger). RESULT.json
-  /// parameters.finger_scale, written when not 1.
+  /// The scale applied to the finger shape files: 1; 0.001, 0.01 or 0.0254 (millimetres,
+  /// centimetres, inches) when a finger's file read as metres would hold the whole push inside it
+  /// or reaches over 1 m from its origin, and so read is a tabletop probe the contacts fit
+  /// (align_shape auto and on, said in the warnings; "off" refuses such a finger).
+  /// RESULT.json parameters.finger_scale, written when not 1.
   double finger_scale = 1.0;
   /// The shift (m, in the finger's frame) applied to finger 0's shape (after finger_scale): zero;
   /// with align_shape auto, when its pose origin lies over 1 mm outside the shape (or a disk's
