@@ -574,6 +574,9 @@ EstimationResult Estimate(const push::Trajectory& given, Model model, Mode mode,
   ValidateConfig(config);
   // A finger file in millimetres, as the object's is under auto and on (the registration finds
   // the object's units): a user's CAD export of both was refused for the finger alone.
+  // Validated first but for the finger's size, which FingerUnits judges (its smoothing is no
+  // place for a NaN or a clock jump).
+  internal::ValidateTrajectory(given, /*finger_size=*/false);
   std::string finger_units;
   double finger_scale = 1.0;
   const std::optional<push::Trajectory> finger_scaled =
@@ -581,7 +584,8 @@ EstimationResult Estimate(const push::Trajectory& given, Model model, Mode mode,
           ? std::nullopt
           : internal::FingerUnits(given, RegistrationOptionsFor(config), &finger_units, &finger_scale);
   const push::Trajectory& in_metres = finger_scaled ? *finger_scaled : given;
-  internal::ValidateTrajectory(in_metres);
+  if (finger_scaled) internal::ValidateTrajectory(in_metres);  // reaches and units with the finger scaled
+  else internal::CheckFingerSizes(in_metres);
   std::string finger_origin;
   geometry::Vec2 finger_shift = geometry::Vec2::Zero();
   const std::optional<push::Trajectory> finger_centred = CentredFinger(in_metres, config, &finger_origin, &finger_shift);

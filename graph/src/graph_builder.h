@@ -480,7 +480,12 @@ Diagnostics Diagnose(const push::Trajectory& trajectory, Model model, const Esti
 /// Refuses a trajectory the estimator cannot use (trajectory_checks.cpp; GraphError naming the
 /// stream, sample and value): missing shapes or streams, NaN, unsupported magnitudes, unsorted
 /// samples, clock jumps within or between streams.
-void ValidateTrajectory(const push::Trajectory& trajectory);
+/// `finger_size` false leaves out CheckFingerSizes (Estimate reads a finger file in other units
+/// first, FingerUnits, on an otherwise validated trajectory).
+void ValidateTrajectory(const push::Trajectory& trajectory, bool finger_size = true);
+/// A finger whose origin lies deeper inside it than the whole push reaches: refused, naming the
+/// units that make it a probe. Part of ValidateTrajectory.
+void CheckFingerSizes(const push::Trajectory& trajectory);
 /// Refuses a push whose fingers never come near the object's tracked origin: every finger that
 /// measures a contact point or a non-zero force (none: the nearest finger) must come within
 /// max(0.5 m, twice the object's and its reach from their pose origins), and every contact stream

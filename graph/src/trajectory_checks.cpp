@@ -438,7 +438,16 @@ void ValidateFingers(const push::Trajectory& traj) {
       throw GraphError("trajectory: fingers[" + std::to_string(k + 1) + "].shape is missing or empty");
 }
 
-void ValidateTrajectory(const push::Trajectory& traj) {
+void CheckFingerSizes(const push::Trajectory& traj) {
+  const push::Streams& m = traj.measured;
+  CheckFingerSize(traj.finger.shape, m.finger_pose, m.object_pose, traj.object.shape, "");
+  for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k) {
+    CheckFingerSize(traj.extra_fingers[k].finger.shape, traj.extra_fingers[k].measured.finger_pose, m.object_pose,
+                    traj.object.shape, "fingers[" + std::to_string(k + 1) + "]: ");
+  }
+}
+
+void ValidateTrajectory(const push::Trajectory& traj, bool finger_size) {
   if (traj.object.shape.empty()) throw GraphError("trajectory: object.shape is missing or empty");
   if (traj.finger.shape.empty()) throw GraphError("trajectory: finger.shape is missing or empty");
   ValidateFingers(traj);
@@ -567,11 +576,7 @@ void ValidateTrajectory(const push::Trajectory& traj) {
     CheckPositionUnits(traj.extra_fingers[k].measured.finger_pose, "fingers[" + std::to_string(k + 1) + "].finger_pose",
                        finger_ratio);
   CheckFingerReachesObject(traj);
-  CheckFingerSize(traj.finger.shape, m.finger_pose, m.object_pose, traj.object.shape, "");
-  for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k) {
-    CheckFingerSize(traj.extra_fingers[k].finger.shape, traj.extra_fingers[k].measured.finger_pose, m.object_pose,
-                    traj.object.shape, "fingers[" + std::to_string(k + 1) + "]: ");
-  }
+  if (finger_size) CheckFingerSizes(traj);
 }
 
 namespace {

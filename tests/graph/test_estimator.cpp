@@ -239,6 +239,22 @@ TEST(Estimator, AFingerInMillimetresIsReadAsSuchOrRefused) {
   for (std::size_t i = 0; i < off_axis.states.size(); ++i)
     EXPECT_LT((off_axis.states[i].object_pose.translation() - in_metres.states[i].object_pose.translation()).norm(), 1e-6)
         << i;
+  // Read before the trajectory's own checks: those still name what else is wrong.
+  t.finger.shape = geometry::TransformShape(given, geometry::Pose2(), 1000.0);
+  auto error = [](const push::Trajectory& bad) {
+    try {
+      Estimate(bad, Model::kCp, Mode::kBatch);
+    } catch (const GraphError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  auto nan_pose = t;
+  nan_pose.measured.finger_pose[4].pose.x = NAN;
+  EXPECT_NE(error(nan_pose).find("finger_pose[4]"), std::string::npos) << error(nan_pose);
+  auto no_object = t;
+  no_object.object.shape = geometry::Shape();
+  EXPECT_NE(error(no_object).find("object.shape"), std::string::npos) << error(no_object);
   t.finger.shape = geometry::Shape::RegularPolygon(32, 0.0047);  // the probe in metres
   EXPECT_NO_THROW(Estimate(t, Model::kCp, Mode::kBatch));
 }
