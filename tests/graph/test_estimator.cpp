@@ -164,6 +164,16 @@ TEST(Estimator, TimeStampsInMillisecondsAreNamed) {
   }
 }
 
+// The estimator's error for `t` (QS batch), or "no error".
+std::string EstimateError(const push::Trajectory& t, const EstimatorConfig& config = {}) {
+  try {
+    Estimate(t, Model::kQs, Mode::kBatch, config);
+  } catch (const GraphError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
 bool HasWarning(const EstimationResult& r, const std::string& text) {
   for (const std::string& w : r.warnings)
     if (w.find(text) != std::string::npos) return true;
@@ -241,14 +251,7 @@ TEST(Estimator, AFingerInMillimetresIsReadAsSuchOrRefused) {
         << i;
   // Read before the trajectory's own checks: those still name what else is wrong.
   t.finger.shape = geometry::TransformShape(given, geometry::Pose2(), 1000.0);
-  auto error = [](const push::Trajectory& bad) {
-    try {
-      Estimate(bad, Model::kCp, Mode::kBatch);
-    } catch (const GraphError& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
-  };
+  auto error = [](const push::Trajectory& bad) { return EstimateError(bad); };
   auto nan_pose = t;
   nan_pose.measured.finger_pose[4].pose.x = NAN;
   EXPECT_NE(error(nan_pose).find("finger_pose[4]"), std::string::npos) << error(nan_pose);
@@ -821,14 +824,7 @@ TEST(Estimator, ACAndAFailedCovarianceAreSaid) {
 
 TEST(Estimator, BadTrajectoriesGetClearErrors) {
   push::Trajectory t = GeneratePush(OffsetPush(1, 0.3));
-  auto message = [](const push::Trajectory& tr) {
-    try {
-      Estimate(tr, Model::kQs, Mode::kBatch);
-    } catch (const GraphError& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
-  };
+  auto message = [](const push::Trajectory& tr) { return EstimateError(tr); };
   auto no_object = t;
   no_object.measured.object_pose.clear();
   EXPECT_NE(message(no_object).find("object_pose"), std::string::npos);
@@ -904,14 +900,9 @@ TEST(Estimator, BadTrajectoriesGetClearErrors) {
   for (const double radius : {5.0, 0.005, 0.1}) {
     auto sized = t;
     sized.finger.shape = geometry::Shape::Disk(radius);
-    std::string m = "no error";
     EstimatorConfig off;  // "auto" reads the 5 "m" probe as millimetres (AFingerInMillimetresIsReadAsSuchOrRefused)
     off.align_shape = EstimatorConfig::AlignShape::kOff;
-    try {
-      Estimate(sized, Model::kQs, Mode::kBatch, off);
-    } catch (const GraphError& e) {
-      m = e.what();
-    }
+    const std::string m = EstimateError(sized, off);
     EXPECT_EQ(m.find("Is the finger's shape file in millimetres") != std::string::npos, radius == 5.0) << radius << ": " << m;
   }
   // Clock jumps (a corrupted time stamp 1e9 s ahead) are refused at once in batch and
