@@ -347,15 +347,17 @@ std::optional<push::Trajectory> CentredFinger(const push::Trajectory& traj, cons
   const bool off_centre_disk = finger.num_vertices() == 1 && finger.radius() > 0.0 && centre.norm() > kOutside;
   if (!(outside > kOutside) && !off_centre_disk) return std::nullopt;
   const geometry::Vec2 to_centre = -centre + geometry::Vec2::Zero();  // + 0: no "-0" in the command printed
-  push::Trajectory centred = traj;
-  centred.finger.shape = geometry::TransformShape(finger, geometry::Pose2{to_centre.x(), to_centre.y(), 0.0});
+  const geometry::Shape centred_shape =
+      geometry::TransformShape(finger, geometry::Pose2{to_centre.x(), to_centre.y(), 0.0});
   std::optional<ShapeFitCheck> given, moved;
   try {
     const RegistrationOptions options = RegistrationOptionsFor(config);
     // Judged against the object in metres: with a CAD export in millimetres of both, neither
     // reading fitted, and the probe drawn 10 mm off was estimated 1.98 mm off against 0.95 mm.
-    given = CheckShapeFit(internal::WithObjectInMetres(traj), options);
-    moved = CheckShapeFit(internal::WithObjectInMetres(centred), options);
+    push::Trajectory judged = internal::WithObjectInMetres(traj);
+    given = CheckShapeFit(judged, options);
+    judged.finger.shape = centred_shape;
+    moved = CheckShapeFit(judged, options);
   } catch (const std::exception&) {
     // Too few contacts to judge: the note alone.
   }
@@ -395,6 +397,8 @@ std::optional<push::Trajectory> CentredFinger(const push::Trajectory& traj, cons
   }
   if (use || outside > kOutside) *note = text;
   if (!use) return std::nullopt;
+  push::Trajectory centred = traj;
+  centred.finger.shape = centred_shape;
   return centred;
 }
 
@@ -572,8 +576,8 @@ static bool GroundTruthIsTheMeasurements(const push::Trajectory& t) {
 EstimationResult Estimate(const push::Trajectory& given, Model model, Mode mode, const EstimatorConfig& config) {
   const auto call_start = std::chrono::steady_clock::now();
   ValidateConfig(config);
-  // A finger file in millimetres, as the object's is under auto and on (the registration finds
-  // the object's units): a user's CAD export of both was refused for the finger alone.
+  // A finger file in other units, as the object's is under auto and on (the registration finds
+  // the object's units): a user's CAD export of both in millimetres was refused for the finger alone.
   // Validated first but for the finger's size, which FingerUnits judges (its smoothing is no
   // place for a NaN or a clock jump).
   internal::ValidateTrajectory(given, /*finger_size=*/false);

@@ -304,11 +304,6 @@ void CheckNoClockJump(const std::vector<Sample>& s, const std::string& stream, d
   }
 }
 
-// A finger whose origin lies deeper inside it than every finger-object distance of the recording
-// plus the object's reach would hold the whole object inside it at every sample: its file is in
-// other units (a probe of radius 4.7 given in millimetres was read as 4.7 m, and the shape check
-// then "aligned" the object 4 m away; a 32-gon probe in millimetres ran for 51 s to an object
-// 2.5 m off the tracker's, exit 0). The object's own units the registration detects.
 // How deep the finger's origin lies inside it (a disk's: its radius), rounded or polygonal alike,
 // against how far the push reaches: the finger's farthest distance from the object's origin and
 // the object's reach about it. Deeper than both together, the finger would hold the whole object
@@ -1081,37 +1076,60 @@ std::optional<std::string> ShapeSizeNote(const push::Trajectory& traj) {
                 milli ? "millimetres" : "centimetres", 2.0 * reach * (milli ? 0.1 : 1.0), milli ? 1000 : 100);
 }
 
-push::Trajectory WithObjectInMetres(const push::Trajectory& traj) {
-  // A whole set of files in millimetres (object and finger alike, a CAD export) has the object
-  // 1000 times too large as well, which would hide the finger's units and frame from its checks
-  // (the registration finds the object's units later; ShapeSizeNote covers a trajectory file in
-  // millimetres throughout, positions included, which this leaves).
-  push::Trajectory judged = traj;
-  geometry::Shape& object = judged.object.shape;
+namespace {
+
+// A whole set of files in millimetres (object and finger alike, a CAD export) has the object 1000
+// times too large as well, which would hide the finger's units and frame from its checks (the
+// registration finds the object's units later; ShapeSizeNote covers a trajectory file in
+// millimetres throughout, positions included, which this leaves).
+geometry::Shape ObjectInMetres(const geometry::Shape& object) {
   if (!object.empty() && geometry::RadiusAbout(object, geometry::CoreCentroid(object)) > 1.0)
-    object = geometry::TransformShape(object, geometry::Pose2(), 1e-3);
+    return geometry::TransformShape(object, geometry::Pose2(), 1e-3);
+  return object;
+}
+
+// No tabletop finger's file reaches 1 m from its tracked origin: a probe in millimetres drawn
+// 10 mm off its origin does not hold the push (its origin outside it) but reaches 14.7 "m"; the
+// shape check then called the object's file "6.36 times the size of the finger's path".
+constexpr double kFingerReach = 1.0;  // m
+
+}  // namespace
+
+push::Trajectory WithObjectInMetres(const push::Trajectory& traj) {
+  push::Trajectory judged = traj;
+  judged.object.shape = ObjectInMetres(traj.object.shape);
   return judged;
 }
 
 std::optional<push::Trajectory> FingerUnits(const push::Trajectory& traj, const RegistrationOptions& options,
                                             std::string* note, double* finger_scale) {
-  push::Trajectory judged = WithObjectInMetres(traj);
-  const geometry::Shape& object = judged.object.shape;
+  // Judged without a copy of the trajectory first: it is made only for a finger that needs it
+  // (every estimate passes here).
+  const geometry::Shape object = ObjectInMetres(traj.object.shape);
+  auto poses_of = [&](int index) -> const std::vector<push::PoseSample>& {
+    return index == 0 ? traj.measured.finger_pose : traj.extra_fingers[index - 1].measured.finger_pose;
+  };
+  auto shape_of = [&](const push::Trajectory& t, int index) -> const geometry::Shape& {
+    return index == 0 ? t.finger.shape : t.extra_fingers[index - 1].finger.shape;
+  };
+  std::vector<int> suspects;
+  for (int index = 0; index <= static_cast<int>(traj.extra_fingers.size()); ++index) {
+    const std::optional<FingerDepth> d = MeasureFingerDepth(shape_of(traj, index), poses_of(index), traj.measured.object_pose, object);
+    if (d && (d->HoldsWholePush() || geometry::RadiusAbout(shape_of(traj, index), geometry::Vec2::Zero()) > kFingerReach))
+      suspects.push_back(index);
+  }
+  if (suspects.empty()) return std::nullopt;
+  push::Trajectory judged = traj;
+  judged.object.shape = object;
   std::vector<std::string> said;
   bool scaled = false;
-  // No tabletop finger's file reaches 1 m from its tracked origin: a probe in millimetres drawn
-  // 10 mm off its origin does not hold the push (its origin outside it) but reaches 14.7 "m"; the
-  // shape check then called the object's file "6.36 times the size of the finger's path".
-  constexpr double kFingerReach = 1.0;  // m
-  auto consider = [&](int index) {
+  for (const int index : suspects) {
     geometry::Shape& finger = index == 0 ? judged.finger.shape : judged.extra_fingers[index - 1].finger.shape;
-    const auto& poses = index == 0 ? judged.measured.finger_pose : judged.extra_fingers[index - 1].measured.finger_pose;
+    const auto& poses = poses_of(index);
     const std::optional<FingerDepth> as_given = MeasureFingerDepth(finger, poses, judged.measured.object_pose, object);
-    if (!as_given) return;
     const double reach = geometry::RadiusAbout(finger, geometry::Vec2::Zero());
-    if (!as_given->HoldsWholePush() && !(reach > kFingerReach)) return;
     const std::vector<FingerReading> readings = FingerReadings(finger, poses, judged.measured.object_pose, object);
-    if (readings.empty()) return;  // refused by ValidateTrajectory, or left to the shape check
+    if (readings.empty()) continue;  // refused by ValidateTrajectory, or left to the shape check
     // Which reading the contacts fit (CheckShapeFit: the finger at its radius from the object): a
     // 5 mm probe in centimetres read as a 0.5 mm one in millimetres was estimated 2.99 mm off,
     // "a finger radius 3.4 mm larger would touch". None fits (the object's own frame is off, or
@@ -1133,7 +1151,7 @@ std::optional<push::Trajectory> FingerUnits(const push::Trajectory& traj, const 
     if (!chosen && readings.front().scale == 1e-3) chosen = 0;
     if (!chosen) {
       finger = given;
-      return;
+      continue;
     }
     const FingerReading& r = readings[*chosen];
     finger = geometry::TransformShape(given, geometry::Pose2(), r.scale);
@@ -1160,9 +1178,7 @@ std::optional<push::Trajectory> FingerUnits(const push::Trajectory& traj, const 
     }
     said.push_back(text + Format(". Shape files are in metres: to save it so, pushgraph footprint FILE --scale %g -o "
                                  "finger.json (align_shape \"off\" refuses such a finger instead)", r.scale));
-  };
-  consider(0);
-  for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k) consider(static_cast<int>(k) + 1);
+  }
   if (!scaled) return std::nullopt;
   if (note) {
     note->clear();

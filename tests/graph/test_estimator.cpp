@@ -183,8 +183,8 @@ bool HasWarning(const EstimationResult& r, const std::string& text) {
 // A finger file in millimetres read as metres holds the whole push inside it (a 32-gon probe in
 // mm ran 51 s to 2.5 m off). align_shape "off" refuses it, naming the units, whether it is a
 // rounded disk or a polygon; "auto" and "on" read it as millimetres, as the shape check does the
-// object's file, say so and estimate as with the probe in metres. A finger that scaled by 0.001
-// is no probe (under 0.5 mm) is refused under auto too.
+// object's file, say so and estimate as with the probe in metres; centimetres and inches too,
+// the contacts choosing. A finger that no unit makes a probe is refused under auto too.
 TEST(Estimator, AFingerInMillimetresIsReadAsSuchOrRefused) {
   push::Trajectory t = GeneratePush(OffsetPush(3, 0.5));
   const geometry::Shape given = t.finger.shape;
