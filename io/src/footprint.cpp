@@ -576,6 +576,7 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
     for (int a = 0; a < 3 && flat_axis < 0; ++a) {
       if (hi[a] - lo[a] <= tolerance && hi[a] >= lo[a]) flat_axis = a;
     }
+    if (flat_axis >= 0) rep.flat_axis = flat_axis == 0 ? UpAxis::kX : flat_axis == 1 ? UpAxis::kY : UpAxis::kZ;
     for (int a = 0; a < 3 && flat_axis < 0; ++a) {
       bool on_ends = hi[a] > lo[a];
       int at_lo = 0, at_hi = 0;  // an end face needs three vertices (a lone triangle is no prism)

@@ -1,5 +1,6 @@
 #include "cli_common.h"
 
+#include <pushgraph/graph/registration.h>
 #include <pushgraph/io/errors.h>
 #include <pushgraph/io/footprint.h>
 #include <pushgraph/io/points_csv.h>
@@ -208,10 +209,21 @@ std::optional<geometry::Shape> TessellatedDisk(const geometry::Shape& shape) {
 // or y only (a probe's cylinder lying along y, as the MIT tip.obj) is meant by its cross-section:
 // seen along z it would be its side view (footprint reports the prism axes after its union, so
 // such a file is read twice).
-geometry::Shape LoadMeshArgument(const std::string& path, const std::string& what, std::vector<std::string>* warnings) {
+geometry::Shape LoadMeshArgument(const std::string& path, const std::string& what, std::vector<std::string>* warnings,
+                                 MeshReadings* other_readings) {
   io::FootprintOptions options;
   io::FootprintReport report;
-  geometry::Shape shape = io::MeshFootprint(path, options, &report);
+  geometry::Shape shape;
+  try {
+    shape = io::MeshFootprint(path, options, &report);
+  } catch (const io::IoError&) {
+    // A flat drawing has one reading only: across the plane it is drawn in (its outline drawn in
+    // the x-z plane was refused with "--up y reads it", a flag estimate does not have).
+    if (!report.flat_axis || *report.flat_axis == options.up) throw;
+    options.up = *report.flat_axis;
+    report = {};
+    shape = io::MeshFootprint(path, options, &report);
+  }
   // Objects keep z: a can lying along x is pushed by its 100 x 60 mm side, not its round end.
   const bool finger = what.find("finger") != std::string::npos;
   const auto& prisms = report.prism_axes;
@@ -219,6 +231,16 @@ geometry::Shape LoadMeshArgument(const std::string& path, const std::string& wha
     options.up = prisms[0];
     report = {};
     shape = io::MeshFootprint(path, options, &report);
+  }
+  // An object that is a prism along x or y: its cross-sections, for the recording to choose from.
+  if (!finger && other_readings) {
+    for (const io::UpAxis axis : prisms) {
+      if (axis == options.up) continue;
+      io::FootprintOptions across = options;
+      across.up = axis;
+      other_readings->shapes.push_back(io::MeshFootprint(path, across));
+      other_readings->up.push_back(axis == io::UpAxis::kX ? "x" : axis == io::UpAxis::kY ? "y" : "z");
+    }
   }
   const char* up = options.up == io::UpAxis::kX ? "x" : options.up == io::UpAxis::kY ? "y" : "z";
   int holes = 0;
@@ -236,6 +258,10 @@ geometry::Shape LoadMeshArgument(const std::string& path, const std::string& wha
     for (const std::string flag : {"--object NAME", "--up x", "--up y", "--up z"}) {
       if (const std::size_t at = w.find(flag); at != std::string::npos)
         w.replace(at, flag.size(), "pushgraph footprint " + path + " " + flag + " -o SHAPE.json");
+    }
+    if (other_readings && !other_readings->shapes.empty() && w.find("its side view") != std::string::npos) {
+      other_readings->side_view = w;  // the caller's recording decides whether it is one
+      continue;
     }
     std::fprintf(stderr, "pushgraph: warning: %s %s: %s\n", what.c_str(), path.c_str(), w.c_str());
     if (warnings) warnings->push_back(what + " " + path + ": " + w);
@@ -258,16 +284,23 @@ geometry::Shape LoadMeshArgument(const std::string& path, const std::string& wha
 
 }  // namespace
 
+static std::string FormatSize(double size) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.4g", size);
+  return text;
+}
+
 void WarnShapeUnits(const geometry::Shape& shape, const std::string& what, const std::string& path) {
   if (const auto units = io::ShapeUnitsWarning(shape, 1.0, "pushgraph footprint " + path + " --scale "))
     std::fprintf(stderr, "pushgraph: warning: %s %s: %s\n", what.c_str(), path.c_str(), units->c_str());
 }
 
-geometry::Shape LoadShapeArgument(const std::string& path, const std::string& what, std::vector<std::string>* warnings) {
+geometry::Shape LoadShapeArgument(const std::string& path, const std::string& what, std::vector<std::string>* warnings,
+                                  MeshReadings* other_readings) {
   std::string extension = std::filesystem::path(path).extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return std::tolower(c); });
   try {
-    if (extension == ".obj") return LoadMeshArgument(path, what, warnings);
+    if (extension == ".obj") return LoadMeshArgument(path, what, warnings, other_readings);
     return geometry::LoadShapeJson(path);
   } catch (const std::exception& e) {
     std::string hint;
@@ -275,6 +308,43 @@ geometry::Shape LoadShapeArgument(const std::string& path, const std::string& wh
       hint = " (shape files are JSON from pushgraph footprint; OBJ meshes, named .obj, are read directly)";
     throw CliError(what + " " + path + ": " + e.what() + hint);
   }
+}
+
+void ChooseObjectReading(const std::string& path, const MeshReadings& readings, const graph::EstimatorConfig& config,
+                         push::Trajectory* trajectory, std::vector<std::string>* warnings) {
+  if (readings.shapes.empty()) return;
+  auto say = [&](const std::string& text) {
+    std::fprintf(stderr, "pushgraph: warning: --object %s: %s\n", path.c_str(), text.c_str());
+    if (warnings) warnings->push_back("--object " + path + ": " + text);
+  };
+  if (config.align_shape == graph::EstimatorConfig::AlignShape::kOff) {
+    if (!readings.side_view.empty()) say(readings.side_view);
+    return;
+  }
+  std::vector<geometry::Shape> candidates{trajectory->object.shape};
+  candidates.insert(candidates.end(), readings.shapes.begin(), readings.shapes.end());
+  const graph::ShapeReadingChoice choice =
+      graph::ChooseShapeReading(*trajectory, candidates, graph::RegistrationOptionsFor(config));
+  // The readings by name: reading 0 is the footprint along z, k its cross-section along up[k-1].
+  std::string reason = choice.reason;
+  for (std::size_t k = candidates.size(); k-- > 0;) {
+    const std::string name = k == 0 ? "along z" : "along " + readings.up[k - 1];
+    for (std::size_t at = reason.find("reading " + std::to_string(k)); at != std::string::npos;
+         at = reason.find("reading " + std::to_string(k), at + name.size()))
+      reason.replace(at, 8 + std::to_string(k).size(), name);
+  }
+  if (choice.index > 0) {
+    const std::string& up = readings.up[choice.index - 1];
+    trajectory->object.shape = candidates[choice.index];
+    const geometry::Box2 box = trajectory->object.shape.bounds();
+    say("the mesh is a prism along " + up + " (a y-up export, or an object lying on its side), and the recording's "
+        "contacts fit its cross-section along " + up + ", not its footprint along z (its side view): estimated with the "
+        "cross-section (" + FormatSize(box.max.x() - box.min.x()) + " x " + FormatSize(box.max.y() - box.min.y()) +
+        " in the file's units; " + reason + "); pushgraph footprint " + path + " --up " + up + " -o SHAPE.json saves it");
+    return;
+  }
+  if (!readings.side_view.empty() && !(choice.checked[0] && choice.checks[0].fits))
+    say(readings.side_view + (reason.empty() ? "" : " (the contacts fit no reading clearly better: " + reason + ")"));
 }
 
 }  // namespace pushgraph::cli

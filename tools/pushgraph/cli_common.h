@@ -5,6 +5,7 @@
 #include <pushgraph/geometry/pose.h>
 #include <pushgraph/geometry/shape.h>
 #include <pushgraph/graph/config.h>
+#include <pushgraph/push/trajectory.h>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -54,8 +55,24 @@ void AddAlignShapeOption(CLI::App* sub, std::string* value);
 graph::EstimatorConfig::AlignShape ParseAlignShape(const std::string& value);
 /// A shape file named by a flag or argument (`what`, e.g. "--object"): geometry::LoadShapeJson,
 /// its errors prefixed with the flag.
+/// An object mesh that is a prism along x or y (a y-up export; a can lying on its side) has
+/// another reading besides its footprint along z: its cross-section. With `other_readings`, such
+/// a mesh's cross-sections are returned there, and its "side view" warning is held back in
+/// `side_view` for the caller, whose recording can tell which reading was meant
+/// (ChooseObjectReading).
+struct MeshReadings {
+  std::vector<geometry::Shape> shapes;  ///< the cross-sections
+  std::vector<std::string> up;          ///< their axes, "x" or "y"
+  std::string side_view;                ///< the warning held back, empty if none
+};
 geometry::Shape LoadShapeArgument(const std::string& path, const std::string& what,
-                                  std::vector<std::string>* warnings = nullptr);
+                                  std::vector<std::string>* warnings = nullptr, MeshReadings* other_readings = nullptr);
+/// Which reading of an --object mesh the recording's contacts fit (graph::ChooseShapeReading):
+/// sets trajectory.object.shape, says on stderr what was chosen and why, and adds that, or the
+/// held-back side-view warning when the footprint along z is kept without fitting, to `warnings`.
+/// With align_shape off the footprint along z is kept and the warning said, as before.
+void ChooseObjectReading(const std::string& path, const MeshReadings& readings, const graph::EstimatorConfig& config,
+                         push::Trajectory* trajectory, std::vector<std::string>* warnings);
 /// Says on stderr when a shape is outside 1 mm to 2 m across (io::ShapeUnitsWarning), for the
 /// commands that take a shape's size as given (limit-surface, simulate); estimate's shape check
 /// finds the units itself.

@@ -36,9 +36,10 @@ struct EstimateOptions {
 
 // `mesh_warnings`: what reading the --object and --finger meshes warned of (a side view, several
 // objects united), for RESULT.json too: on stderr alone, a reader of the result never saw them.
-push::Trajectory LoadInput(const EstimateOptions& o, std::string* source, std::vector<std::string>* mesh_warnings) {
+push::Trajectory LoadInput(const EstimateOptions& o, std::string* source, std::vector<std::string>* mesh_warnings,
+                           MeshReadings* object_readings) {
   evaluation::InputOverrides given;
-  if (!o.object.empty()) given.object_shape = LoadShapeArgument(o.object, "--object", mesh_warnings);
+  if (!o.object.empty()) given.object_shape = LoadShapeArgument(o.object, "--object", mesh_warnings, object_readings);
   if (!o.finger.empty()) given.finger_shape = LoadShapeArgument(o.finger, "--finger", mesh_warnings);
   if (o.mass > 0.0) given.mass = o.mass;
   if (o.mu >= 0.0) given.mu_surface = o.mu;
@@ -62,7 +63,8 @@ void RunEstimate(const EstimateOptions& o) {
   if (!o.config.empty()) graph::LoadEstimatorConfig(o.config);
   std::string source;
   std::vector<std::string> mesh_warnings;
-  push::Trajectory traj = LoadInput(o, &source, &mesh_warnings);
+  MeshReadings object_readings;
+  push::Trajectory traj = LoadInput(o, &source, &mesh_warnings, &object_readings);
   if (!o.add_noise.empty()) {
     // The paper's Sec. IV noise on the clean streams (the recording, or the file's ground truth);
     // the clean streams stay as ground truth, so metrics are computed.
@@ -89,6 +91,7 @@ void RunEstimate(const EstimateOptions& o) {
   }
   graph::EstimationResult result;
   try {
+    ChooseObjectReading(o.object, object_readings, config, &traj, &mesh_warnings);
     result = graph::Estimate(traj, model, mode, config);
   } catch (const graph::GraphError& e) {
     throw CliError(o.input + ": " + e.what());

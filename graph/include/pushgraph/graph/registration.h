@@ -199,6 +199,36 @@ RegistrationResult RegisterShape(const push::Trajectory& trajectory, const Regis
 RegistrationResult RegisterShape(const std::vector<const push::Trajectory*>& recordings,
                                  const RegistrationOptions& options = {});
 
+/// Which of several readings of one object file a recording's contacts fit. A mesh exported with
+/// y up (Blender's, glTF's convention) is a prism along y: seen along z its footprint is its side
+/// view (rect1: 90 x 12.7 mm for its 90 x 90 mm top), and estimating with it gave 1.35 mm against
+/// 0.95. Its cross-section along y is the footprint meant. A can lying along y is a prism along y
+/// too, but pushed on its side, whose footprint along z is right: only the contacts can tell.
+///
+/// Reading 0 (the default, e.g. along z) is kept when its contacts fit it (CheckShapeFit).
+/// Otherwise the reading whose contacts fit as given with the smallest median gap is chosen; when
+/// none fits as given, each is registered (RegisterShape, one noise scale for all) and another
+/// reading is chosen only when its registered cost is lower than reading 0's by 2 (a
+/// log-likelihood), or reading 0 is no size of the push at all (size_mismatch).
+///
+///   std::vector<geometry::Shape> readings{along_z, along_y};
+///   const graph::ShapeReadingChoice c = graph::ChooseShapeReading(trajectory, readings);
+///   trajectory.object.shape = readings[c.index];
+struct ShapeReadingChoice {
+  int index = 0;                      ///< the reading chosen
+  std::vector<ShapeFitCheck> checks;  ///< each reading as given (empty when it could not be checked)
+  std::vector<bool> checked;          ///< whether checks[k] holds a check (too few contacts: no)
+  /// Registered Cauchy costs (RegistrationResult::aligned_cost) when no reading fit as given; NaN
+  /// for a reading not registered or refused for its size.
+  std::vector<double> registered_costs;
+  bool by_registration = false;       ///< the choice rests on the registered costs
+  /// Why: "reading 1 fits (median contact gap 1.1 mm, ...), reading 0 does not (...)"; empty
+  /// when reading 0 fits as given.
+  std::string reason;
+};
+ShapeReadingChoice ChooseShapeReading(const push::Trajectory& trajectory, const std::vector<geometry::Shape>& readings,
+                                      const RegistrationOptions& options = {});
+
 /// The finger's reference point in the object frame at every finger sample in contact (object
 /// pose interpolated; both streams smoothed first when options.smooth), with the time stamps
 /// and the finger's pose relative to the object: the data registration fits.

@@ -46,6 +46,9 @@ struct FootprintReport {
   /// The axes along which the mesh is a prism (every vertex on two end planes, at least three on
   /// each): an extruded outline, whose cross-section is its footprint along that axis.
   std::vector<UpAxis> prism_axes;
+  /// Set when every used vertex lies in one plane (an outline drawn flat): the axis across it,
+  /// the one reading of such a file (filled before MeshFootprint refuses another up axis).
+  std::optional<UpAxis> flat_axis;
 };
 
 /// Throws IoError naming the file for unreadable, empty or broken meshes, an unknown object name,
