@@ -33,11 +33,17 @@ using internal::SplitMix;
 
 // Mesh footprints by path and axis: every recording of an object shares one (the Boolean union
 // of a mesh's faces takes up to seconds).
+struct Footprint {
+  geometry::Shape shape;
+  std::vector<UpAxis> prism_axes;  // io::FootprintReport's
+};
 std::mutex g_footprint_mutex;
-std::map<std::string, geometry::Shape> g_footprints;  // mesh path + axis -> footprint
+std::map<std::string, Footprint> g_footprints;  // mesh path + axis -> footprint
 
-geometry::Shape CachedFootprint(const std::string& path, UpAxis up) {
-  const std::string key = path + (up == UpAxis::kY ? "#y" : "#z");
+const char* AxisName(UpAxis up) { return up == UpAxis::kX ? "x" : up == UpAxis::kY ? "y" : "z"; }
+
+Footprint CachedFootprint(const std::string& path, UpAxis up) {
+  const std::string key = path + "#" + AxisName(up);
   {
     std::lock_guard<std::mutex> lock(g_footprint_mutex);
     auto it = g_footprints.find(key);
@@ -45,9 +51,29 @@ geometry::Shape CachedFootprint(const std::string& path, UpAxis up) {
   }
   io::FootprintOptions o;
   o.up = up;
-  geometry::Shape s = io::MeshFootprint(path, o);
+  io::FootprintReport report;
+  Footprint f{io::MeshFootprint(path, o, &report), report.prism_axes};
   std::lock_guard<std::mutex> lock(g_footprint_mutex);
-  return g_footprints.emplace(key, std::move(s)).first->second;
+  return g_footprints.emplace(key, std::move(f)).first->second;
+}
+
+// The probe's cylinder: its axis is the prism axis whose cross-section is round (the dataset's
+// tip.obj lies along y; a y-up export of it stands along z). Bounds as wide as tall and an area
+// of pi r^2 within 5 %; y when none is.
+UpAxis ProbeAxis(const std::string& path) {
+  const Footprint along_y = CachedFootprint(path, UpAxis::kY);
+  std::vector<UpAxis> candidates{UpAxis::kY};
+  for (const UpAxis a : along_y.prism_axes)
+    if (a != UpAxis::kY) candidates.push_back(a);
+  for (const UpAxis a : candidates) {
+    const Footprint f = CachedFootprint(path, a);
+    if (std::find(f.prism_axes.begin(), f.prism_axes.end(), a) == f.prism_axes.end()) continue;
+    const geometry::Box2 box = f.shape.bounds();
+    const double w = box.max.x() - box.min.x(), h = box.max.y() - box.min.y(), r = 0.25 * (w + h);
+    if (std::abs(w - h) <= 0.05 * std::max(w, h) && std::abs(f.shape.core_area() - M_PI * r * r) <= 0.05 * M_PI * r * r)
+      return a;
+  }
+  return UpAxis::kY;
 }
 
 // An `obj` folder holding NAME.obj beside or above the recording (the dataset's layout:
@@ -99,20 +125,20 @@ push::Trajectory LoadCleanTrajectory(const EvaluationItem& item, const Evaluatio
     t.ground_truth = t.measured;
     return t;
   }
-  ObjectModel model;
-  if (o.object_override) {
-    model = *o.object_override;
-  } else if (auto it = o.objects.find(item.group); it != o.objects.end()) {
-    model = it->second;
-  } else {
-    std::string dir = o.mesh_dir.empty() ? FindMeshDir(item.path, item.group) : o.mesh_dir;
-    if (dir.empty()) {
-      throw EvaluationError(item.path + ": no mesh for object '" + item.group +
-                    "' (no obj/" + item.group + ".obj beside or above it); give --mesh-dir, --object/--finger/--mass/--mu or an evaluation config");
-    }
-    model = MitObjectModel(item.group, dir);
+  return ReadMitTrajectory(item.path, *MitItemModel(item, o), o.mit_rate);
+}
+
+std::optional<ObjectModel> MitItemModel(const EvaluationItem& item, const EvaluationOptions& o) {
+  if (item.source == EvaluationItem::Source::kSimulated || DetectInputKind(item.path) == InputKind::kTrajectory)
+    return std::nullopt;
+  if (o.object_override) return *o.object_override;
+  if (auto it = o.objects.find(item.group); it != o.objects.end()) return it->second;
+  std::string dir = o.mesh_dir.empty() ? FindMeshDir(item.path, item.group) : o.mesh_dir;
+  if (dir.empty()) {
+    throw EvaluationError(item.path + ": no mesh for object '" + item.group +
+                  "' (no obj/" + item.group + ".obj beside or above it); give --mesh-dir, --object/--finger/--mass/--mu or an evaluation config");
   }
-  return ReadMitTrajectory(item.path, model, o.mit_rate);
+  return MitObjectModel(item.group, dir);
 }
 
 }  // namespace internal
@@ -261,11 +287,19 @@ ObjectModel MitObjectModel(const std::string& name, const std::string& mesh_dir)
                   "' (known: rect1-3, ellip1-3, tri1-3, hex, butter); give its shape and mass");
   }
   ObjectModel m;
-  m.object.shape = CachedFootprint((fs::path(mesh_dir) / (name + ".obj")).string(), UpAxis::kZ);
+  const std::string mesh = (fs::path(mesh_dir) / (name + ".obj")).string();
+  const Footprint top = CachedFootprint(mesh, UpAxis::kZ);
+  m.object.shape = top.shape;
+  for (const UpAxis a : top.prism_axes) {
+    if (a == UpAxis::kZ) continue;
+    m.other_readings.push_back(CachedFootprint(mesh, a).shape);
+    m.reading_axes.push_back(AxisName(a));
+  }
   // The probe is a cylinder: a disk of the mesh's radius (its footprint's vertices lie on the
   // circle). A disk, not the polygon: the intersection factor's obstacle (a Minkowski sum) then
   // does not depend on the relative rotation and is built once instead of at every new angle.
-  const geometry::Box2 tip = CachedFootprint((fs::path(mesh_dir) / "tip.obj").string(), UpAxis::kY).bounds();
+  const std::string probe = (fs::path(mesh_dir) / "tip.obj").string();
+  const geometry::Box2 tip = CachedFootprint(probe, ProbeAxis(probe)).shape.bounds();
   m.finger.shape = geometry::Shape::Disk(0.25 * ((tip.max.x() - tip.min.x()) + (tip.max.y() - tip.min.y())));
   m.finger.mu_contact = 0.25;
   m.object.mass = *mass;

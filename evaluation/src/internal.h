@@ -55,6 +55,9 @@ void AccumulateRaw(const push::Trajectory& traj, const std::string& prefix, Stat
 /// The clean trajectory of an item: its file's ground truth (or streams), the MIT recording
 /// with its object model, or the simulated push.
 push::Trajectory LoadCleanTrajectory(const EvaluationItem& item, const EvaluationOptions& options);
+/// The object model of an MIT recording item (the override, the configuration's objects, or its
+/// mesh folder); nullopt for trajectory files and simulated pushes.
+std::optional<ObjectModel> MitItemModel(const EvaluationItem& item, const EvaluationOptions& options);
 /// The MIT object name of a file ("..._shape=ellip1_..."), else its folder's name.
 std::string MitGroup(const std::string& path);
 

@@ -182,12 +182,23 @@ std::vector<EvaluationItem> PlanEvaluation(const std::vector<std::string>& files
 std::vector<std::string> RegisterGroups(std::vector<EvaluationItem>& items, const EvaluationOptions& options) {
   using Align = graph::EstimatorConfig::AlignShape;
   std::vector<std::string> lines;
-  if (options.estimator.align_shape == Align::kOff) return lines;
   std::map<std::string, std::vector<std::size_t>> groups;
   for (std::size_t i = 0; i < items.size(); ++i) {
     if (items[i].source == EvaluationItem::Source::kFile) groups[items[i].group].push_back(i);
   }
   for (const auto& [group, members] : groups) {
+    // The object's mesh and its other readings (a prism along x or y).
+    std::optional<ObjectModel> model;
+    try {
+      model = MitItemModel(items[members.front()], options);
+    } catch (const std::exception&) {
+    }
+    if (options.estimator.align_shape == Align::kOff) {
+      if (model && !model->other_readings.empty())
+        lines.push_back(group + ": warning: the object's mesh is a prism along " + model->reading_axes.front() +
+                        ", and seen along z its footprint is its side view (align_shape off: used as it is)");
+      continue;
+    }
     std::vector<push::Trajectory> clean;
     for (std::size_t i : members) {
       try {
@@ -201,6 +212,28 @@ std::vector<std::string> RegisterGroups(std::vector<EvaluationItem>& items, cons
     for (const push::Trajectory& t : clean) pooled.push_back(&t);
     graph::RegistrationOptions ro = graph::RegistrationOptionsFor(options.estimator);
     ro.estimate_scale = options.estimator.align_scale;
+    // Which reading of the object's mesh the recordings fit: a y-up export read along z is its
+    // side view (rect1: 90 x 12.7 mm).
+    if (model && !model->other_readings.empty()) {
+      std::vector<geometry::Shape> readings{clean.front().object.shape};
+      readings.insert(readings.end(), model->other_readings.begin(), model->other_readings.end());
+      std::vector<std::string> names{"along z"};
+      for (const std::string& axis : model->reading_axes) names.push_back("along " + axis);
+      const graph::ShapeReadingChoice choice = graph::ChooseShapeReading(pooled, readings, ro, names);
+      const std::string& reason = choice.reason;
+      if (choice.index > 0) {
+        const std::string& up = model->reading_axes[choice.index - 1];
+        for (std::size_t i : members) items[i].object_shape = readings[choice.index];
+        for (push::Trajectory& t : clean) t.object.shape = readings[choice.index];
+        lines.push_back(group + ": the object's mesh is a prism along " + up + " (a y-up export, or an object lying on its "
+                        "side), and its recordings' contacts fit its cross-section along " + up +
+                        ", not its footprint along z (its side view): used for every recording (" + reason + ")");
+      } else if (!choice.reason.empty()) {
+        lines.push_back(group + ": warning: the object's mesh is a prism along " + model->reading_axes.front() +
+                        ", and seen along z its footprint is its side view; its recordings fit no other reading "
+                        "clearly better (" + reason + ")");
+      }
+    }
     try {
       const graph::RegistrationResult r = graph::RegisterShape(pooled, ro);
       // A shape no unit makes the size of the paths is not placed (each estimate refuses it).
@@ -294,6 +327,7 @@ EvaluationRow EvaluateItem(const EvaluationItem& item, const EvaluationOptions& 
   std::string stage = "reading";
   try {
     push::Trajectory clean = LoadCleanTrajectory(item, o);
+    if (item.object_shape) clean.object.shape = *item.object_shape;
     if (item.shape_transform) {
       const graph::ShapeTransform& t = *item.shape_transform;
       clean.object.shape = geometry::TransformShape(clean.object.shape, t.pose, t.scale, t.mirrored);

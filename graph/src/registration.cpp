@@ -260,10 +260,15 @@ ContactPath MeasuredContactPath(const push::Trajectory& traj, const Registration
 }
 
 ShapeFitCheck CheckShapeFit(const push::Trajectory& trajectory, const RegistrationOptions& options) {
+  return CheckShapeFit(std::vector<const push::Trajectory*>{&trajectory}, options);
+}
+
+ShapeFitCheck CheckShapeFit(const std::vector<const push::Trajectory*>& recordings, const RegistrationOptions& options) {
+  if (recordings.empty()) throw GraphError("CheckShapeFit: no recording given");
   std::vector<double> spans;
-  const Contacts c = PoolContacts({&trajectory}, options, &spans);
-  return CheckContacts(trajectory.object.shape, trajectory.finger.shape, c.ForFit(options.max_refine_samples, spans, options),
-                       options);
+  const Contacts c = PoolContacts(recordings, options, &spans);
+  return CheckContacts(recordings.front()->object.shape, recordings.front()->finger.shape,
+                       c.ForFit(options.max_refine_samples, spans, options), options);
 }
 
 RegistrationResult RegisterShape(const push::Trajectory& trajectory, const RegistrationOptions& options) {

@@ -16,38 +16,56 @@
 namespace pushgraph::graph {
 
 ShapeReadingChoice ChooseShapeReading(const push::Trajectory& trajectory, const std::vector<geometry::Shape>& readings,
-                                      const RegistrationOptions& options) {
+                                      const RegistrationOptions& options, const std::vector<std::string>& names) {
+  return ChooseShapeReading(std::vector<const push::Trajectory*>{&trajectory}, readings, options, names);
+}
+
+ShapeReadingChoice ChooseShapeReading(const std::vector<const push::Trajectory*>& recordings,
+                                      const std::vector<geometry::Shape>& readings, const RegistrationOptions& options,
+                                      const std::vector<std::string>& names) {
   using internal::Format;
   if (readings.empty()) throw GraphError("ChooseShapeReading: no reading given");
+  if (recordings.empty()) throw GraphError("ChooseShapeReading: no recording given");
   ShapeReadingChoice choice;
   const std::size_t n = readings.size();
   choice.checks.resize(n);
   choice.checked.assign(n, false);
   choice.registered_costs.assign(n, std::numeric_limits<double>::quiet_NaN());
   if (n == 1) return choice;
-  // The finger in its own units, as the estimator reads it (a CAD export of both in millimetres).
-  push::Trajectory judged = trajectory;
-  try {
-    std::string note;
-    double scale = 1.0;
-    if (std::optional<push::Trajectory> scaled = internal::FingerUnits(trajectory, options, &note, &scale))
-      judged = std::move(*scaled);
-  } catch (const std::exception&) {
-    // The estimate refuses such a trajectory with its own message; here it is judged as given.
+  // The fingers in their own units, as the estimator reads them (a CAD export of both in millimetres).
+  std::vector<push::Trajectory> judged;
+  for (const push::Trajectory* t : recordings) {
+    judged.push_back(*t);
+    try {
+      std::string note;
+      double scale = 1.0;
+      if (std::optional<push::Trajectory> scaled = internal::FingerUnits(*t, options, &note, &scale))
+        judged.back() = std::move(*scaled);
+    } catch (const std::exception&) {
+      // The estimate refuses such a trajectory with its own message; here it is judged as given.
+    }
   }
+  std::vector<const push::Trajectory*> pooled;
+  for (const push::Trajectory& t : judged) pooled.push_back(&t);
+  auto set_reading = [&](const geometry::Shape& shape) {
+    for (push::Trajectory& t : judged) t.object.shape = shape;
+  };
   // Each reading as given (the object's units found as the finger's checks find them).
   for (std::size_t k = 0; k < n; ++k) {
-    judged.object.shape = readings[k];
+    set_reading(readings[k]);
+    const geometry::Shape in_metres = internal::WithObjectInMetres(judged.front()).object.shape;
+    set_reading(in_metres);
     try {
-      choice.checks[k] = CheckShapeFit(internal::WithObjectInMetres(judged), options);
+      choice.checks[k] = CheckShapeFit(pooled, options);
       choice.checked[k] = true;
     } catch (const std::exception&) {
     }
   }
+  auto name = [&](std::size_t k) { return names.size() == n ? names[k] : Format("reading %zu", k); };
   auto describe = [&](std::size_t k) {
-    return choice.checked[k] ? Format("reading %zu %s (%s)", k, choice.checks[k].fits ? "fits" : "does not fit",
+    return choice.checked[k] ? Format("%s %s (%s)", name(k).c_str(), choice.checks[k].fits ? "fits" : "does not fit",
                                       choice.checks[k].Describe().c_str())
-                             : Format("reading %zu could not be checked", k);
+                             : name(k) + " could not be checked";
   };
   if (!choice.checked[0] || choice.checks[0].fits) return choice;
   std::optional<std::size_t> fitting;
@@ -69,9 +87,9 @@ ShapeReadingChoice ChooseShapeReading(const push::Trajectory& trajectory, const 
   std::vector<bool> ok(n, false);
   RegistrationOptions common = options;
   for (std::size_t k = 0; k < n; ++k) {
-    judged.object.shape = readings[k];
+    set_reading(readings[k]);
     try {
-      registered[k] = RegisterShape(judged, common);
+      registered[k] = RegisterShape(pooled, common);
       ok[k] = true;
       if (k == 0 && common.noise <= 0.0) common.noise = registered[0].noise;
       if (!registered[k].size_mismatch) choice.registered_costs[k] = registered[k].aligned_cost;
@@ -89,8 +107,8 @@ ShapeReadingChoice ChooseShapeReading(const push::Trajectory& trajectory, const 
   const double margin = registered[0].size_mismatch ? INFINITY : registered[0].aligned_cost - registered[*best].aligned_cost;
   std::string costs;
   for (std::size_t k = 0; k < n; ++k) {
-    costs += (k ? ", " : "") + (std::isnan(choice.registered_costs[k]) ? Format("reading %zu none", k)
-                                                                        : Format("reading %zu %.1f", k, choice.registered_costs[k]));
+    costs += (k ? ", " : "") + name(k) +
+             (std::isnan(choice.registered_costs[k]) ? std::string(" none") : Format(" %.1f", choice.registered_costs[k]));
   }
   choice.reason += "; aligned to the contacts, their costs (a log-likelihood, lower is better): " + costs;
   // Lower by a clear margin (the estimator's tie margin): the contacts of one push often leave a

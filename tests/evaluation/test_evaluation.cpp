@@ -11,6 +11,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 namespace pushgraph::evaluation {
 namespace {
@@ -326,6 +327,72 @@ TEST_F(Evaluation, RealMitRecordingWithFrozenForceHasNoForceRows) {
   fs::copy_file(rect, dir_ / "abs" / "blob1" / "motion_surface=abs_shape=blob1_x.h5");
   const EvaluationRow bad = EvaluateItem(PlanEvaluation({(dir_ / "abs" / "blob1" / "motion_surface=abs_shape=blob1_x.h5").string()}, o)[0], o);
   EXPECT_NE(bad.error.find("blob1"), std::string::npos) << bad.error;
+}
+
+// A z-up model exported with y up: every vertex (x, y, z) written as (x, z, -y).
+void WriteYUpExport(const std::string& from, const std::string& to) {
+  std::ifstream in(from);
+  std::ofstream out(to);
+  out.precision(17);
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("v ", 0) == 0) {
+      double x, y, z;
+      std::istringstream(line.substr(2)) >> x >> y >> z;
+      out << "v " << x << " " << z << " " << -y << "\n";
+    } else {
+      out << line << "\n";
+    }
+  }
+}
+
+// A folder of the dataset's meshes exported with y up (Blender's OBJ convention): rect1.obj read
+// along z is its 90 x 12.7 mm side view, and the probe tip.obj, a cylinder standing along z now,
+// read along y gave a disk the size of its side view. The group's recordings choose rect1's
+// cross-section, the probe's round section is found, and the rows equal the shipped meshes'.
+TEST_F(Evaluation, AFolderOfMeshesExportedWithYUpIsReadByTheirCrossSections) {
+  const std::string rect_dir = kMit + "abs/rect1/";
+  if (!fs::exists(rect_dir) || !fs::exists(kMit + "obj/rect1.obj")) GTEST_SKIP() << "no MIT data at " << kMit;
+  const fs::path y_up = dir_ / "y_up";
+  fs::create_directories(y_up);
+  for (const std::string mesh : {"rect1.obj", "tip.obj"}) WriteYUpExport(kMit + "obj/" + mesh, (y_up / mesh).string());
+  const ObjectModel model = MitObjectModel("rect1", y_up.string());
+  const geometry::Box2 side = model.object.shape.bounds();
+  EXPECT_NEAR(side.max.y() - side.min.y(), 0.0127, 1e-4) << "read along z, the side view";
+  ASSERT_EQ(model.other_readings.size(), 1u);
+  EXPECT_EQ(model.reading_axes[0], "y");
+  EXPECT_NEAR(model.finger.shape.radius(), 0.0047, 1e-6) << "the probe's round section";
+  EvaluationOptions o;
+  o.protocols = ParseProtocols("table1");
+  o.mit_rate = 50.0;
+  const std::vector<std::string> files{rect_dir + "motion_surface=abs_shape=rect1_a=0_v=75_i=2.000_s=0.700_t=-1.047.h5",
+                                       rect_dir + "motion_surface=abs_shape=rect1_a=0_v=75_i=2.000_s=0.800_t=0.349.h5"};
+  EvaluationOptions exported = o, shipped = o;
+  exported.mesh_dir = y_up.string();
+  shipped.mesh_dir = kMit + "obj";
+  std::vector<EvaluationItem> items = PlanEvaluation(files, exported), reference = PlanEvaluation(files, shipped);
+  const std::vector<std::string> lines = RegisterGroups(items, exported);
+  ASSERT_FALSE(lines.empty());
+  EXPECT_NE(lines[0].find("contacts fit its cross-section along y, not its footprint along z"), std::string::npos) << lines[0];
+  RegisterGroups(reference, shipped);
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    ASSERT_TRUE(items[i].object_shape.has_value());
+    EXPECT_FALSE(reference[i].object_shape.has_value());
+    const EvaluationRow a = EvaluateItem(items[i], exported), b = EvaluateItem(reference[i], shipped);
+    ASSERT_TRUE(a.error.empty() && b.error.empty()) << a.error << b.error;
+    ASSERT_EQ(a.stats.size(), b.stats.size());
+    for (const auto& [key, value] : b.stats) {
+      ASSERT_TRUE(a.stats.count(key)) << key;
+      if (key.find("/time/") != std::string::npos) continue;  // the solve's wall time
+      EXPECT_NEAR(a.stats.at(key), value, 1e-9 * (1.0 + std::abs(value))) << key;
+    }
+  }
+  // align_shape off: read along z as given, and said.
+  exported.estimator.align_shape = graph::EstimatorConfig::AlignShape::kOff;
+  std::vector<EvaluationItem> as_given = PlanEvaluation(files, exported);
+  const std::vector<std::string> off = RegisterGroups(as_given, exported);
+  ASSERT_EQ(off.size(), 1u);
+  EXPECT_NE(off[0].find("its footprint is its side view (align_shape off"), std::string::npos) << off[0];
+  EXPECT_FALSE(as_given[0].object_shape.has_value());
 }
 
 TEST_F(Evaluation, CommandReportsBadOptionsInOneLine) {

@@ -182,10 +182,28 @@ namespace {
 // vertices lie on the cylinder within 0.5 %, and a polygonal finger needs an exact Minkowski-sum
 // obstacle per relative angle (a rect1 recording: 6.4 s against 0.4 s as a disk). Centre and
 // radius are the vertices' mean and mean distance, so the finger's frame is kept.
-std::optional<geometry::Shape> TessellatedDisk(const geometry::Shape& shape) {
+std::optional<geometry::Shape> TessellatedDisk(const geometry::Shape& shape, std::size_t* corners) {
   if (shape.polygons().size() != 1 || !shape.polygons()[0].holes.empty() || shape.radius() != 0.0) return std::nullopt;
-  const geometry::Ring& ring = shape.polygons()[0].outer;
+  // Its corners: a vertex within 1e-9 of the outline's size of the previous one, or on the
+  // straight line between its neighbours to 1e-9 of the edge, is none (a seam kept by the exact
+  // union of a re-exported mesh's rounded coordinates: a y-up tip.obj gave 34 vertices, two of
+  // them 1e-18 m apart).
+  const geometry::Ring& given = shape.polygons()[0].outer;
+  const geometry::Box2 box = shape.bounds();
+  const double size = (box.max - box.min).norm();
+  geometry::Ring distinct;
+  for (const geometry::Vec2& v : given)
+    if (distinct.empty() || (v - distinct.back()).norm() > 1e-9 * size) distinct.push_back(v);
+  while (distinct.size() > 1 && (distinct.front() - distinct.back()).norm() <= 1e-9 * size) distinct.pop_back();
+  geometry::Ring ring;
+  for (std::size_t i = 0; i < distinct.size(); ++i) {
+    const std::size_t m = distinct.size();
+    const geometry::Vec2 a = distinct[(i + m - 1) % m], v = distinct[i], b = distinct[(i + 1) % m];
+    const geometry::Vec2 ab = b - a, av = v - a;
+    if (std::abs(ab.x() * av.y() - ab.y() * av.x()) > 1e-9 * ab.squaredNorm()) ring.push_back(v);
+  }
   const std::size_t n = ring.size();
+  *corners = n;
   if (n < 20) return std::nullopt;  // a 12-gon's inscribed circle is 3.4 % smaller than its circumcircle
   geometry::Vec2 centre = geometry::Vec2::Zero();
   for (const geometry::Vec2& v : ring) centre += v;
@@ -267,13 +285,14 @@ geometry::Shape LoadMeshArgument(const std::string& path, const std::string& wha
     if (warnings) warnings->push_back(what + " " + path + ": " + w);
   }
   if (finger) {
-    if (const std::optional<geometry::Shape> disk = TessellatedDisk(shape)) {
+    std::size_t corners = 0;
+    if (const std::optional<geometry::Shape> disk = TessellatedDisk(shape, &corners)) {
       const geometry::Vec2 centre = disk->polygons()[0].outer[0];
       std::fprintf(stderr,
                    "pushgraph: %s %s: its footprint is a regular %zu-gon, a tessellated cylinder: used as the disk "
                    "of radius %.4g mm at (%.3f, %.3f) mm it approximates (a polygonal finger solves 6 to 13x "
                    "slower; pushgraph footprint %s%s -o SHAPE.json keeps the polygon)\n",
-                   what.c_str(), path.c_str(), shape.polygons()[0].outer.size(), 1e3 * disk->radius(),
+                   what.c_str(), path.c_str(), corners, 1e3 * disk->radius(),
                    1e3 * centre.x(), 1e3 * centre.y(), path.c_str(),
                    options.up == io::UpAxis::kZ ? "" : (std::string(" --up ") + up).c_str());
       return *disk;
@@ -323,16 +342,11 @@ void ChooseObjectReading(const std::string& path, const MeshReadings& readings, 
   }
   std::vector<geometry::Shape> candidates{trajectory->object.shape};
   candidates.insert(candidates.end(), readings.shapes.begin(), readings.shapes.end());
+  std::vector<std::string> names{"along z"};
+  for (const std::string& axis : readings.up) names.push_back("along " + axis);
   const graph::ShapeReadingChoice choice =
-      graph::ChooseShapeReading(*trajectory, candidates, graph::RegistrationOptionsFor(config));
-  // The readings by name: reading 0 is the footprint along z, k its cross-section along up[k-1].
-  std::string reason = choice.reason;
-  for (std::size_t k = candidates.size(); k-- > 0;) {
-    const std::string name = k == 0 ? "along z" : "along " + readings.up[k - 1];
-    for (std::size_t at = reason.find("reading " + std::to_string(k)); at != std::string::npos;
-         at = reason.find("reading " + std::to_string(k), at + name.size()))
-      reason.replace(at, 8 + std::to_string(k).size(), name);
-  }
+      graph::ChooseShapeReading(*trajectory, candidates, graph::RegistrationOptionsFor(config), names);
+  const std::string& reason = choice.reason;
   if (choice.index > 0) {
     const std::string& up = readings.up[choice.index - 1];
     trajectory->object.shape = candidates[choice.index];

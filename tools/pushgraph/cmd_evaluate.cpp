@@ -121,7 +121,11 @@ void RunEvaluate(const EvaluateOptions& o) {
     if (o.object.empty() || o.finger.empty() || !(o.mass > 0.0) || !(o.mu >= 0.0))
       throw CliError("--object, --finger, --mass and --mu go together (they describe every MIT recording)");
     evaluation::ObjectModel m;
-    m.object.shape = LoadShapeArgument(o.object, "--object");
+    MeshReadings readings;
+    m.object.shape = LoadShapeArgument(o.object, "--object", nullptr, &readings);
+    // Its cross-sections, when it is a prism along x or y: the recordings choose (RegisterGroups).
+    m.other_readings = readings.shapes;
+    m.reading_axes = readings.up;
     m.object.mass = o.mass;
     m.object.mu_surface = o.mu;
     m.finger.shape = LoadShapeArgument(o.finger, "--finger");

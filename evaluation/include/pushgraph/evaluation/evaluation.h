@@ -93,6 +93,9 @@ struct EvaluationItem {
   /// The group's shape registration (RegisterGroups): applied to the object's shape before any
   /// estimate, when the group's recordings together say the shape does not fit as given.
   std::optional<graph::ShapeTransform> shape_transform;
+  /// The group's reading of its object mesh (RegisterGroups), when its recordings fit another
+  /// one than the footprint along z: used instead of the object's shape, before shape_transform.
+  std::optional<geometry::Shape> object_shape;
 };
 
 /// Items for the files (their kind is detected when evaluated: a file that cannot be read gets
@@ -105,6 +108,8 @@ std::vector<EvaluationItem> PlanEvaluation(const std::vector<std::string>& files
 /// mesh, one tracker, pushes on several sides fix what one push leaves free), before sharding so
 /// that every shard uses the same transforms. Groups whose shape does not fit as given get the
 /// transform in their items (options.estimator.align_shape "off": none do; "on": every group).
+/// A group whose object mesh has other readings (ObjectModel::other_readings) first gets the one
+/// its recordings fit (graph::ChooseShapeReading; item.object_shape).
 /// Simulated pushes are left alone. Returns one line per group that was checked (what was
 /// found, for the user and the tables).
 std::vector<std::string> RegisterGroups(std::vector<EvaluationItem>& items, const EvaluationOptions& options);

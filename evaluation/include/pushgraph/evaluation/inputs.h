@@ -55,6 +55,11 @@ InputKind DetectInputKind(const std::string& path);
 struct ObjectModel {
   push::ObjectDescription object;
   push::FingerDescription finger{geometry::Shape(), 0.25};
+  /// Other readings of the object's mesh besides its footprint along z: its cross-sections when
+  /// it is a prism along x or y (a y-up export, or an object lying on its side), with their axes
+  /// ("x", "y"). RegisterGroups lets the group's recordings choose (graph::ChooseShapeReading).
+  std::vector<geometry::Shape> other_readings;
+  std::vector<std::string> reading_axes;
 };
 
 /// Masses of the dataset's eleven objects from its own shape table: rect1 0.8374, rect2 1.045,

@@ -132,6 +132,9 @@ struct ShapeFitCheck {
 /// The cheap check alone (smoothing and one exact query per contact sample): what
 /// EstimatorConfig::align_shape "auto" runs on every estimate before deciding to search.
 ShapeFitCheck CheckShapeFit(const push::Trajectory& trajectory, const RegistrationOptions& options = {});
+/// The same over several recordings of one object (pooled contacts; the first one's shapes).
+ShapeFitCheck CheckShapeFit(const std::vector<const push::Trajectory*>& recordings,
+                            const RegistrationOptions& options = {});
 
 struct RegistrationResult {
   ShapeTransform transform;  ///< the best transform (the identity when nothing was found)
@@ -226,8 +229,15 @@ struct ShapeReadingChoice {
   /// when reading 0 fits as given.
   std::string reason;
 };
+/// `names` name the readings in `reason` ("along z", "along y"); empty: "reading 0", "reading 1".
 ShapeReadingChoice ChooseShapeReading(const push::Trajectory& trajectory, const std::vector<geometry::Shape>& readings,
-                                      const RegistrationOptions& options = {});
+                                      const RegistrationOptions& options = {},
+                                      const std::vector<std::string>& names = {});
+/// The same from several recordings of one object (pooled contacts, as RegisterShape's).
+ShapeReadingChoice ChooseShapeReading(const std::vector<const push::Trajectory*>& recordings,
+                                      const std::vector<geometry::Shape>& readings,
+                                      const RegistrationOptions& options = {},
+                                      const std::vector<std::string>& names = {});
 
 /// The finger's reference point in the object frame at every finger sample in contact (object
 /// pose interpolated; both streams smoothed first when options.smooth), with the time stamps
