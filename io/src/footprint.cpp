@@ -4,6 +4,8 @@
 #include <pushgraph/io/footprint.h>
 #include <pushgraph/io/trajectory_json.h>  // IoError
 
+#include "mesh_soup.h"
+
 #include <CGAL/Boolean_set_operations_2.h>
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 #include <CGAL/Polygon_set_2.h>
@@ -379,26 +381,17 @@ std::vector<std::vector<int>> SnapSeams(const std::vector<std::vector<int>>& fac
   return out;
 }
 
-// tinyobjloader reads any text and skips what it does not know: an STL file read as "the mesh
-// has no faces", with no word of the format.
+// tinyobjloader reads any text and skips what it does not know: a glTF file read as "the mesh
+// has no faces", with no word of the format. (STL, PLY and OFF are read: mesh_soup.h.)
 void RefuseOtherMeshFormats(const std::string& path) {
   std::string extension = std::filesystem::path(path).extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return std::tolower(c); });
-  std::ifstream in(path, std::ios::binary);
-  std::string head(80, '\0');
-  in.read(head.data(), static_cast<std::streamsize>(head.size()));
-  head.resize(static_cast<std::size_t>(std::max<std::streamsize>(in.gcount(), 0)));
-  const std::size_t start = head.find_first_not_of(" \t\r\n");
-  const bool ascii_stl = start != std::string::npos && head.compare(start, 6, "solid ") == 0;
-  const char* format = extension == ".stl" || ascii_stl ? "STL"
-                       : extension == ".ply"           ? "PLY"
-                       : extension == ".off"           ? "OFF"
-                       : extension == ".3mf"           ? "3MF"
-                       : extension == ".dae"           ? "COLLADA"
+  const char* format = extension == ".3mf"                           ? "3MF"
+                       : extension == ".dae"                         ? "COLLADA"
                        : extension == ".gltf" || extension == ".glb" ? "glTF"
                                                                      : nullptr;
   if (format != nullptr)
-    throw IoError(path + ": " + format + " meshes are not read, only Wavefront OBJ (export it as OBJ, e.g. with "
+    throw IoError(path + ": " + format + " meshes are not read, only Wavefront OBJ, STL, PLY and OFF (export it as one of them, e.g. with "
                   "MeshLab, Blender or assimp: assimp export " + std::filesystem::path(path).filename().string() + " MESH.obj)");
 }
 
@@ -409,47 +402,82 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw IoError(path + ": is a directory, not a mesh file");
   RefuseOtherMeshFormats(path);
-  tinyobj::ObjReaderConfig config;
-  // Faces as the file gives them: tinyobjloader's triangulation of a polygon face depends on the
-  // vertex it starts at (a U-shaped 8-gon listed from its fourth vertex had its notch filled).
-  config.triangulate = false;
-  config.vertex_color = false;
-  config.mtl_search_path = "";  // materials are irrelevant to a footprint
-  tinyobj::ObjReader reader;
-  if (!reader.ParseFromFile(path, config)) {
-    std::string message = reader.Error();
-    while (!message.empty() && (message.back() == '\n' || message.back() == '\r')) message.pop_back();
-    std::replace(message.begin(), message.end(), '\n', ' ');
-    throw IoError(path + ": cannot read mesh: " + (message.empty() ? std::string("unknown error") : message));
-  }
-  const tinyobj::attrib_t& attrib = reader.GetAttrib();
+  // The mesh's vertices and faces by object or group (an STL, PLY or OFF file: one, unnamed).
+  struct Group {
+    std::string name;
+    std::vector<std::vector<int>> faces;  // vertex indices, as the file lists them
+  };
+  std::vector<Group> groups;
+  std::vector<double> coordinates;
   FootprintReport local;
   FootprintReport& rep = report ? *report : local;
   rep = FootprintReport{};
-  for (const tinyobj::shape_t& s : reader.GetShapes()) rep.objects.push_back(s.name);
-  if (!options.object.empty() && std::find(rep.objects.begin(), rep.objects.end(), options.object) == rep.objects.end()) {
-    std::string names;
-    for (const std::string& n : rep.objects) {
-      if (!n.empty()) names += (names.empty() ? "" : ", ") + n;
+  if (std::optional<internal::MeshSoup> soup = internal::ReadMeshSoup(path)) {
+    coordinates = std::move(soup->coordinates);
+    groups.push_back({"", std::move(soup->faces)});
+    if (!options.object.empty())
+      throw IoError(path + ": no object named '" + options.object + "' (" + soup->format +
+                    " files hold one unnamed mesh: leave out the object name)");
+  } else {
+    tinyobj::ObjReaderConfig config;
+    // Faces as the file gives them: tinyobjloader's triangulation of a polygon face depends on the
+    // vertex it starts at (a U-shaped 8-gon listed from its fourth vertex had its notch filled).
+    config.triangulate = false;
+    config.vertex_color = false;
+    config.mtl_search_path = "";  // materials are irrelevant to a footprint
+    tinyobj::ObjReader reader;
+    if (!reader.ParseFromFile(path, config)) {
+      std::string message = reader.Error();
+      while (!message.empty() && (message.back() == '\n' || message.back() == '\r')) message.pop_back();
+      std::replace(message.begin(), message.end(), '\n', ' ');
+      throw IoError(path + ": cannot read mesh: " + (message.empty() ? std::string("unknown error") : message));
     }
-    throw IoError(path + ": no object named '" + options.object + "' (" +
-                  (names.empty() ? std::string("the file has no named objects or groups ('o' or 'g' lines)")
-                                 : "the file has: " + names) +
-                  ")");
+    const tinyobj::attrib_t& attrib = reader.GetAttrib();
+    for (const tinyobj::shape_t& s : reader.GetShapes()) rep.objects.push_back(s.name);
+    if (!options.object.empty() && std::find(rep.objects.begin(), rep.objects.end(), options.object) == rep.objects.end()) {
+      std::string names;
+      for (const std::string& n : rep.objects) {
+        if (!n.empty()) names += (names.empty() ? "" : ", ") + n;
+      }
+      throw IoError(path + ": no object named '" + options.object + "' (" +
+                    (names.empty() ? std::string("the file has no named objects or groups ('o' or 'g' lines)")
+                                   : "the file has: " + names) +
+                    ")");
+    }
+    ObjLineFindings found;
+    coordinates = ReadVertexCoordinates(path, attrib.vertices.size(), &found);
+    if (found.crossing > 0) {
+      rep.warnings.push_back(std::to_string(found.crossing) + " face(s) cross themselves (the first at line " + found.first_crossing +
+                             "): such a face is triangulated as a fan, which covers neither its outline's inside nor its "
+                             "hull; split it into simple faces");
+    }
+    if (found.unknown > 0) {
+      rep.warnings.push_back(std::to_string(found.unknown) + " line(s) that are no OBJ statement were skipped (the first at line " +
+                             found.first_unknown + "): is it an OBJ file, and complete?");
+    }
+    if (coordinates.empty()) coordinates.assign(attrib.vertices.begin(), attrib.vertices.end());
+    const int count = static_cast<int>(attrib.vertices.size() / 3);
+    for (const tinyobj::shape_t& s : reader.GetShapes()) {
+      Group group{s.name, {}};
+      const auto& idx = s.mesh.indices;
+      std::size_t first = 0;
+      for (std::size_t f = 0; f < s.mesh.num_face_vertices.size(); first += s.mesh.num_face_vertices[f], ++f) {
+        const std::size_t n = s.mesh.num_face_vertices[f];
+        if (n < 3 || first + n > idx.size()) continue;
+        std::vector<int> face;
+        for (std::size_t k = 0; k < n; ++k) {
+          const int vi = idx[first + k].vertex_index;
+          if (vi < 0 || vi >= count)
+            throw IoError(path + ": object '" + s.name + "' face " + std::to_string(f) + " refers to missing vertex " +
+                          std::to_string(vi + 1));
+          face.push_back(vi);
+        }
+        group.faces.push_back(std::move(face));
+      }
+      groups.push_back(std::move(group));
+    }
   }
-  const int nv = static_cast<int>(attrib.vertices.size() / 3);
-  ObjLineFindings found;
-  std::vector<double> coordinates = ReadVertexCoordinates(path, attrib.vertices.size(), &found);
-  if (found.crossing > 0) {
-    rep.warnings.push_back(std::to_string(found.crossing) + " face(s) cross themselves (the first at line " + found.first_crossing +
-                           "): such a face is triangulated as a fan, which covers neither its outline's inside nor its "
-                           "hull; split it into simple faces");
-  }
-  if (found.unknown > 0) {
-    rep.warnings.push_back(std::to_string(found.unknown) + " line(s) that are no OBJ statement were skipped (the first at line " +
-                           found.first_unknown + "): is it an OBJ file, and complete?");
-  }
-  if (coordinates.empty()) coordinates.assign(attrib.vertices.begin(), attrib.vertices.end());
+  const int nv = static_cast<int>(coordinates.size() / 3);
   auto project = [&](int index) -> std::array<double, 2> {
     const double x = coordinates[3 * index] * options.scale, y = coordinates[3 * index + 1] * options.scale,
                  z = coordinates[3 * index + 2] * options.scale;
@@ -459,25 +487,11 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
       default: return {x, y};
     }
   };
-  std::vector<std::vector<int>> faces;  // vertex indices, as the file lists them
-  for (const tinyobj::shape_t& s : reader.GetShapes()) {
-    if (!options.object.empty() && s.name != options.object) continue;
-    const auto& idx = s.mesh.indices;
-    std::size_t first = 0;
-    for (std::size_t f = 0; f < s.mesh.num_face_vertices.size(); first += s.mesh.num_face_vertices[f], ++f) {
-      const std::size_t n = s.mesh.num_face_vertices[f];
-      if (n < 3 || first + n > idx.size()) continue;
-      ++rep.faces;
-      std::vector<int> face;
-      for (std::size_t k = 0; k < n; ++k) {
-        const int vi = idx[first + k].vertex_index;
-        if (vi < 0 || vi >= nv)
-          throw IoError(path + ": object '" + s.name + "' face " + std::to_string(f) + " refers to missing vertex " +
-                        std::to_string(vi + 1));
-        face.push_back(vi);
-      }
-      faces.push_back(std::move(face));
-    }
+  std::vector<std::vector<int>> faces;  // of the chosen object (all when none is named)
+  for (const Group& g : groups) {
+    if (!options.object.empty() && g.name != options.object) continue;
+    rep.faces += static_cast<int>(g.faces.size());
+    faces.insert(faces.end(), g.faces.begin(), g.faces.end());
   }
   const std::vector<std::vector<int>> snapped = SnapSeams(faces, nv, project, &rep.vertices_snapped);
   if (rep.vertices_snapped > 0) {
@@ -543,12 +557,11 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
   {
     std::vector<std::string> with_faces;
     std::vector<char> used(nv, 0);
-    for (const tinyobj::shape_t& s : reader.GetShapes()) {
-      if (!options.object.empty() && s.name != options.object) continue;
-      if (!s.mesh.indices.empty()) with_faces.push_back(s.name.empty() ? "(unnamed)" : s.name);
-      for (const auto& index : s.mesh.indices) {
-        if (index.vertex_index >= 0 && index.vertex_index < nv) used[index.vertex_index] = 1;
-      }
+    for (const Group& g : groups) {
+      if (!options.object.empty() && g.name != options.object) continue;
+      if (!g.faces.empty()) with_faces.push_back(g.name.empty() ? "(unnamed)" : g.name);
+      for (const std::vector<int>& face : g.faces)
+        for (const int v : face) used[v] = 1;
     }
     if (options.object.empty() && with_faces.size() > 1) {
       std::string names;

@@ -377,7 +377,7 @@ own frame (metres). Immutable; copies share their acceleration structures.
             return shape;
           },
           "path"_a, "up"_a = "z", "object"_a = "", "scale"_a = 1.0,
-          "The footprint of an OBJ mesh: the exact union of its triangles projected along `up` ('x', 'y' or 'z'; "
+          "The footprint of a mesh (OBJ, STL, PLY or OFF): the exact union of its triangles projected along `up` ('x', 'y' or 'z'; "
           "'y' gives (x, -z), the top view of a y-up export), holes kept; `object` picks one object/group of the "
           "file; `scale` 0.001 for a mesh in millimetres. A UserWarning says when the footprint is probably not "
           "what was meant: a prism seen from the side, several objects united, a shape outside 1 mm to 2 m across.")

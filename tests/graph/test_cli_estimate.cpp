@@ -11,7 +11,9 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -99,6 +101,53 @@ class EstimateCli : public pushgraph::testing::ToolTest {
       }
     }
     return path;
+  }
+  // The dataset's mesh as a CAD tool exports it: a binary STL (float32), its coordinates times `scale`.
+  std::string StlExport(const std::string& mesh, double scale, const std::string& name) {
+    std::vector<std::array<float, 3>> vertices;
+    std::vector<std::array<float, 12>> facets;
+    std::ifstream in(Mit() + "obj/" + mesh);
+    for (std::string line; std::getline(in, line);) {
+      std::istringstream s(line);
+      std::string kind;
+      s >> kind;
+      if (kind == "v") {
+        double x, y, z;
+        s >> x >> y >> z;
+        vertices.push_back({static_cast<float>(x * scale), static_cast<float>(y * scale), static_cast<float>(z * scale)});
+      } else if (kind == "f") {
+        std::vector<int> face;
+        for (std::string token; s >> token;) face.push_back(std::stoi(token.substr(0, token.find('/'))) - 1);
+        for (std::size_t k = 1; k + 1 < face.size(); ++k) {
+          std::array<float, 12> f{};
+          for (int c = 0; c < 3; ++c)
+            for (int a = 0; a < 3; ++a) f[3 + 3 * c + a] = vertices[face[c == 0 ? 0 : k + c - 1]][a];
+          facets.push_back(f);
+        }
+      }
+    }
+    const std::string path = dir() + "/" + name;
+    std::ofstream out(path, std::ios::binary);
+    const std::string header(80, ' ');
+    out.write(header.data(), 80);
+    const std::uint32_t count = static_cast<std::uint32_t>(facets.size());
+    out.write(reinterpret_cast<const char*>(&count), 4);
+    for (const auto& f : facets) {
+      out.write(reinterpret_cast<const char*>(f.data()), 48);
+      out.write("\0\0", 2);
+    }
+    return path;
+  }
+  // The largest difference of the object poses' first `components` (x, y, theta) of two results
+  // with the same steps.
+  static double LargestObjectPoseDifference(const nlohmann::json& a, const nlohmann::json& b, int components = 3) {
+    EXPECT_EQ(a["states"].size(), b["states"].size());
+    double largest = 0.0;
+    for (std::size_t i = 0; i < a["states"].size() && i < b["states"].size(); ++i)
+      for (int k = 0; k < components; ++k)
+        largest = std::max(largest, std::abs(a["states"][i]["object_pose"][k].get<double>() -
+                                             b["states"][i]["object_pose"][k].get<double>()));
+    return largest;
   }
   static constexpr double kRect1Mass = 0.8374, kEllip1Mass = 0.8937, kProbe = 0.0047;
 };
@@ -489,11 +538,17 @@ TEST_F(EstimateCli, MeshFilesAreReadDirectly) {
   for (const auto& w : two["warnings"])
     said = said || w.get<std::string>().find("two_objects.obj: the file holds 2 objects or groups") != std::string::npos;
   EXPECT_TRUE(said) << two["warnings"].dump();
+  // STL, PLY and OFF meshes are read too (an empty one says so); other files are told which are.
   std::ofstream(dir() + "/probe.stl") << "solid probe\nendsolid probe\n";
   const pushgraph::testing::ToolRun stl =
       Tool("estimate '" + h5 + "' --object " + dir() + "/probe.stl --finger " + dir() + "/tip.json" + mass + "-o " + dir() + "/x.json");
   EXPECT_EQ(stl.status, 1);
-  EXPECT_NE(stl.err.find("OBJ meshes, named .obj, are read directly"), std::string::npos) << stl.err;
+  EXPECT_NE(stl.err.find("probe.stl: the mesh has no faces (an empty STL file, or not STL)"), std::string::npos) << stl.err;
+  std::ofstream(dir() + "/probe.3mf") << "PK\x03\x04";
+  const pushgraph::testing::ToolRun other =
+      Tool("estimate '" + h5 + "' --object " + dir() + "/probe.3mf --finger " + dir() + "/tip.json" + mass + "-o " + dir() + "/x.json");
+  EXPECT_EQ(other.status, 1);
+  EXPECT_NE(other.err.find("meshes named .obj, .stl, .ply or .off are read directly"), std::string::npos) << other.err;
 }
 
 // The mesh in millimetres and nothing else: the placement found with the units (turned by 12.1
@@ -512,15 +567,7 @@ TEST_F(EstimateCli, AMeshExportedWithYUpIsReadByItsCrossSection) {
   const std::string rest = " --finger " + Mit() + "obj/tip.obj --model cp --mass 0.8374 --mu 0.35 -o ";
   ASSERT_EQ(Tool("estimate '" + h5 + "' --object " + Mit() + "obj/rect1.obj" + rest + dir() + "/z_up.json").status, 0);
   const nlohmann::json truth = Load(dir() + "/z_up.json");
-  auto largest_difference = [&](const nlohmann::json& j) {
-    double largest = 0.0;
-    EXPECT_EQ(j["states"].size(), truth["states"].size());
-    for (std::size_t i = 0; i < j["states"].size() && i < truth["states"].size(); ++i)
-      for (int k = 0; k < 3; ++k)
-        largest = std::max(largest, std::abs(j["states"][i]["object_pose"][k].get<double>() -
-                                             truth["states"][i]["object_pose"][k].get<double>()));
-    return largest;
-  };
+  auto largest_difference = [&](const nlohmann::json& j) { return LargestObjectPoseDifference(j, truth); };
   for (const double degrees : {-90.0, 90.0}) {
     const std::string mesh = TurnedMesh("rect1.obj", degrees, "rect1_turned.obj");
     const std::string out = dir() + "/turned.json";
@@ -555,6 +602,12 @@ TEST_F(EstimateCli, AMeshExportedWithYUpIsReadByItsCrossSection) {
   ASSERT_EQ(off.status, 0) << off.err;
   EXPECT_NE(off.err.find("seen along z its footprint is its side view"), std::string::npos) << off.err;
   EXPECT_EQ(off.err.find("estimated with the cross-section"), std::string::npos) << off.err;
+  // mit-import writes the reading its recording fits into the trajectory file.
+  const pushgraph::testing::ToolRun imported = Tool("mit-import '" + h5 + "' --object " + y_up + " --finger " + Mit() +
+                                                    "obj/tip.obj --mass 0.8374 --mu-surface 0.35 -o " + dir() + "/imported.json");
+  ASSERT_EQ(imported.status, 0) << imported.err;
+  const geometry::Box2 top = pushgraph::io::LoadTrajectoryJson(dir() + "/imported.json").object.shape.bounds();
+  EXPECT_NEAR(top.max.y() - top.min.y(), 0.09, 1e-6) << "its cross-section, not the 12.7 mm side view";
   // The outline of rect1 drawn flat in the x-z plane (y = 0; (x, -z) is the footprint's (x, y)).
   const std::string flat = dir() + "/flat.obj";
   std::ofstream(flat) << "v -0.045 0 0.045\nv 0.045 0 0.045\nv 0.045 0 -0.045\nv -0.045 0 -0.045\nf 1 2 3\nf 1 3 4\n";
@@ -562,6 +615,26 @@ TEST_F(EstimateCli, AMeshExportedWithYUpIsReadByItsCrossSection) {
   ASSERT_EQ(drawn.status, 0) << drawn.err;
   EXPECT_NE(drawn.err.find("the mesh's footprint along y"), std::string::npos) << drawn.err;
   EXPECT_LT(largest_difference(Load(dir() + "/flat.json")), 2e-3) << "a sharp-cornered square for rect1";
+}
+
+// A CAD export as binary STL in millimetres, object and probe, was refused ("STL meshes are not
+// read, only Wavefront OBJ"): now read directly, in the units its contacts fit, and estimated as
+// the dataset's OBJ files in metres are (float32 coordinates: 2e-9 m).
+TEST_F(EstimateCli, AnStlExportInMillimetresIsReadDirectly) {
+  if (Mit().empty()) GTEST_SKIP() << "no MIT data";
+  const std::string h5 = Mit() + "abs/rect1/motion_surface=abs_shape=rect1_a=0_v=75_i=2.000_s=0.700_t=-1.047.h5";
+  const std::string rest = " --model cp --mass 0.8374 --mu 0.35 -o ";
+  const pushgraph::testing::ToolRun stl = Tool("estimate '" + h5 + "' --object " + StlExport("rect1.obj", 1000.0, "rect1.stl") +
+                                               " --finger " + StlExport("tip.obj", 1000.0, "tip.stl") + rest + dir() + "/stl.json");
+  ASSERT_EQ(stl.status, 0) << stl.err;
+  EXPECT_NE(stl.err.find("tip.stl: its footprint is a regular 32-gon, a tessellated cylinder"), std::string::npos) << stl.err;
+  const pushgraph::testing::ToolRun obj = Tool("estimate '" + h5 + "' --object " + Mit() + "obj/rect1.obj --finger " + Mit() +
+                                               "obj/tip.obj" + rest + dir() + "/obj.json");
+  ASSERT_EQ(obj.status, 0) << obj.err;
+  const nlohmann::json a = Load(dir() + "/stl.json"), b = Load(dir() + "/obj.json");
+  EXPECT_EQ(a["parameters"]["shape_scale"].get<double>(), 1e-3);
+  EXPECT_EQ(a["parameters"]["finger_scale"].get<double>(), 1e-3);
+  EXPECT_LT(LargestObjectPoseDifference(a, b), 1e-6);
 }
 
 TEST_F(EstimateCli, AMeshInMillimetresIsOfferedItsUnitsAlone) {
@@ -776,13 +849,7 @@ TEST_F(EstimateCli, ACadExportInMillimetresIsReadAsSuchFingerIncluded) {
   EXPECT_EQ(a["parameters"]["finger_scale"].get<double>(), 1e-3);
   EXPECT_FALSE(b["parameters"].contains("finger_scale"));
   EXPECT_EQ(a["parameters"]["shape_scale"].get<double>(), 1e-3);
-  ASSERT_EQ(a["states"].size(), b["states"].size());
-  double largest = 0.0;
-  for (std::size_t i = 0; i < a["states"].size(); ++i)
-    for (int k = 0; k < 2; ++k)
-      largest = std::max(largest, std::abs(a["states"][i]["object_pose"][k].get<double>() -
-                                           b["states"][i]["object_pose"][k].get<double>()));
-  EXPECT_LT(largest, 1e-6);
+  EXPECT_LT(LargestObjectPoseDifference(a, b, 2), 1e-6);
   // Drawn 10 mm off its axis as well: it holds nothing (its origin outside it) but reaches 14.7 "m"
   // from it; read as millimetres, then centred (the shape check had called the object's file "6.36
   // times the size of the finger's path").
@@ -794,13 +861,7 @@ TEST_F(EstimateCli, ACadExportInMillimetresIsReadAsSuchFingerIncluded) {
   EXPECT_EQ(c["parameters"]["finger_scale"].get<double>(), 1e-3);
   ASSERT_TRUE(c["parameters"].contains("finger_transform")) << c["parameters"].dump();
   EXPECT_NEAR(c["parameters"]["finger_transform"][0].get<double>(), -0.01, 1e-9);
-  ASSERT_EQ(c["states"].size(), b["states"].size());
-  largest = 0.0;
-  for (std::size_t i = 0; i < c["states"].size(); ++i)
-    for (int k = 0; k < 2; ++k)
-      largest = std::max(largest, std::abs(c["states"][i]["object_pose"][k].get<double>() -
-                                           b["states"][i]["object_pose"][k].get<double>()));
-  EXPECT_LT(largest, 1e-6);
+  EXPECT_LT(LargestObjectPoseDifference(c, b, 2), 1e-6);
   // --align-shape off keeps the refusal, naming the units.
   const pushgraph::testing::ToolRun off =
       Tool("estimate '" + h5 + "' --object " + object + " --finger " + finger + " --align-shape off" + rest + dir() + "/off.json");

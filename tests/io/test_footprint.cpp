@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -323,6 +325,87 @@ TEST_F(Footprint, ANonConvexPolygonFaceIsUnitedAsItIs) {
   }
 }
 
+// A CAD export: the dataset's rect1.obj (its 636 triangles, 4 through holes) as a binary STL in
+// millimetres (float32 coordinates), an ASCII STL, a PLY and an OFF file: the footprint of each
+// is the OBJ's, to float32's rounding for the binary STL and exactly for the text formats.
+TEST_F(Footprint, StlPlyAndOffMeshesAreReadAsTheObjIs) {
+  if (!SharedAvailable()) GTEST_SKIP() << "no shared MIT meshes";
+  std::vector<std::array<double, 3>> vertices;
+  std::vector<std::array<int, 3>> triangles;
+  {
+    std::ifstream in(kObj + "rect1.obj");
+    for (std::string line; std::getline(in, line);) {
+      std::istringstream s(line);
+      std::string kind;
+      s >> kind;
+      if (kind == "v") {
+        std::array<double, 3> v{};
+        s >> v[0] >> v[1] >> v[2];
+        vertices.push_back(v);
+      } else if (kind == "f") {
+        std::vector<int> face;
+        for (std::string token; s >> token;) face.push_back(std::stoi(token.substr(0, token.find('/'))) - 1);
+        for (std::size_t k = 1; k + 1 < face.size(); ++k) triangles.push_back({face[0], face[k], face[k + 1]});
+      }
+    }
+  }
+  ASSERT_EQ(triangles.size(), 636u);
+  const geometry::Shape obj = io::MeshFootprint(kObj + "rect1.obj");
+  {
+    std::ofstream out(dir_ / "rect1_mm.stl", std::ios::binary);
+    char header[80] = "binary STL, millimetres";
+    out.write(header, 80);
+    const std::uint32_t count = static_cast<std::uint32_t>(triangles.size());
+    out.write(reinterpret_cast<const char*>(&count), 4);
+    for (const auto& t : triangles) {
+      float values[12] = {0, 0, 0};
+      for (int k = 0; k < 3; ++k)
+        for (int a = 0; a < 3; ++a) values[3 + 3 * k + a] = static_cast<float>(1000.0 * vertices[t[k]][a]);
+      out.write(reinterpret_cast<const char*>(values), sizeof values);
+      const std::uint16_t attributes = 0;
+      out.write(reinterpret_cast<const char*>(&attributes), 2);
+    }
+  }
+  std::ostringstream ascii, off, ply;
+  ascii.precision(17), off.precision(17), ply.precision(17);
+  ascii << "solid rect1\n";
+  for (const auto& t : triangles) {
+    ascii << "facet normal 0 0 0\nouter loop\n";
+    for (int k = 0; k < 3; ++k) ascii << "vertex " << vertices[t[k]][0] << " " << vertices[t[k]][1] << " " << vertices[t[k]][2] << "\n";
+    ascii << "endloop\nendfacet\n";
+  }
+  ascii << "endsolid rect1\n";
+  off << "OFF\n" << vertices.size() << " " << triangles.size() << " 0\n";
+  ply << "ply\nformat ascii 1.0\nelement vertex " << vertices.size() << "\nproperty double x\nproperty double y\n"
+      << "property double z\nelement face " << triangles.size() << "\nproperty list uchar int vertex_indices\nend_header\n";
+  for (const auto& v : vertices) off << v[0] << " " << v[1] << " " << v[2] << "\n", ply << v[0] << " " << v[1] << " " << v[2] << "\n";
+  for (const auto& t : triangles) off << "3 " << t[0] << " " << t[1] << " " << t[2] << "\n", ply << "3 " << t[0] << " " << t[1] << " " << t[2] << "\n";
+  io::FootprintOptions millimetres;
+  millimetres.scale = 1e-3;
+  struct Case {
+    std::string path;
+    io::FootprintOptions options;
+    double tolerance;
+  };
+  const Case cases[] = {{(dir_ / "rect1_mm.stl").string(), millimetres, 1e-8},  // float32 of 45 mm: 2e-9 m
+                        {Write("rect1.stl", ascii.str()), {}, 0.0},
+                        {Write("rect1.off", off.str()), {}, 0.0},
+                        {Write("rect1.ply", ply.str()), {}, 0.0}};
+  for (const Case& c : cases) {
+    io::FootprintReport report;
+    const geometry::Shape s = io::MeshFootprint(c.path, c.options, &report);
+    EXPECT_EQ(report.faces, 636) << c.path;
+    EXPECT_EQ(Holes(s), 4) << c.path;
+    ASSERT_EQ(report.prism_axes.size(), 1u) << c.path;
+    EXPECT_EQ(report.prism_axes[0], io::UpAxis::kZ) << c.path;
+    EXPECT_NEAR(s.core_area(), obj.core_area(), 1e-6 * obj.core_area() + c.tolerance * 0.4) << c.path;
+    double worst = 0.0;
+    for (const auto& p : s.polygons())
+      for (const geometry::Vec2& v : p.outer) worst = std::max(worst, std::abs(geometry::QueryPoint(obj, v).signed_distance));
+    EXPECT_LE(worst, c.tolerance) << c.path;
+  }
+}
+
 TEST_F(Footprint, ClearErrors) {
   auto expect_error = [](const std::string& path, const io::FootprintOptions& o, const std::string& needle) {
     try {
@@ -335,10 +418,20 @@ TEST_F(Footprint, ClearErrors) {
   };
   expect_error((dir_ / "missing.obj").string(), {}, "cannot read mesh");
   expect_error(Write("empty.obj", "# nothing here\n"), {}, "no faces");
-  // Other mesh formats are named (an STL read as "the mesh has no faces").
-  expect_error(Write("part.stl", "solid part\nendsolid part\n"), {}, "STL meshes are not read, only Wavefront OBJ");
-  expect_error(Write("part_stl.obj", "solid part\nfacet normal 0 0 1\n"), {}, "STL meshes are not read");
-  expect_error(Write("part.PLY", "ply\nformat ascii 1.0\n"), {}, "PLY meshes are not read");
+  // Other mesh formats are named (a glTF read as "the mesh has no faces"); broken STL, PLY and
+  // OFF files say which format they failed as.
+  expect_error(Write("part.gltf", "{\"asset\": {}}\n"), {}, "glTF meshes are not read, only Wavefront OBJ, STL, PLY and OFF");
+  expect_error(Write("part.stl", "solid part\nendsolid part\n"), {}, "the mesh has no faces (an empty STL file, or not STL)");
+  expect_error(Write("part_stl.obj", "solid part\nfacet normal 0 0 1\n"), {}, "(an empty STL file, or not STL)");
+  expect_error(Write("part.PLY", "ply\nformat ascii 1.0\n"), {}, "cannot read PLY mesh");
+  expect_error(Write("text.stl", "hello world\n"), {}, "not STL");
+  expect_error(Write("badidx.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n"), {}, "cannot read OFF mesh");
+  expect_error(Write("nan.off", "OFF\n3 1 0\n0 0 0\nnan 0 0\n0 1 0\n3 0 1 2\n"), {}, "");
+  expect_error((dir_ / "missing.stl").string(), {}, "no such file");
+  io::FootprintOptions named;
+  named.object = "part";
+  expect_error(Write("square.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n"), named,
+               "OFF files hold one unnamed mesh");
   io::FootprintOptions up_y;
   up_y.up = io::UpAxis::kY;
   expect_error(Write("flat.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), up_y, "zero area");

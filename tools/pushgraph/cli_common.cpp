@@ -319,12 +319,14 @@ geometry::Shape LoadShapeArgument(const std::string& path, const std::string& wh
   std::string extension = std::filesystem::path(path).extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return std::tolower(c); });
   try {
-    if (extension == ".obj") return LoadMeshArgument(path, what, warnings, other_readings);
+    // Meshes: OBJ, and what CAD tools export besides (STL, PLY, OFF); everything else is shape JSON.
+    if (extension == ".obj" || extension == ".stl" || extension == ".ply" || extension == ".off")
+      return LoadMeshArgument(path, what, warnings, other_readings);
     return geometry::LoadShapeJson(path);
   } catch (const std::exception& e) {
     std::string hint;
-    if (extension != ".json" && extension != ".obj" && std::string(e.what()).find("malformed JSON") != std::string::npos)
-      hint = " (shape files are JSON from pushgraph footprint; OBJ meshes, named .obj, are read directly)";
+    if (extension != ".json" && std::string(e.what()).find("malformed JSON") != std::string::npos)
+      hint = " (shape files are JSON from pushgraph footprint; meshes named .obj, .stl, .ply or .off are read directly)";
     throw CliError(what + " " + path + ": " + e.what() + hint);
   }
 }

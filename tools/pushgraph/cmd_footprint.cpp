@@ -1,4 +1,4 @@
-// pushgraph footprint MESH.obj|SHAPE.json [--up x|y|z] [--object NAME] [--scale S] [--mirror]
+// pushgraph footprint MESH.obj|.stl|.ply|.off|SHAPE.json [--up x|y|z] [--object NAME] [--scale S] [--mirror]
 // [--transform X,Y,THETA] [-o SHAPE.json]: the exact planar footprint of a mesh as shape JSON,
 // optionally moved into another frame (the transform that `pushgraph estimate` reports when it
 // aligns a shape: p' = pose * (scale * mirror(p))); a shape JSON input is only transformed.
@@ -24,7 +24,7 @@ void RegisterFootprint(CLI::App& app) {
     bool quiet = false, mirror = false;
   };
   auto args = std::make_shared<Args>();
-  cmd->add_option("MESH", args->mesh, "Mesh file (Wavefront OBJ), or a shape JSON to transform")->required();
+  cmd->add_option("MESH", args->mesh, "Mesh file (Wavefront OBJ, STL, PLY or OFF), or a shape JSON to transform")->required();
   cmd->add_option("--up", args->up, "Axis to project along: x, y or z")->capture_default_str();
   cmd->add_option("--object", args->object, "Only this object/group of the file (default: all together)");
   cmd->add_option("--scale", args->scale, "Multiply coordinates, e.g. 0.001 for millimetres")

@@ -21,8 +21,9 @@ void RegisterMitImport(CLI::App& app) {
   };
   auto a = std::make_shared<Args>();
   cmd->add_option("RECORDING", a->recording, "Recording (.h5 or .json)")->required();
-  cmd->add_option("--object", a->object, "Object shape JSON (e.g. from pushgraph footprint) or OBJ mesh")->required();
-  cmd->add_option("--finger", a->finger, "Finger shape JSON or OBJ mesh")->required();
+  cmd->add_option("--object", a->object, "Object shape JSON (e.g. from pushgraph footprint) or mesh (OBJ, STL, PLY, OFF)")
+      ->required();
+  cmd->add_option("--finger", a->finger, "Finger shape JSON or mesh (OBJ, STL, PLY, OFF)")->required();
   cmd->add_option("--mass", a->mass, "Object mass (kg)")->required()->check(MassValue());
   cmd->add_option("--mu-surface", a->mu_surface, "Object-table friction coefficient")->required()->check(FrictionValue(false));
   cmd->add_option("--mu-contact", a->mu_contact, "Finger-object friction coefficient")
@@ -41,11 +42,14 @@ void RegisterMitImport(CLI::App& app) {
     options.contact_force = io::MitContactForce(a->mass, a->mu_surface);
     const io::MitRecording rec = io::ReadMitPush(a->recording, options);
     push::ObjectDescription object;
-    object.shape = LoadShapeArgument(a->object, "--object");
+    MeshReadings readings;  // a y-up export's cross-section, when the recording's contacts fit it
+    object.shape = LoadShapeArgument(a->object, "--object", nullptr, &readings);
     object.mass = a->mass;
     object.mu_surface = a->mu_surface;
     push::FingerDescription finger{LoadShapeArgument(a->finger, "--finger"), a->mu_contact};
-    io::SaveTrajectoryJson(io::MitToTrajectory(rec, object, finger), a->output);
+    push::Trajectory trajectory = io::MitToTrajectory(rec, object, finger);
+    ChooseObjectReading(a->object, readings, graph::EstimatorConfig{}, &trajectory, nullptr);
+    io::SaveTrajectoryJson(trajectory, a->output);
     for (const std::string& note : rec.notes) std::cerr << "mit-import: " << note << "\n";
     std::cerr << "mit-import: " << rec.streams.object_pose.size() << " object, " << rec.streams.finger_pose.size()
               << " finger, " << rec.streams.force.size() << " force samples";
