@@ -268,7 +268,10 @@ geometry::Shape LoadMeshArgument(const std::string& path, const std::string& wha
                "pushgraph: %s %s: the mesh's footprint along %s%s, in its own frame and units (%zu polygon(s), %d "
                "hole(s), %.4g x %.4g m); another up axis, scale or frame: pushgraph footprint %s --up/--scale/"
                "--transform -o SHAPE.json\n",
-               what.c_str(), path.c_str(), up, options.up == io::UpAxis::kZ ? "" : " (a prism along it: its cross-section)",
+               what.c_str(), path.c_str(), up,
+               options.up == io::UpAxis::kZ ? ""
+               : report.flat_axis           ? " (an outline drawn flat across it)"
+                                            : " (a prism along it: its cross-section)",
                shape.polygons().size(), holes, box.max.x() - box.min.x(),
                box.max.y() - box.min.y(), path.c_str());
   for (std::string w : report.warnings) {
@@ -301,13 +304,14 @@ geometry::Shape LoadMeshArgument(const std::string& path, const std::string& wha
   return shape;
 }
 
-}  // namespace
-
-static std::string FormatSize(double size) {
+// A length in the file's own units, as printed in messages.
+std::string FormatSize(double size) {
   char text[32];
   std::snprintf(text, sizeof text, "%.4g", size);
   return text;
 }
+
+}  // namespace
 
 void WarnShapeUnits(const geometry::Shape& shape, const std::string& what, const std::string& path) {
   if (const auto units = io::ShapeUnitsWarning(shape, 1.0, "pushgraph footprint " + path + " --scale "))

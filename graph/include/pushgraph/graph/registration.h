@@ -225,8 +225,8 @@ struct ShapeReadingChoice {
   /// for a reading not registered or refused for its size.
   std::vector<double> registered_costs;
   bool by_registration = false;       ///< the choice rests on the registered costs
-  /// Why: "reading 1 fits (median contact gap 1.1 mm, ...), reading 0 does not (...)"; empty
-  /// when reading 0 fits as given.
+  /// Why: "as given, reading 0 does not fit (median contact gap 38.8 mm, ...); reading 1 fits
+  /// (...)", then the registered costs when they decided; empty when reading 0 fits as given.
   std::string reason;
 };
 /// `names` name the readings in `reason` ("along z", "along y"); empty: "reading 0", "reading 1".
