@@ -182,6 +182,12 @@ class OnlineEstimator:
     def dropped_late_samples(self):
         return self._core.dropped_late_samples
 
+    def warnings(self):
+        """What is wrong with the setup so far, as sentences (finish() repeats them): the object's
+        shape is checked against the contacts as estimate() does (not applied: a shape in other
+        units or off the tracker's frame is named, with the placement the contacts prefer)."""
+        return self._core.warnings()
+
     def finish(self):
         """Every step's estimate, as estimate() returns it. Call once."""
         return self._core.finish()

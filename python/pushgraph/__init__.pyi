@@ -1,6 +1,6 @@
 # Typing stubs of the pure-Python layer (__init__.py).
 import os
-from typing import Any, Dict, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 from ._pushgraph import (EDGE, INSIDE, ON_BOUNDARY, OUTSIDE, VERTEX, DistanceField, EvaluationError, GeometryError, GraphError, IoError,
                          LimitSurface, LimitSurfaceError, PushError, Shape, ShapePair, load_trajectory, read_mit_push,
@@ -30,4 +30,5 @@ class OnlineEstimator:
     def latest_state(self) -> Dict[str, Any]: ...
     @property
     def dropped_late_samples(self) -> int: ...
+    def warnings(self) -> List[str]: ...
     def finish(self) -> Dict[str, Any]: ...

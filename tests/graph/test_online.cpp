@@ -110,6 +110,81 @@ std::string FeedUntilRefused(const push::Trajectory& t, int* updates) {
   return "";
 }
 
+// The object's shape in other units or turned off the tracker's frame: said during the push, at
+// the first update whose contacts can judge it, and again by Finish() (an object 11.6 m off
+// with a shape in millimetres, and only "the last window's solve stopped" to say so). A shape
+// that fits in its units alone is read so (unless align_shape is "off"): the estimate is then
+// the shape in metres' own.
+TEST(Online, AShapeInMillimetresOrTurnedIsNamedDuringThePush) {
+  const push::Trajectory t = GeneratePush(OffsetPush(23, 2.0));
+  using Align = EstimatorConfig::AlignShape;
+  struct Case {
+    const char* name;
+    geometry::Shape shape;
+    bool diagnostics;
+    Align align;
+    const char* expected;  // in the warning; nullptr: no warning
+    bool units_applied;
+  };
+  const Shape& truth = t.object.shape;
+  const Shape in_mm = geometry::TransformShape(truth, {0.0, 0.0, 0.0}, 1000.0);
+  const std::vector<Case> cases = {
+      {"as given", truth, true, Align::kAuto, nullptr, false},
+      {"in millimetres", in_mm, true, Align::kAuto, "the shape is in millimetres. Read so from this update on", true},
+      {"in millimetres, align_shape off", in_mm, true, Align::kOff, "OnlineEstimator estimates with the shape as given", false},
+      {"turned by 30 degrees", geometry::TransformShape(truth, {0.0, 0.0, 30.0 * M_PI / 180.0}), true, Align::kAuto,
+       "the contacts' best placement: turned by", false},
+      {"in millimetres, diagnostics off", in_mm, false, Align::kAuto, nullptr, false},
+  };
+  double truth_rms = NAN;
+  for (const Case& c : cases) {
+    push::Trajectory setup = SetupOf(t);
+    setup.object.shape = c.shape;
+    EstimatorConfig config;
+    config.diagnostics = c.diagnostics;
+    config.align_shape = c.align;
+    config.covariance = false;
+    OnlineEstimator online(setup, Model::kQs, config, StreamsOf(t));
+    int updates = 0, said_at = -1;
+    double said_t = NAN;
+    Feed(t, online, [&] {
+      if (!online.UpdateDue()) return;
+      online.Update();
+      ++updates;
+      if (said_at < 0 && !online.Warnings().empty()) said_at = updates, said_t = online.LatestState().t;
+    });
+    const EstimationResult r = online.Finish();
+    const double rms = r.metrics.at("object_position_rms");
+    if (std::isnan(truth_rms)) truth_rms = rms;
+    std::printf("[online] shape %s: object RMS %.4g mm; %zu warning(s), the first at update %d of %d (t = %.2f s)%s%s\n",
+                c.name, 1e3 * rms, online.Warnings().size(), said_at, updates, said_t, online.Warnings().empty() ? "" : ": ",
+                online.Warnings().empty() ? "" : online.Warnings().front().c_str());
+    EXPECT_EQ(r.shape_alignment.has_value() && r.shape_alignment->aligned, c.units_applied) << c.name;
+    if (c.units_applied) {
+      EXPECT_TRUE(r.shape_alignment->units_only);
+      EXPECT_EQ(r.shape_alignment->transform.scale, 0.001);
+      EXPECT_NEAR(rms, truth_rms, 1e-6) << c.name;
+    }
+    if (c.expected == nullptr) {
+      EXPECT_TRUE(online.Warnings().empty()) << c.name << ": " << online.Warnings().front();
+      for (const std::string& w : r.warnings) EXPECT_EQ(w.find("shape check"), std::string::npos) << c.name << ": " << w;
+      continue;
+    }
+    ASSERT_EQ(online.Warnings().size(), 1u) << c.name;
+    const std::string& w = online.Warnings().front();
+    EXPECT_NE(w.find("does not fit the contacts as given"), std::string::npos) << w;
+    EXPECT_NE(w.find(c.expected), std::string::npos) << w;
+    ASSERT_TRUE(r.shape_alignment.has_value()) << c.name;
+    EXPECT_TRUE(r.shape_alignment->checked && !r.shape_alignment->check.fits) << c.name;
+    if (!c.units_applied) EXPECT_GT(rms, 2.0 * truth_rms) << c.name;
+    // During the push, not only at its end.
+    EXPECT_GT(said_at, 0) << c.name;
+    EXPECT_LT(said_at, updates / 2) << c.name;
+    ASSERT_FALSE(r.warnings.empty());
+    EXPECT_EQ(r.warnings.front(), w);
+  }
+}
+
 // A finger tracked in another frame (2 m off), fed sample by sample: refused at the first update
 // after it touched, as the batch refuses the file (helper-27 N0b: an object 1.87 m off, no word).
 TEST(Online, AFingerInAnotherFrameIsRefusedAtTheFirstTouch) {

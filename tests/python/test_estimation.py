@@ -149,6 +149,34 @@ def test_online_estimator_fed_from_python(push):
     result = online.finish()
     assert updates > 3 and len(result["t"]) > 100
     assert np.all(np.isfinite(result["object_pose"]))
+    assert online.warnings() == []
+
+
+def test_online_estimator_names_a_shape_in_millimetres(push):
+    setup = {"object": dict(push["object"]), "finger": push["finger"], "measured": {}}
+    setup["object"]["shape"] = push["object"]["shape"].transformed(scale=1000.0)
+    online = pg.OnlineEstimator(setup, model="qs", config={"covariance": False}, contact_point=True, force=True)
+    m = push["measured"]
+    samples = [(t, stream, v) for stream, value in [("object_pose", "pose"), ("finger_pose", "pose"),
+                                                    ("contact_point", "point"), ("force", "force")]
+               for t, v in zip(m[stream]["t"], m[stream][value])]
+    samples.sort(key=lambda s: (s[0], s[1]))
+    add = {"object_pose": online.add_object_pose, "finger_pose": online.add_finger_pose,
+           "contact_point": online.add_contact_point, "force": online.add_force}
+    said = None
+    for k, (t, stream, v) in enumerate(samples):
+        add[stream](t, v)
+        if (k + 1 == len(samples) or samples[k + 1][0] > t) and online.update_due():
+            online.update()
+            if said is None and online.warnings():
+                said = t
+    assert said is not None and said < samples[-1][0]  # during the push
+    (warning,) = online.warnings()
+    assert "does not fit the contacts as given" in warning and "millimetres" in warning
+    result = online.finish()  # checked once more on every sample: the same finding, its placement refined
+    print(online.warnings())
+    assert len(online.warnings()) == 1 and "millimetres" in online.warnings()[0]
+    assert result["warnings"][0] == online.warnings()[0]
 
 
 def test_estimates_run_in_threads(push):

@@ -35,6 +35,7 @@
 
 #include <cmath>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace pushgraph::graph {
@@ -133,6 +134,15 @@ class OnlineEstimator {
   bool AddForce(double t, int finger, const geometry::Vec2& force);
   int DroppedLateSamples() const;
   int DroppedFaultySamples() const;
+  /// What the estimator found wrong with its setup so far, as sentences (Finish()'s warnings
+  /// repeat them). With `diagnostics` on, the updates check the object's shape against the
+  /// contacts as `Estimate` does (RegisterShape on the samples so far, every 0.1 s of data until
+  /// the contacts can judge it, then each time the data has doubled). A shape that fits at a
+  /// unit's scale alone (a CAD file in millimetres) is read in that unit from that update on,
+  /// every step so far solved again, unless align_shape is "off". Any other misfit (a shape
+  /// turned or shifted off the tracker's frame) is named with the placement the contacts prefer,
+  /// not applied: the steps already solved keep the shape they were solved with.
+  const std::vector<std::string>& Warnings() const;
 
   /// True once incremental_update_every object measurements up to the settled time (see
   /// Update) arrived since the last update, or, while the object stream is silent (occlusion),
