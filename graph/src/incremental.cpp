@@ -810,8 +810,13 @@ struct OnlineEstimator::Impl {
             ". Read so from this update on: every step so far is solved again at that scale (align_shape \"off\" "
             "keeps the shape as given); the setup's shape scaled by %g saves this", scale);
         traj.object.shape = geometry::TransformShape(traj.object.shape, geometry::Pose2{}, scale, false);
-        const EstimatorConfig cfg = smoother->cfg;
-        smoother = std::make_unique<FixedLagSmoother>(traj, model, cfg, &streams);
+        // The updates so far stay in the result's count and update_times_s.
+        auto fresh = std::make_unique<FixedLagSmoother>(traj, model, smoother->cfg, &streams);
+        fresh->stats.updates = smoother->stats.updates;
+        fresh->stats.update_times_s = smoother->stats.update_times_s;
+        fresh->stats.max_update_time_s = smoother->stats.max_update_time_s;
+        fresh->total_update_time = smoother->total_update_time;
+        smoother = std::move(fresh);
         alignment.aligned = alignment.units_only = alignment.suggested = true;
         alignment.transform = ShapeTransform{};
         alignment.transform.scale = scale;
@@ -1107,7 +1112,13 @@ double OnlineEstimator::Update(double until) {
   const double checked = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   m.smoother->builder.AppendSteps(until);
   if (m.object_period > 0.0) m.smoother->window_duration = m.smoother->cfg.IncrementalWindowPeriods() * m.object_period;
-  return checked + m.smoother->Update(until, false);
+  const double solved = m.smoother->Update(until, false);
+  // The check is part of this update's time, in the result's update_times_s too.
+  SolverStats& stats = m.smoother->stats;
+  stats.update_times_s.back() += checked;
+  stats.max_update_time_s = std::max(stats.max_update_time_s, stats.update_times_s.back());
+  m.smoother->total_update_time += checked;
+  return checked + solved;
 }
 
 StateEstimate OnlineEstimator::LatestState() const { return impl_->smoother->LatestState("OnlineEstimator"); }

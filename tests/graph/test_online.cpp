@@ -156,6 +156,11 @@ TEST(Online, AShapeInMillimetresOrTurnedIsNamedDuringThePush) {
     const EstimationResult r = online.Finish();
     const double rms = r.metrics.at("object_position_rms");
     if (std::isnan(truth_rms)) truth_rms = rms;
+    // Every update counted (the one that started the smoother again too), and Finish()'s own
+    // for the samples after the last.
+    EXPECT_GE(r.solver.updates, updates) << c.name;
+    EXPECT_LE(r.solver.updates, updates + 1) << c.name;
+    EXPECT_EQ(static_cast<int>(r.solver.update_times_s.size()), r.solver.updates) << c.name;
     std::printf("[online] shape %s: object RMS %.4g mm; %zu warning(s), the first at update %d of %d (t = %.2f s)%s%s\n",
                 c.name, 1e3 * rms, online.Warnings().size(), said_at, updates, said_t, online.Warnings().empty() ? "" : ": ",
                 online.Warnings().empty() ? "" : online.Warnings().front().c_str());
