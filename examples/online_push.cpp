@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <string>
 #include <vector>
 
 namespace {
@@ -106,6 +107,9 @@ int main() {
     std::printf("object position RMS %.3f mm (measured %.3f mm), force RMS %.3f N (measured %.3f N), object NEES %.2f\n",
                 1e3 * get("object_position_rms"), 1e3 * get("measured_object_position_rms"), get("force_rms"),
                 get("measured_force_rms"), get("object_pose_nees"));
+    // What the estimator found wrong with its setup or its solves (online.Warnings() has the
+    // setup's findings as soon as an update makes them: a shape in other units or frame).
+    for (const std::string& warning : result.warnings) std::printf("warning: %s\n", warning.c_str());
     if (!(get("object_position_rms") < get("measured_object_position_rms"))) {
       std::fprintf(stderr, "online_push: the estimate is not better than the measurements\n");
       return 1;
