@@ -184,8 +184,9 @@ class OnlineEstimator:
 
     def warnings(self):
         """What is wrong with the setup so far, as sentences (finish() repeats them): the object's
-        shape is checked against the contacts as estimate() does (not applied: a shape in other
-        units or off the tracker's frame is named, with the placement the contacts prefer)."""
+        shape is checked against the contacts as estimate() does. A shape that fits in other units
+        alone (a CAD file in millimetres) is read in them from then on; one turned or shifted off
+        the tracker's frame is named with the placement the contacts prefer, not applied."""
         return self._core.warnings()
 
     def finish(self):
