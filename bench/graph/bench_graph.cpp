@@ -43,6 +43,7 @@ void BatchOn(benchmark::State& state, const push::Trajectory& traj, bool ceres, 
   cfg.covariance_method = method;
   cfg.diagnostics = false;
   cfg.align_shape = graph::EstimatorConfig::AlignShape::kOff;
+  cfg.tessellated_finger_as_disk = false;  // BM_BatchQsPolygonFinger measures the 32-gon itself
   cfg.solver = ceres ? graph::EstimatorConfig::Solver::kCeres : graph::EstimatorConfig::Solver::kChain;
   graph::SolverStats stats;
   for (auto _ : state) {

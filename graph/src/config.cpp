@@ -196,13 +196,14 @@ EstimatorConfig ParseEstimatorConfig(const std::string& json_text, const std::st
                              {"on", EstimatorConfig::AlignShape::kOn},
                              {"off", EstimatorConfig::AlignShape::kOff}});
     } else if (key == "covariance" || key == "estimate_c" || key == "estimate_mu" || key == "align_scale" ||
-               key == "diagnostics" || key == "incremental_smoothing") {
+               key == "diagnostics" || key == "incremental_smoothing" || key == "tessellated_finger_as_disk") {
       if (!it->is_boolean()) Fail(source, key, "expected true or false");
       (key == "covariance"    ? cfg.covariance
        : key == "estimate_c"  ? cfg.estimate_c
        : key == "estimate_mu" ? cfg.estimate_mu
        : key == "diagnostics" ? cfg.diagnostics
        : key == "incremental_smoothing" ? cfg.incremental_smoothing
+       : key == "tessellated_finger_as_disk" ? cfg.tessellated_finger_as_disk
                               : cfg.align_scale) = it->get<bool>();
     } else if (key == "losses") {
       if (!it->is_object()) Fail(source, key, "expected an object");

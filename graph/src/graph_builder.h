@@ -558,6 +558,18 @@ push::Trajectory WithObjectInMetres(const push::Trajectory& trajectory);
 /// last scale applied); nullopt when none is.
 std::optional<push::Trajectory> FingerUnits(const push::Trajectory& trajectory, const RegistrationOptions& options,
                                             std::string* note, double* finger_scale);
+/// Contact streams that do not lie on their finger: the median distance of a finger's contact
+/// points from its boundary (its pose taken from the nearest finger sample within 0.05 s) above
+/// max(5 mm, 3 sqrt(sigma_contact^2 + sigma_finger^2)), over at least 5 such samples: a tactile
+/// sensor in another frame or with an offset, which pulled every model's estimate beyond the raw
+/// data's. Returns the trajectory with those streams left out and sets `note`; nullopt when none is.
+std::optional<push::Trajectory> DropContactStreamsOffTheFinger(const push::Trajectory& trajectory,
+                                                               const push::MeasurementSigmas& sigmas, std::string* note);
+/// Every finger whose outline is a tessellated cylinder (geometry::TessellatedDisk) as the disk
+/// it approximates, when config.tessellated_finger_as_disk; sets `note` (which fingers, their
+/// disks, how to keep the polygon). nullopt when no finger is one.
+std::optional<push::Trajectory> TessellatedFingersAsDisks(const push::Trajectory& trajectory, const EstimatorConfig& config,
+                                                          std::string* note);
 /// A warning naming every measurement sigma above ten times the range of its stream's values
 /// (and above 1 cm, 1 N; rotation above 10 rad): such a stream carries no weight.
 std::optional<std::string> MeasurementSigmaNote(const push::Trajectory& trajectory, const push::MeasurementSigmas& sigmas);

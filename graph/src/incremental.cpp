@@ -598,12 +598,16 @@ struct FixedLagSmoother {
 
 // Replay: the update times come from the recorded object stream.
 struct IncrementalEstimator::Impl {
+  // The trajectory with its tessellated fingers as disks, as Estimate reads it (nullopt: none).
+  std::string finger_disks;
+  std::optional<push::Trajectory> disk_fingers;
   FixedLagSmoother smoother;
   std::vector<double> triggers;
   std::size_t next_trigger = 0;
 
   Impl(const push::Trajectory& traj, Model model, const EstimatorConfig& cfg)
-      : smoother(traj, model, cfg, nullptr) {
+      : disk_fingers(internal::TessellatedFingersAsDisks(traj, cfg, &finger_disks)),
+        smoother(disk_fingers ? *disk_fingers : traj, model, cfg, nullptr) {
     const auto& obj = traj.measured.object_pose;
     const auto& steps = smoother.builder.steps();
     double period = MedianObjectPeriod(obj);
@@ -653,7 +657,9 @@ int IncrementalEstimator::TotalSteps() const { return static_cast<int>(impl_->sm
 
 EstimationResult IncrementalEstimator::Finish() {
   if (!Done()) throw GraphError("IncrementalEstimator::Finish called before the last update");
-  return impl_->smoother.Finish();
+  EstimationResult r = impl_->smoother.Finish();
+  if (impl_->disk_fingers) r.warnings.insert(r.warnings.begin(), impl_->finger_disks);
+  return r;
 }
 
 // Online: the samples are appended to an owned trajectory as they arrive.
@@ -730,6 +736,7 @@ struct OnlineEstimator::Impl {
   // whose whole-graph comparison finds it; the contacts' own "fits better elsewhere" named the
   // true rect1 shape on a 4 s push.
   static constexpr double kShapeCheckSamples = 3.0;  // the batch's "too little contact" bound
+  static constexpr double kTabletopReach = 1.0;      // m from the centroid, as ShapeSizeNote
   static constexpr double kShapeCheckRetry = 0.1;    // s (0.5: the second check of a 250 Hz MIT recording came 25 updates late)
   static constexpr double kShapeCheckSpan = 4.0;     // s
   bool shape_judged = false;
@@ -789,7 +796,9 @@ struct OnlineEstimator::Impl {
       return;
     }
     shape_judged = true;
-    std::string text = internal::Format("shape check (OnlineEstimator, on the samples up to t = %.4g s): ", until);
+    // The time into the data: a robot's epoch time stamps printed as "t = 1.462e+09 s" hid it.
+    std::string text = internal::Format("shape check (OnlineEstimator, on the samples up to %.3f s into the data, t = %s s): ",
+                                        until - first_t, Precise(until).c_str());
     text += "the object's shape does not fit the contacts as given (" + r->check.Describe() + ")";
     if (r->size_mismatch) {
       text += internal::Format(
@@ -858,11 +867,29 @@ struct OnlineEstimator::Impl {
     }
     return setup;
   }
+  // The setup with its tessellated fingers as disks, as Estimate reads them (warnings says so).
+  static push::Trajectory AsEstimated(const push::Trajectory& setup, const EstimatorConfig& cfg) {
+    std::string note;
+    std::optional<push::Trajectory> disks = internal::TessellatedFingersAsDisks(Empty(setup), cfg, &note);
+    return disks ? std::move(*disks) : setup;
+  }
   Impl(const push::Trajectory& setup, Model model, const EstimatorConfig& cfg, const OnlineStreams& streams)
-      : traj(Empty(setup)),
+      : traj(AsEstimated(setup, cfg)),
         model(model),
         streams(streams),
         smoother(std::make_unique<FixedLagSmoother>(traj, model, cfg, &this->streams)) {
+    if (std::string note; internal::TessellatedFingersAsDisks(setup, cfg, &note)) warnings.push_back(note);
+    // A shape that no tabletop object has: its units are read by the shape check, once the contacts
+    // can judge them; until then (0.2 to 0.4 s of contact) the updates were metres off, unsaid.
+    if (cfg.diagnostics && !traj.object.shape.empty()) {
+      const double reach = geometry::RadiusAbout(traj.object.shape, geometry::CoreCentroid(traj.object.shape));
+      if (reach > kTabletopReach)
+        warnings.push_back(internal::Format(
+            "object: its shape reaches %.4g m from its centroid, which no tabletop object does: a file in millimetres, "
+            "centimetres or inches? The shape check reads its units once the contacts can judge them (3 independent "
+            "contact samples); the updates before that estimate with the shape as given",
+            reach));
+    }
     // Every finger (finger k is the setup's extra_fingers[k - 1]) has the same kinds of sensors.
     fingers = 1 + static_cast<int>(traj.extra_fingers.size());
     last_seen.assign(1 + 3 * fingers, -INFINITY);
@@ -950,6 +977,14 @@ struct OnlineEstimator::Impl {
   // within max_latency (and 1.5 k object periods) of the newest sample of any stream, so a late
   // camera is waited for while an occluded one, or a tactile sensor silent out of contact, does
   // not hold the others back.
+  // Every pose stream (the object's, each finger's) has a sample at or before `until`.
+  bool PosesUpTo(double until) const {
+    auto has = [until](const std::vector<push::PoseSample>& poses) { return !poses.empty() && !(poses.front().t > until); };
+    bool all = has(traj.measured.object_pose) && has(traj.measured.finger_pose);
+    for (const push::ExtraFinger& f : traj.extra_fingers) all = all && has(f.measured.finger_pose);
+    return all;
+  }
+
   double SettledTime() const {
     // At the sensor rate (incremental_update_every_steps) only max_latency counts: a camera slower
     // than the update rate is not waited for between its frames.
@@ -1064,6 +1099,9 @@ bool OnlineEstimator::UpdateDue() const {
   // Only what an update would take counts: samples up to the settled time (a late camera's
   // poses are waited for, not counted before they arrive).
   const double settled = m.SettledTime();
+  // The first update needs every pose stream up to that time (Update refuses it otherwise): on an
+  // MIT recording a force sample before the first camera frame made it due, and Update threw.
+  if (m.smoother->next_step == 0 && !m.PosesUpTo(settled)) return false;
   if (m.smoother->cfg.incremental_update_every_steps >= 1) {
     // At least three steps in the first update (see IncrementalEstimator).
     const int needed = std::max(m.smoother->cfg.incremental_update_every_steps, m.smoother->next_step == 0 ? 3 : 1);

@@ -226,8 +226,16 @@ template <class Sample>
 void CheckSorted(const std::vector<Sample>& s, const std::string& stream, bool repeats = false) {
   for (std::size_t i = 1; i < s.size(); ++i) {
     if (!(s[i].t > s[i - 1].t) && !(repeats && s[i].t == s[i - 1].t)) {
-      throw GraphError("trajectory: streams." + stream + " is not " + (repeats ? "increasing" : "strictly increasing") +
-                       " in time at sample " + std::to_string(i));
+      // Where and why: a Python dict's rows are taken in their order (the file reader sorts a
+      // file's), and epoch times in float32 repeat for 128 s.
+      const bool float32 = s[i].t == s[i - 1].t && std::abs(s[i].t) > 1e7 && static_cast<double>(static_cast<float>(s[i].t)) == s[i].t;
+      throw GraphError(Format("trajectory: streams.%s is not %s in time at sample %zu (t = %.17g s after t = %.17g s at "
+                              "sample %zu): %s",
+                              stream.c_str(), repeats ? "increasing" : "strictly increasing", i, s[i].t, s[i - 1].t, i - 1,
+                              float32 ? "the time stamps look like float32 values (epoch seconds in float32 step by "
+                                        "128 s): keep them as float64"
+                                      : "sort each stream's samples by time (the trajectory file reader does; a "
+                                        "trajectory built in code or a Python dict is taken in its order)"));
     }
     // As the trajectory reader: less than a nanosecond apart is one time stamp written twice.
     if (!repeats && s[i].t - s[i - 1].t < 1e-9) {
@@ -1099,6 +1107,77 @@ push::Trajectory WithObjectInMetres(const push::Trajectory& traj) {
   push::Trajectory judged = traj;
   judged.object.shape = ObjectInMetres(traj.object.shape);
   return judged;
+}
+
+std::optional<push::Trajectory> DropContactStreamsOffTheFinger(const push::Trajectory& traj,
+                                                               const push::MeasurementSigmas& sigmas, std::string* note) {
+  constexpr double kNearInTime = 0.05;  // s: the finger moves under 3 mm in it at 5 cm/s
+  constexpr double kLeastOffset = 5e-3;  // m
+  constexpr std::size_t kLeastSamples = 5;
+  // Three times the sum of the two noises: pure noise has a median of 0.67 times it.
+  const double bound = std::max(kLeastOffset, 3.0 * std::hypot(sigmas.contact, sigmas.finger_trans));
+  std::string said;
+  push::Trajectory out = traj;
+  auto judge = [&](const std::vector<push::PoseSample>& poses, const geometry::Shape& finger,
+                   std::vector<push::PointSample>* contacts, const std::string& prefix) {
+    if (poses.empty() || contacts->size() < kLeastSamples || finger.empty()) return;
+    std::vector<double> distances;
+    for (const push::PointSample& c : *contacts) {
+      const push::PoseSample& at = NearestInTime(poses, c.t);
+      if (std::abs(at.t - c.t) > kNearInTime) continue;
+      const geometry::Vec2 local = geometry::InverseAct(at.pose, c.point);  // the finger's frame
+      distances.push_back(std::abs(geometry::QueryPoint(finger, local).signed_distance));
+    }
+    if (distances.size() < kLeastSamples) return;
+    const auto mid = distances.begin() + static_cast<std::ptrdiff_t>(distances.size() / 2);
+    std::nth_element(distances.begin(), mid, distances.end());
+    const double median = *mid;
+    if (!(median > bound)) return;
+    said += (said.empty() ? "" : "; ") +
+            Format("streams.%scontact_point: its %zu samples lie a median %.1f mm from the finger's boundary (the finger "
+                   "pose at their times), where the contact sensor's and the finger tracker's noise (%.3g and %.3g mm) "
+                   "would put them within %.1f mm: a contact sensor in another frame than the poses' (the finger's or "
+                   "the object's) or with an offset; left out of the estimate",
+                   prefix.c_str(), contacts->size(), 1e3 * median, 1e3 * sigmas.contact, 1e3 * sigmas.finger_trans,
+                   1e3 * bound);
+    contacts->clear();
+  };
+  judge(traj.measured.finger_pose, traj.finger.shape, &out.measured.contact_point, "");
+  for (std::size_t k = 0; k < out.extra_fingers.size(); ++k) {
+    push::ExtraFinger& f = out.extra_fingers[k];
+    judge(f.measured.finger_pose, f.finger.shape, &f.measured.contact_point, "fingers[" + std::to_string(k + 1) + "].");
+  }
+  if (said.empty()) return std::nullopt;
+  *note = said + " (contact is then gated on the force stream, else taken as always on; a stream in the world frame "
+                 "of the poses, on the finger's boundary, is used)";
+  return out;
+}
+
+std::optional<push::Trajectory> TessellatedFingersAsDisks(const push::Trajectory& traj, const EstimatorConfig& config,
+                                                          std::string* note) {
+  if (!config.tessellated_finger_as_disk) return std::nullopt;
+  std::string said;
+  auto replace = [&](geometry::Shape* shape, const std::string& which) {
+    const std::optional<geometry::TessellatedDiskFit> fit = geometry::TessellatedDisk(*shape);
+    if (!fit) return;
+    const geometry::Vec2 centre = fit->disk.polygons()[0].outer[0];
+    said += (said.empty() ? "" : "; ") +
+            Format("%s: its shape is a regular %zu-gon (a tessellated cylinder): estimated as the disk of radius %.4g mm "
+                   "at (%.3f, %.3f) mm it approximates",
+                   which.c_str(), fit->corners, 1e3 * fit->disk.radius(), 1e3 * centre.x(), 1e3 * centre.y());
+    *shape = fit->disk;
+  };
+  push::Trajectory disks = traj;
+  replace(&disks.finger.shape, "finger");
+  for (std::size_t k = 0; k < disks.extra_fingers.size(); ++k)
+    replace(&disks.extra_fingers[k].finger.shape, "finger " + std::to_string(k + 1));
+  if (said.empty()) return std::nullopt;
+  // Why: a polygon's many short faces are each a local witness's feature, and its exact
+  // C-obstacles are cached per relative angle.
+  *note = said +
+          " (as the 32-gon of the MIT tip.obj, the probe solved 6 to 13 times slower and the fixed-lag smoother drifted "
+          "from the tracker on a slow push; \"tessellated_finger_as_disk\": false keeps the polygon)";
+  return disks;
 }
 
 std::optional<push::Trajectory> FingerUnits(const push::Trajectory& traj, const RegistrationOptions& options,

@@ -250,6 +250,52 @@ struct Where {
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 const double kInf = std::numeric_limits<double>::infinity();
 
+// A tessellated cylinder (a round probe's mesh) is read as its disk; nothing else is.
+TEST(TessellatedDisk, ARegularPolygonOfManyCornersIsItsDiskAndNothingElseIs) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int trial = 0; trial < 50; ++trial) {
+    const int n = 20 + static_cast<int>(unit(rng) * 60.0);
+    const double r = 1e-3 * (1.0 + 20.0 * unit(rng));
+    const Vec2 centre(0.05 * (unit(rng) - 0.5), 0.05 * (unit(rng) - 0.5));
+    const double turn = 2.0 * M_PI * unit(rng);
+    Ring ring;
+    for (int i = 0; i < n; ++i) {
+      const double a = turn + 2.0 * M_PI * i / n;
+      ring.push_back(centre + r * Vec2(std::cos(a), std::sin(a)));
+    }
+    const std::optional<TessellatedDiskFit> fit = TessellatedDisk(Shape::FromPolygons({Polygon{ring, {}}}));
+    ASSERT_TRUE(fit.has_value()) << n << "-gon";
+    EXPECT_EQ(fit->corners, static_cast<std::size_t>(n));
+    EXPECT_NEAR(fit->disk.radius(), r, 1e-12);
+    EXPECT_LT((fit->disk.polygons()[0].outer[0] - centre).norm(), 1e-12);
+    // A seam vertex of an exact union (a point on an edge) is no corner. (A near-duplicate, the
+    // other kind, is refused by FromPolygons; the CLI's y-up tip.obj test has one.)
+    Ring seams = ring;
+    seams.insert(seams.begin() + 3, 0.5 * (ring[2] + ring[3]));
+    const std::optional<TessellatedDiskFit> with_seams = TessellatedDisk(Shape::FromPolygons({Polygon{seams, {}}}));
+    ASSERT_TRUE(with_seams.has_value());
+    EXPECT_EQ(with_seams->corners, static_cast<std::size_t>(n));
+    // One corner 1 % out: a polygon, not a disk.
+    Ring dented = ring;
+    dented[n / 2] = centre + 1.01 * (ring[n / 2] - centre);
+    EXPECT_FALSE(TessellatedDisk(Shape::FromPolygons({Polygon{dented, {}}})).has_value()) << n;
+    // Rounded, or with a hole: kept as given.
+    EXPECT_FALSE(TessellatedDisk(Shape::FromPolygons({Polygon{ring, {}}}, 1e-4)).has_value());
+  }
+  EXPECT_FALSE(TessellatedDisk(Shape::RegularPolygon(12, 0.005)).has_value());  // a 12-gon is no disk
+  EXPECT_TRUE(TessellatedDisk(Shape::RegularPolygon(20, 0.005)).has_value());
+  EXPECT_FALSE(TessellatedDisk(Shape::Disk(0.005)).has_value());
+  EXPECT_FALSE(TessellatedDisk(Shape::Box(0.01, 0.01)).has_value());
+  Ring outer, hole;
+  for (int i = 0; i < 32; ++i) {
+    const double a = 2.0 * M_PI * i / 32;
+    outer.push_back(0.01 * Vec2(std::cos(a), std::sin(a)));
+  }
+  hole = {{-0.001, -0.001}, {-0.001, 0.001}, {0.001, 0.001}, {0.001, -0.001}};
+  EXPECT_FALSE(TessellatedDisk(Shape::FromPolygons({Polygon{outer, {hole}}})).has_value());
+}
+
 TEST(ShapeBadInput, SelfIntersectingBowTie) {
   EXPECT_TRUE(ThrowsAt([] { Shape::FromPolygons({Polygon{{{0, 0}, {1, 1}, {1, 0}, {0, 1}}, {}}}); },
                        {0, -1, {0, 1, 2, 3}}));

@@ -502,7 +502,10 @@ TEST_F(EstimateCli, MeshFilesAreReadDirectly) {
             std::string::npos)
       << direct.err;
   // The command that keeps the polygon reads it along the same axis (without --up y it gave the side view).
-  EXPECT_NE(direct.err.find("obj/tip.obj --up y -o SHAPE.json keeps the polygon"), std::string::npos) << direct.err;
+  EXPECT_NE(direct.err.find("to keep the polygon: pushgraph footprint " + Mit() + "obj/tip.obj --up y -o SHAPE.json, and "
+                            "\"tessellated_finger_as_disk\": false in --config"),
+            std::string::npos)
+      << direct.err;
   ASSERT_EQ(Tool("footprint " + Mit() + "obj/rect1.obj -q -o " + dir() + "/rect1.json").status, 0);
   std::ofstream(dir() + "/tip.json") << R"({"polygons": [{"outer": [[0, 0]]}], "radius": 0.0047})";
   const pushgraph::testing::ToolRun converted = Tool("estimate '" + h5 + "' --object " + dir() + "/rect1.json --finger " +

@@ -262,6 +262,70 @@ TEST(Estimator, AFingerInMillimetresIsReadAsSuchOrRefused) {
   EXPECT_NO_THROW(Estimate(t, Model::kCp, Mode::kBatch));
 }
 
+// A contact sensor in another frame or with an offset (every point 5 cm off the finger): its
+// stream is left out and said so, and the estimate is the one without it; a stream on the finger
+// is kept. Finger 1's stream is judged the same way.
+TEST(Estimator, AContactStreamOffTheFingerIsLeftOutAndSaid) {
+  const push::Trajectory t = GeneratePush(OffsetPush(4, 0.5));
+  ASSERT_GT(t.measured.contact_point.size(), 20u);
+  EstimatorConfig config;
+  config.covariance = false;
+  const EstimationResult kept = Estimate(t, Model::kCp, Mode::kBatch, config);
+  EXPECT_FALSE(HasWarning(kept, "contact_point: its")) << ::testing::PrintToString(kept.warnings);
+  push::Trajectory off = t;
+  for (push::PointSample& c : off.measured.contact_point) c.point += geometry::Vec2(0.05, 0.0);
+  push::Trajectory none = t;
+  none.measured.contact_point.clear();
+  for (const Model model : {Model::kCp, Model::kQs}) {
+    const EstimationResult r = Estimate(off, model, Mode::kBatch, config);
+    EXPECT_TRUE(HasWarning(r, "streams.contact_point: its " + std::to_string(t.measured.contact_point.size()) +
+                                  " samples lie a median "))
+        << ::testing::PrintToString(r.warnings);
+    EXPECT_TRUE(HasWarning(r, "left out of the estimate")) << ::testing::PrintToString(r.warnings);
+    const EstimationResult without = Estimate(none, model, Mode::kBatch, config);
+    ASSERT_EQ(r.states.size(), without.states.size());
+    for (std::size_t i = 0; i < r.states.size(); ++i)
+      EXPECT_LT((r.states[i].object_pose.translation() - without.states[i].object_pose.translation()).norm(), 1e-9) << i;
+  }
+  // Within the noise's reach (3 times the two sigmas, 21 mm here) a stream is used as it is.
+  push::Trajectory near = t;
+  for (push::PointSample& c : near.measured.contact_point) c.point += geometry::Vec2(0.004, 0.0);
+  EXPECT_FALSE(HasWarning(Estimate(near, Model::kCp, Mode::kBatch, config), "contact_point: its"));
+}
+
+// A finger that is a regular 32-gon (a tessellated cylinder: the MIT tip.obj's footprint) is
+// estimated as the disk it approximates, in every mode and by IncrementalEstimator itself, and
+// the warnings say so; tessellated_finger_as_disk false keeps the polygon.
+TEST(Estimator, ATessellatedFingerIsEstimatedAsItsDisk) {
+  push::Trajectory t = GeneratePush(OffsetPush(3, 0.5));
+  ASSERT_NEAR(t.finger.shape.radius(), 0.005, 1e-12);
+  push::Trajectory tessellated = t;
+  tessellated.finger.shape = geometry::Shape::RegularPolygon(32, 0.005);
+  EstimatorConfig config;
+  config.covariance = false;
+  for (const Mode mode : {Mode::kBatch, Mode::kIncremental}) {
+    const EstimationResult disk = Estimate(t, Model::kQs, mode, config);
+    const EstimationResult r = Estimate(tessellated, Model::kQs, mode, config);
+    EXPECT_TRUE(HasWarning(r, "finger: its shape is a regular 32-gon (a tessellated cylinder): estimated as the disk of "
+                              "radius 5 mm at (0.000, 0.000) mm"))
+        << ::testing::PrintToString(r.warnings);
+    EXPECT_FALSE(HasWarning(disk, "tessellated")) << ::testing::PrintToString(disk.warnings);
+    ASSERT_EQ(r.states.size(), disk.states.size());
+    for (std::size_t i = 0; i < r.states.size(); ++i)
+      EXPECT_LT((r.states[i].object_pose.translation() - disk.states[i].object_pose.translation()).norm(), 1e-6) << i;
+  }
+  IncrementalEstimator direct(tessellated, Model::kQs, config);
+  while (!direct.Done()) direct.Update();
+  const EstimationResult replay = direct.Finish();
+  EXPECT_TRUE(HasWarning(replay, "regular 32-gon (a tessellated cylinder)")) << ::testing::PrintToString(replay.warnings);
+  EstimatorConfig keep = config;
+  keep.tessellated_finger_as_disk = false;
+  const EstimationResult polygon = Estimate(tessellated, Model::kCp, Mode::kBatch, keep);
+  EXPECT_FALSE(HasWarning(polygon, "tessellated")) << ::testing::PrintToString(polygon.warnings);
+  EXPECT_THROW(ParseEstimatorConfig(R"({"tessellated_finger_as_disk": 1})"), GraphError);
+  EXPECT_FALSE(ParseEstimatorConfig(R"({"tessellated_finger_as_disk": false})").tessellated_finger_as_disk);
+}
+
 // A finger file drawn off its pose origin (the probe's disk 10 mm beside it): the contacts fit it
 // centred on the tracked point and not as given, so "auto" estimates with it centred and says
 // so; the same file with poses that really are a marker's 10 mm beside the tip fits as given and
@@ -851,6 +915,19 @@ TEST(Estimator, BadTrajectoriesGetClearErrors) {
   auto no_shape = t;
   no_shape.finger.shape = geometry::Shape();
   EXPECT_NE(message(no_shape).find("finger.shape"), std::string::npos);
+  // Two rows out of order (a Python dict is taken in its order): where, with both times, and what to do.
+  auto swapped = t;
+  std::swap(swapped.measured.object_pose[5], swapped.measured.object_pose[6]);
+  EXPECT_NE(message(swapped).find("streams.object_pose is not strictly increasing in time at sample 6 (t = "),
+            std::string::npos) << message(swapped);
+  EXPECT_NE(message(swapped).find("sort each stream's samples by time"), std::string::npos) << message(swapped);
+  // Epoch seconds stored as float32 step by 128 s.
+  auto float32 = t;
+  for (auto* stream : {&float32.measured.object_pose, &float32.measured.finger_pose})
+    for (auto& p : *stream) p.t = static_cast<float>(1.461859e9 + p.t);
+  for (auto& c : float32.measured.contact_point) c.t = static_cast<float>(1.461859e9 + c.t);
+  for (auto& f : float32.measured.force) f.t = static_cast<float>(1.461859e9 + f.t);
+  EXPECT_NE(message(float32).find("look like float32 values"), std::string::npos) << message(float32);
   // A finger tracked in another frame, 2 m or 20 m off: refused (the shape check had scaled the
   // object 100 or 1000 times to reach it). 0.3 m off is within 0.5 m and left to the shape check.
   for (const double offset : {2.0, 20.0}) {

@@ -151,7 +151,9 @@ TEST(Online, AShapeInMillimetresOrTurnedIsNamedDuringThePush) {
       if (!online.UpdateDue()) return;
       online.Update();
       ++updates;
-      if (said_at < 0 && !online.Warnings().empty()) said_at = updates, said_t = online.LatestState().t;
+      const auto& ws = online.Warnings();
+      const bool said = std::any_of(ws.begin(), ws.end(), [](const std::string& w) { return w.find("shape check") == 0; });
+      if (said_at < 0 && said) said_at = updates, said_t = online.LatestState().t;
     });
     const EstimationResult r = online.Finish();
     const double rms = r.metrics.at("object_position_rms");
@@ -175,8 +177,15 @@ TEST(Online, AShapeInMillimetresOrTurnedIsNamedDuringThePush) {
       for (const std::string& w : r.warnings) EXPECT_EQ(w.find("shape check"), std::string::npos) << c.name << ": " << w;
       continue;
     }
-    ASSERT_EQ(online.Warnings().size(), 1u) << c.name;
-    const std::string& w = online.Warnings().front();
+    // A shape in millimetres is said from the start (no tabletop object reaches 1 m), its units
+    // read by the shape check.
+    const bool huge = c.shape.bounds().max.norm() > 1.0;
+    ASSERT_EQ(online.Warnings().size(), huge ? 2u : 1u) << c.name;
+    if (huge)
+      EXPECT_NE(online.Warnings().front().find("which no tabletop object does: a file in millimetres, centimetres or inches?"),
+                std::string::npos)
+          << online.Warnings().front();
+    const std::string& w = online.Warnings().back();
     EXPECT_NE(w.find("does not fit the contacts as given"), std::string::npos) << w;
     EXPECT_NE(w.find(c.expected), std::string::npos) << w;
     ASSERT_TRUE(r.shape_alignment.has_value()) << c.name;
@@ -185,8 +194,8 @@ TEST(Online, AShapeInMillimetresOrTurnedIsNamedDuringThePush) {
     // During the push, not only at its end.
     EXPECT_GT(said_at, 0) << c.name;
     EXPECT_LT(said_at, updates / 2) << c.name;
-    ASSERT_FALSE(r.warnings.empty());
-    EXPECT_EQ(r.warnings.front(), w);
+    ASSERT_GT(r.warnings.size(), huge ? 1u : 0u);
+    EXPECT_EQ(r.warnings[huge ? 1 : 0], w);
   }
 }
 
@@ -367,6 +376,32 @@ TEST(Online, ForceSpikesAreLeftOutAsSensorFaults) {
   EXPECT_NE(r.warnings[0].find("force[" + std::to_string(k) + "]"), std::string::npos) << r.warnings[0];
   EXPECT_NEAR(r.metrics.at("object_position_rms"), clean.metrics.at("object_position_rms"),
               0.05 * clean.metrics.at("object_position_rms"));
+}
+
+// A force sample and a finger pose before the first camera frames (an MIT recording's order:
+// force at 0, finger at 2.2 ms, two object poses 0.2 ms apart at 2.8 ms): the first update is
+// not due until every pose stream has a sample up to the settled time; UpdateDue() said it was,
+// and Update() then threw "no object pose measurement".
+TEST(Online, TheFirstUpdateIsNotDueBeforeEveryPoseStreamHasASample) {
+  const push::Trajectory t = GeneratePush(OffsetPush(3, 0.3));
+  const geometry::Pose2 pose = t.measured.object_pose.front().pose;
+  const geometry::Pose2 finger = t.measured.finger_pose.front().pose;
+  const geometry::Vec2 none(0.0, 0.0);
+  OnlineEstimator online(SetupOf(t), Model::kQs, EstimatorConfig{}, StreamsOf(t));
+  online.AddForce(0.0, none);
+  online.AddFingerPose(0.0022, finger);
+  online.AddObjectPose(0.0028, pose);
+  online.AddObjectPose(0.0030, pose);
+  online.AddForce(0.0040, none);
+  EXPECT_FALSE(online.UpdateDue());
+  EXPECT_THROW(online.Update(), GraphError);  // an explicit update still says why
+  for (int k = 1; k <= 8; ++k) {
+    online.AddFingerPose(0.0022 + 0.004 * k, finger);
+    online.AddObjectPose(0.0030 + 0.004 * k, pose);
+    online.AddForce(0.0040 + 0.004 * k, none);
+  }
+  ASSERT_TRUE(online.UpdateDue());
+  EXPECT_NO_THROW(online.Update());
 }
 
 TEST(Online, RefusesBadAndLateSamples) {

@@ -177,51 +177,6 @@ CLI::Validator FrictionValue(bool zero_allowed) {
 
 namespace {
 
-// A finger mesh whose footprint is a regular polygon of 20 or more vertices (a tessellated
-// cylinder: the MIT tip.obj is a 32-gon of radius 4.7 mm) is the disk it approximates: its
-// vertices lie on the cylinder within 0.5 %, and a polygonal finger needs an exact Minkowski-sum
-// obstacle per relative angle (a rect1 recording: 6.4 s against 0.4 s as a disk). Centre and
-// radius are the vertices' mean and mean distance, so the finger's frame is kept.
-std::optional<geometry::Shape> TessellatedDisk(const geometry::Shape& shape, std::size_t* corners) {
-  if (shape.polygons().size() != 1 || !shape.polygons()[0].holes.empty() || shape.radius() != 0.0) return std::nullopt;
-  // Its corners: a vertex within 1e-9 of the outline's size of the previous one, or on the
-  // straight line between its neighbours to 1e-9 of the edge, is none (a seam kept by the exact
-  // union of a re-exported mesh's rounded coordinates: a y-up tip.obj gave 34 vertices, two of
-  // them 1e-18 m apart).
-  const geometry::Ring& given = shape.polygons()[0].outer;
-  const geometry::Box2 box = shape.bounds();
-  const double size = (box.max - box.min).norm();
-  geometry::Ring distinct;
-  for (const geometry::Vec2& v : given)
-    if (distinct.empty() || (v - distinct.back()).norm() > 1e-9 * size) distinct.push_back(v);
-  while (distinct.size() > 1 && (distinct.front() - distinct.back()).norm() <= 1e-9 * size) distinct.pop_back();
-  geometry::Ring ring;
-  for (std::size_t i = 0; i < distinct.size(); ++i) {
-    const std::size_t m = distinct.size();
-    const geometry::Vec2 a = distinct[(i + m - 1) % m], v = distinct[i], b = distinct[(i + 1) % m];
-    const geometry::Vec2 ab = b - a, av = v - a;
-    if (std::abs(ab.x() * av.y() - ab.y() * av.x()) > 1e-9 * ab.squaredNorm()) ring.push_back(v);
-  }
-  const std::size_t n = ring.size();
-  *corners = n;
-  if (n < 20) return std::nullopt;  // a 12-gon's inscribed circle is 3.4 % smaller than its circumcircle
-  geometry::Vec2 centre = geometry::Vec2::Zero();
-  for (const geometry::Vec2& v : ring) centre += v;
-  centre /= static_cast<double>(n);
-  double mean = 0.0;
-  for (const geometry::Vec2& v : ring) mean += (v - centre).norm();
-  mean /= static_cast<double>(n);
-  const double step = 2.0 * M_PI / static_cast<double>(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const geometry::Vec2 a = ring[i] - centre, b = ring[(i + 1) % n] - centre;
-    const double turn = std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));  // CCW, convex: one step
-    if (std::abs(a.norm() - mean) > 5e-3 * mean || std::abs(turn - step) > 0.2 * step) return std::nullopt;
-  }
-  for (int k = 0; k < 2; ++k)
-    if (std::abs(centre[k]) < 1e-9 * mean) centre[k] = 0.0;  // the mean of a centred ring: rounding only
-  return geometry::Shape::Disk(mean, centre);
-}
-
 // A mesh read as `pushgraph footprint MESH` would (up z, metres, the file's own frame), said on
 // stderr, since another axis or scale needs that command. A finger mesh that is a prism along x
 // or y only (a probe's cylinder lying along y, as the MIT tip.obj) is meant by its cross-section:
@@ -288,17 +243,19 @@ geometry::Shape LoadMeshArgument(const std::string& path, const std::string& wha
     if (warnings) warnings->push_back(what + " " + path + ": " + w);
   }
   if (finger) {
-    std::size_t corners = 0;
-    if (const std::optional<geometry::Shape> disk = TessellatedDisk(shape, &corners)) {
-      const geometry::Vec2 centre = disk->polygons()[0].outer[0];
+    // A tessellated cylinder is the disk it approximates (geometry::TessellatedDisk; the
+    // estimator does the same for any finger shape unless tessellated_finger_as_disk is false).
+    if (const std::optional<geometry::TessellatedDiskFit> fit = geometry::TessellatedDisk(shape)) {
+      const geometry::Vec2 centre = fit->disk.polygons()[0].outer[0];
       std::fprintf(stderr,
                    "pushgraph: %s %s: its footprint is a regular %zu-gon, a tessellated cylinder: used as the disk "
                    "of radius %.4g mm at (%.3f, %.3f) mm it approximates (a polygonal finger solves 6 to 13x "
-                   "slower; pushgraph footprint %s%s -o SHAPE.json keeps the polygon)\n",
-                   what.c_str(), path.c_str(), corners, 1e3 * disk->radius(),
+                   "slower; to keep the polygon: pushgraph footprint %s%s -o SHAPE.json, and "
+                   "\"tessellated_finger_as_disk\": false in --config)\n",
+                   what.c_str(), path.c_str(), fit->corners, 1e3 * fit->disk.radius(),
                    1e3 * centre.x(), 1e3 * centre.y(), path.c_str(),
                    options.up == io::UpAxis::kZ ? "" : (std::string(" --up ") + up).c_str());
-      return *disk;
+      return fit->disk;
     }
   }
   return shape;

@@ -16,7 +16,9 @@
 //   auto notch  = LoadShapeJson("data/shapes/notched_block.json");
 #include <pushgraph/geometry/types.h>
 
+#include <cstddef>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -101,5 +103,18 @@ Vec2 CoreCentroid(const Shape& shape);
 /// Largest distance from `centre` to the shape (rounding included): the radius of the smallest
 /// disk about `centre` that holds it.
 double RadiusAbout(const Shape& shape, const Vec2& centre);
+
+/// A tessellated cylinder's footprint (a round probe exported as a mesh: the MIT tip.obj is a
+/// 32-gon of radius 4.7 mm) and the disk it stands for.
+struct TessellatedDiskFit {
+  Shape disk;               ///< centre the corners' mean, radius their mean distance from it
+  std::size_t corners = 0;  ///< of the regular polygon
+};
+/// The disk a regular polygon of 20 or more corners approximates: one polygon, no holes, no
+/// rounding, every corner within 0.5 % of the mean radius and every turn within 20 % of
+/// 360 / corners degrees (a 12-gon's inscribed circle is already 3.4 % inside its circumcircle).
+/// Seam vertices (duplicates, or points on the line through their neighbours, which an exact
+/// union of a re-exported mesh keeps) are no corners. nullopt for any other shape.
+std::optional<TessellatedDiskFit> TessellatedDisk(const Shape& shape);
 
 }  // namespace pushgraph::geometry
