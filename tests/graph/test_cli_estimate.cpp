@@ -276,6 +276,15 @@ TEST_F(EstimateCli, BadInputGetsOneLineErrors) {
   std::ofstream(cfg) << R"({"window": 3})";
   r = Tool("estimate " + in + " -o " + out + " --config " + cfg);
   EXPECT_NE(r.err.find("'window'"), std::string::npos) << r.err;
+  // An output that cannot be written is said before the work (it was said after the estimate).
+  r = Tool("estimate " + in + " -o /nonexistent/dir/result.json");
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("-o /nonexistent/dir/result.json: its folder /nonexistent/dir does not exist"), std::string::npos)
+      << r.err;
+  r = Tool("estimate " + in + " -o " + dir() + " --svg " + dir() + "/a.svg");
+  EXPECT_NE(r.err.find("-o " + dir() + " is a folder"), std::string::npos) << r.err;
+  r = Tool("estimate " + in + " -o " + out + " --svg /nonexistent/a.svg");
+  EXPECT_NE(r.err.find("--svg /nonexistent/a.svg: its folder /nonexistent does not exist"), std::string::npos) << r.err;
 }
 
 // The data's measurement sigmas first, the configuration file's keys on top: a config that

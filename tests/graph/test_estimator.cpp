@@ -262,6 +262,24 @@ TEST(Estimator, AFingerInMillimetresIsReadAsSuchOrRefused) {
   EXPECT_NO_THROW(Estimate(t, Model::kCp, Mode::kBatch));
 }
 
+// Ground truth over part of the push (its first third only): the metrics score those steps, and
+// the warnings say so; a complete truth says nothing.
+TEST(Estimator, GroundTruthOverPartOfThePushIsSaid) {
+  const push::Trajectory t = GeneratePush(OffsetPush(5, 0.5));
+  EstimatorConfig config;
+  config.covariance = false;
+  const EstimationResult whole = Estimate(t, Model::kCp, Mode::kBatch, config);
+  EXPECT_FALSE(HasWarning(whole, "metrics: ground_truth")) << ::testing::PrintToString(whole.warnings);
+  push::Trajectory part = t;
+  auto& truth = part.ground_truth->object_pose;
+  truth.resize(truth.size() / 3);
+  ASSERT_GE(truth.size(), 2u);
+  const EstimationResult r = Estimate(part, Model::kCp, Mode::kBatch, config);
+  EXPECT_TRUE(HasWarning(r, "metrics: ground_truth.object_pose (" + std::to_string(truth.size()) + " samples, t = "))
+      << ::testing::PrintToString(r.warnings);
+  EXPECT_TRUE(HasWarning(r, "the metrics score those steps only")) << ::testing::PrintToString(r.warnings);
+}
+
 // A contact sensor in another frame or with an offset (every point 5 cm off the finger): its
 // stream is left out and said so, and the estimate is the one without it; a stream on the finger
 // is kept. Finger 1's stream is judged the same way.

@@ -89,7 +89,8 @@ struct NamedPath {
   std::string path;  ///< empty: not given (skipped)
 };
 /// Refuses, before any work, an output that is one of the inputs or another output: the same
-/// path, or the same file under another name (a link, "./a" and "a"). Names both.
+/// path, or the same file under another name (a link, "./a" and "a"). Names both. Also an output
+/// that is a folder, or whose folder does not exist or is not writable.
 void CheckOutputsAreNew(const std::vector<NamedPath>& inputs, const std::vector<NamedPath>& outputs);
 /// Writes JSON with doubles printed to 17 significant digits.
 std::string DumpJson(const nlohmann::json& value, int indent = 2);

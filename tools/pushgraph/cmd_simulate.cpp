@@ -211,6 +211,16 @@ void Run(const SimulateOptions& o) {
     throw CliError("every object pose sample falls inside an --occlusion window (stop mode): the file would have no "
                    "object poses, which estimate needs; shorten the windows or use --occlusion-mode degrade");
   }
+  // What the file will not support, said as it is written (it was said only by estimate).
+  if (trajectory.measured.object_pose.empty())
+    std::fprintf(stderr, "pushgraph: warning: simulate: %s has no object poses (--rate-object 0): pushgraph estimate "
+                         "refuses it, since nothing else anchors the object\n", o.output.c_str());
+  // The simulator is quasi-static (no inertia): faster than about 0.5 m/s a real tabletop object
+  // no longer follows it (mu g = 3 m/s^2 stops a 1 m/s slide within 17 cm).
+  if (o.speed > 0.5)
+    std::fprintf(stderr, "pushgraph: warning: simulate: --speed %s m/s: the quasi-static model ignores inertia, which "
+                         "a real object pushed this fast does not (tabletop pushes are 1 to 300 mm/s)\n",
+                 FormatDouble(o.speed).c_str());
   io::SaveTrajectoryJson(trajectory, o.output);
   if (!o.svg.empty()) {
     evaluation::PushPlotOptions picture;
