@@ -58,7 +58,14 @@ std::string WriteFile(const std::string& path, const std::string& content, int l
   const auto failure = [&](const std::string& what, int error) { return Failure(path, what, error); };
   std::error_code ec;
   const fs::file_status own = fs::symlink_status(path, ec);
-  if (!ec && fs::is_symlink(own)) return WriteThroughLink(path, content, links_followed);
+  if (!ec && fs::is_symlink(own)) {
+    // A link to a pipe, a terminal or a socket (/dev/stdout into a pipe names "pipe:[N]", no
+    // path): written into through the link, as a shell redirection would.
+    const fs::file_status pointed = fs::status(path, ec);
+    if (!ec && (fs::is_fifo(pointed) || fs::is_character_file(pointed) || fs::is_socket(pointed)))
+      return WriteThrough(path, content);
+    return WriteThroughLink(path, content, links_followed);
+  }
   if (fs::is_directory(path, ec)) return path + ": is a directory, not a file to write";
   if (!ec && fs::exists(own) && !fs::is_regular_file(own)) return WriteThrough(path, content);
   // The temporary file sits beside the target (same file system, so the rename is atomic).

@@ -646,7 +646,7 @@ EstimationResult Estimate(const push::Trajectory& given, Model model, Mode mode,
                          "adds noise to the recording and scores against it (pushgraph estimate --add-noise, pushgraph "
                          "evaluate)");
   }
-  if (!r.metrics.empty() && !r.states.empty() && trajectory.ground_truth) {
+  if (!r.metrics.empty() && !r.states.empty() && trajectory.ground_truth && !trajectory.ground_truth->object_pose.empty()) {
     // Ground truth over part of the push scores that part only: two truth rows before contact
     // gave an object RMS of 0.635 mm for a 29-sample push, and no word (a hostile user's file).
     std::size_t scored = 0;
@@ -655,10 +655,10 @@ EstimationResult Estimate(const push::Trajectory& given, Model model, Mode mode,
     if (scored < 0.9 * static_cast<double>(r.states.size())) {  // a truth stream ending a frame early is no matter
       const auto& truth = trajectory.ground_truth->object_pose;
       r.warnings.push_back(internal::Format(
-          "metrics: ground_truth.object_pose (%zu sample%s%s) covers %zu of the estimate's %zu steps (t = %.9g to %.9g s): "
-          "the metrics score those steps only",
+          "metrics: ground_truth.object_pose (%zu sample%s%s) covers %zu of the estimate's %zu steps (t = %.9g to %.9g s; "
+          "truth is read at a step's time between samples at most 0.1 s apart): the metrics score those steps only",
           truth.size(), truth.size() == 1 ? "" : "s",
-          truth.empty() ? "" : internal::Format(", t = %.9g to %.9g s", truth.front().t, truth.back().t).c_str(), scored,
+          internal::Format(", t = %.9g to %.9g s", truth.front().t, truth.back().t).c_str(), scored,
           r.states.size(), r.states.front().t, r.states.back().t));
     }
   }

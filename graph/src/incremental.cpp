@@ -886,9 +886,11 @@ struct OnlineEstimator::Impl {
       if (reach > kTabletopReach)
         warnings.push_back(internal::Format(
             "object: its shape reaches %.4g m from its centroid, which no tabletop object does: a file in millimetres, "
-            "centimetres or inches? The shape check reads its units once the contacts can judge them (3 independent "
-            "contact samples); the updates before that estimate with the shape as given",
-            reach));
+            "centimetres or inches? The shape check %s once the contacts can judge them (3 independent contact "
+            "samples); the updates before that estimate with the shape as given",
+            reach,
+            cfg.align_shape == EstimatorConfig::AlignShape::kOff ? "names its units (align_shape \"off\" applies none)"
+                                                                  : "reads its units"));
     }
     // Every finger (finger k is the setup's extra_fingers[k - 1]) has the same kinds of sensors.
     fingers = 1 + static_cast<int>(traj.extra_fingers.size());

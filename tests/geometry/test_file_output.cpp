@@ -93,6 +93,19 @@ TEST_F(FileOutput, LinksAndSpecialFilesAreWrittenThroughNotReplaced) {
   reader.join();
   EXPECT_EQ(received, "through the pipe");
   EXPECT_TRUE(fs::is_fifo(fifo));
+
+  // /dev/stdout into a pipe (`pushgraph estimate ... -o /dev/stdout | jq`): a link to
+  // "pipe:[N]", which names no file; it failed with "cannot create a temporary file in /proc/self/fd".
+  int ends[2];
+  ASSERT_EQ(::pipe(ends), 0);
+  const std::string through = "/proc/self/fd/" + std::to_string(ends[1]);
+  ASSERT_TRUE(fs::is_symlink(fs::symlink_status(through)));
+  EXPECT_EQ(WriteFileAtomically(through, "into the pipe"), "");
+  ::close(ends[1]);
+  char buffer[64] = {};
+  const ssize_t n = ::read(ends[0], buffer, sizeof buffer - 1);
+  ::close(ends[0]);
+  EXPECT_EQ(std::string(buffer, n > 0 ? static_cast<std::size_t>(n) : 0), "into the pipe");
 }
 
 TEST_F(FileOutput, ConcurrentWritersLeaveOneWholeFile) {

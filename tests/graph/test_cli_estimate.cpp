@@ -82,7 +82,8 @@ class EstimateCli : public pushgraph::testing::ToolTest {
   // user's exporter writes it.
   // `exact_quarter` false keeps the quarter turn's rounding (cos 90 deg = 6e-17), as some
   // exporters write it: seams 1e-18 m apart.
-  std::string TurnedMesh(const std::string& mesh, double degrees, const std::string& name, bool exact_quarter = true) {
+  std::string TurnedMesh(const std::string& mesh, double degrees, const std::string& name, bool exact_quarter = true,
+                         double scale = 1.0) {
     std::ifstream in(Mit() + "obj/" + mesh);
     const std::string path = dir() + "/" + name;
     std::ofstream out(path);
@@ -95,7 +96,7 @@ class EstimateCli : public pushgraph::testing::ToolTest {
         // A quarter turn's cosine is 6e-17, not 0: such terms are dropped, as an exporter does.
         const bool quarter = exact_quarter && std::abs(c) < 1e-12;
         const double yy = quarter ? -s * z : c * y - s * z, zz = quarter ? s * y : s * y + c * z;
-        out << "v " << x << " " << yy << " " << zz << "\n";
+        out << "v " << scale * x << " " << scale * yy << " " << scale * zz << "\n";
       } else {
         out << line << "\n";
       }
@@ -609,6 +610,15 @@ TEST_F(EstimateCli, AMeshExportedWithYUpIsReadByItsCrossSection) {
     EXPECT_NE(r.err.find("regular 32-gon, a tessellated cylinder: used as the disk of radius 4.7 mm"), std::string::npos)
         << r.err;
     EXPECT_LT(largest_difference(Load(dir() + "/both.json")), 1e-6);
+  }
+  // In millimetres too (a CAD export): the command that saves the shape reads it along y and in
+  // metres (it said "--scale 0.001" alone, which saves the side view).
+  {
+    const std::string y_up_mm = TurnedMesh("rect1.obj", -90.0, "rect1_y_up_mm.obj", true, 1000.0);
+    const pushgraph::testing::ToolRun r = Tool("estimate '" + h5 + "' --object " + y_up_mm + rest + dir() + "/y_up_mm.json");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("pushgraph footprint " + y_up_mm + " --up y --scale 0.001"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("pushgraph footprint " + y_up_mm + " --scale"), std::string::npos) << r.err;
   }
   const pushgraph::testing::ToolRun off = Tool("estimate '" + h5 + "' --object " + y_up + rest + dir() + "/off.json --align-shape off");
   ASSERT_EQ(off.status, 0) << off.err;

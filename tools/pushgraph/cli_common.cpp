@@ -86,9 +86,13 @@ void CheckOutputsAreNew(const std::vector<NamedPath>& inputs, const std::vector<
       throw CliError(out.what + " " + out.path + " is a folder: give a file name in it");
     const fs::path folder = fs::path(out.path).has_parent_path() ? fs::path(out.path).parent_path() : fs::path(".");
     if (!fs::is_directory(folder, ec))
-      throw CliError(out.what + " " + out.path + ": its folder " + folder.string() + " does not exist (create it first)");
+      throw CliError(out.what + " " + out.path + ": its folder " + folder.string() +
+                     (ec && ec != std::errc::no_such_file_or_directory ? " cannot be read (" + ec.message() + ")"
+                                                                       : " does not exist (create it first)"));
+    // A symbolic link (/dev/stdout) is written through to what it names, which the writer finds.
+    const bool link = fs::is_symlink(fs::symlink_status(out.path, ec));
     const fs::file_status target = fs::status(out.path, ec);
-    const bool written_into = fs::is_character_file(target) || fs::is_fifo(target) || fs::is_socket(target);
+    const bool written_into = link || fs::is_character_file(target) || fs::is_fifo(target) || fs::is_socket(target);
     if (!written_into && ::access(folder.c_str(), W_OK | X_OK) != 0)
       throw CliError(out.what + " " + out.path + ": its folder " + folder.string() + " is not writable (" +
                      std::strerror(errno) + ")");
@@ -309,16 +313,16 @@ geometry::Shape LoadShapeArgument(const std::string& path, const std::string& wh
   }
 }
 
-void ChooseObjectReading(const std::string& path, const MeshReadings& readings, const graph::EstimatorConfig& config,
-                         push::Trajectory* trajectory, std::vector<std::string>* warnings) {
-  if (readings.shapes.empty()) return;
+std::string ChooseObjectReading(const std::string& path, const MeshReadings& readings, const graph::EstimatorConfig& config,
+                                push::Trajectory* trajectory, std::vector<std::string>* warnings) {
+  if (readings.shapes.empty()) return "";
   auto say = [&](const std::string& text) {
     std::fprintf(stderr, "pushgraph: warning: --object %s: %s\n", path.c_str(), text.c_str());
     if (warnings) warnings->push_back("--object " + path + ": " + text);
   };
   if (config.align_shape == graph::EstimatorConfig::AlignShape::kOff) {
     if (!readings.side_view.empty()) say(readings.side_view);
-    return;
+    return "";
   }
   std::vector<geometry::Shape> candidates{trajectory->object.shape};
   candidates.insert(candidates.end(), readings.shapes.begin(), readings.shapes.end());
@@ -335,10 +339,11 @@ void ChooseObjectReading(const std::string& path, const MeshReadings& readings, 
         "contacts fit its cross-section along " + up + ", not its footprint along z (its side view): estimated with the "
         "cross-section (" + FormatSize(box.max.x() - box.min.x()) + " x " + FormatSize(box.max.y() - box.min.y()) +
         " in the file's units; " + reason + "); pushgraph footprint " + path + " --up " + up + " -o SHAPE.json saves it");
-    return;
+    return up;
   }
   if (!readings.side_view.empty() && !(choice.checked[0] && choice.checks[0].fits))
     say(readings.side_view + (reason.empty() ? "" : " (the contacts fit no reading clearly better: " + reason + ")"));
+  return "";
 }
 
 }  // namespace pushgraph::cli

@@ -70,9 +70,10 @@ geometry::Shape LoadShapeArgument(const std::string& path, const std::string& wh
 /// Which reading of an --object mesh the recording's contacts fit (graph::ChooseShapeReading):
 /// sets trajectory.object.shape, says on stderr what was chosen and why, and adds that, or the
 /// held-back side-view warning when the footprint along z is kept without fitting, to `warnings`.
-/// With align_shape off the footprint along z is kept and the warning said, as before.
-void ChooseObjectReading(const std::string& path, const MeshReadings& readings, const graph::EstimatorConfig& config,
-                         push::Trajectory* trajectory, std::vector<std::string>* warnings);
+/// With align_shape off the footprint along z is kept and the warning said, as before. Returns
+/// the up axis chosen when it is not z ("x" or "y"), else "".
+std::string ChooseObjectReading(const std::string& path, const MeshReadings& readings, const graph::EstimatorConfig& config,
+                                push::Trajectory* trajectory, std::vector<std::string>* warnings);
 /// Says on stderr when a shape is outside 1 mm to 2 m across (io::ShapeUnitsWarning), for the
 /// commands that take a shape's size as given (limit-surface, simulate); estimate's shape check
 /// finds the units itself.

@@ -90,15 +90,19 @@ void RunEstimate(const EstimateOptions& o) {
                    "fixed): use --mode batch or drop them");
   }
   graph::EstimationResult result;
+  std::string object_up;  // the mesh's reading, when not along z
   try {
-    ChooseObjectReading(o.object, object_readings, config, &traj, &mesh_warnings);
+    object_up = ChooseObjectReading(o.object, object_readings, config, &traj, &mesh_warnings);
     result = graph::Estimate(traj, model, mode, config);
   } catch (const graph::GraphError& e) {
     throw CliError(o.input + ": " + e.what());
   }
-  // The library names the shape file SHAPE_FILE in its "to save it" commands; here it is known.
+  // The library names the shape file SHAPE_FILE in its "to save it" commands; here it is known,
+  // and so is the axis it was read along (a y-up export in millimetres: "--scale 0.001" alone
+  // saved its side view).
   if (!o.object.empty()) {
-    const std::string file = o.object.find_first_of(" '\"") == std::string::npos ? o.object : "'" + o.object + "'";
+    const std::string file = (o.object.find_first_of(" '\"") == std::string::npos ? o.object : "'" + o.object + "'") +
+                             (object_up.empty() ? "" : " --up " + object_up);
     for (std::string& w : result.warnings) {
       for (std::size_t at = w.find("SHAPE_FILE"); at != std::string::npos; at = w.find("SHAPE_FILE", at + file.size())) {
         w.replace(at, 10, file);
