@@ -542,6 +542,9 @@ std::optional<push::Trajectory> DropObjectPoseGlitches(const push::Trajectory& t
 std::optional<std::string> YawUnitNote(const push::Trajectory& trajectory);
 /// A step of the object pose stream that stays (samples on each side agree): said, not repaired.
 std::optional<std::string> TrackerStepNote(const push::Trajectory& trajectory);
+/// The farthest a tabletop object's shape reaches from its centroid (m): objects pushed by a
+/// finger span centimetres to decimetres (MIT's 9 to 16 cm); beyond, a file in other units.
+inline constexpr double kTabletopReach = 1.0;
 /// A warning when the object's shape reaches more than 1 m from its centroid: a file in
 /// centimetres or millimetres throughout (shapes and positions agree, so nothing else sees it).
 std::optional<std::string> ShapeSizeNote(const push::Trajectory& trajectory);
@@ -559,7 +562,8 @@ push::Trajectory WithObjectInMetres(const push::Trajectory& trajectory);
 std::optional<push::Trajectory> FingerUnits(const push::Trajectory& trajectory, const RegistrationOptions& options,
                                             std::string* note, double* finger_scale);
 /// Contact streams that do not lie on their finger: the median distance of a finger's contact
-/// points from its boundary (its pose taken from the nearest finger sample within 0.05 s) above
+/// points from its boundary (its pose interpolated at their times, where a finger sample lies
+/// within 0.05 s) above
 /// max(5 mm, 3 sqrt(sigma_contact^2 + sigma_finger^2)), over at least 5 such samples: a tactile
 /// sensor in another frame or with an offset, which pulled every model's estimate beyond the raw
 /// data's. Returns the trajectory with those streams left out and sets `note`; nullopt when none is.

@@ -664,6 +664,7 @@ EstimationResult IncrementalEstimator::Finish() {
 
 // Online: the samples are appended to an owned trajectory as they arrive.
 struct OnlineEstimator::Impl {
+  std::string finger_disks;  // the setup's tessellated fingers read as disks (empty: none); before traj
   push::Trajectory traj;  // grows; the smoother's builder reads it
   Model model;
   OnlineStreams streams;
@@ -736,7 +737,6 @@ struct OnlineEstimator::Impl {
   // whose whole-graph comparison finds it; the contacts' own "fits better elsewhere" named the
   // true rect1 shape on a 4 s push.
   static constexpr double kShapeCheckSamples = 3.0;  // the batch's "too little contact" bound
-  static constexpr double kTabletopReach = 1.0;      // m from the centroid, as ShapeSizeNote
   static constexpr double kShapeCheckRetry = 0.1;    // s (0.5: the second check of a 250 Hz MIT recording came 25 updates late)
   static constexpr double kShapeCheckSpan = 4.0;     // s
   bool shape_judged = false;
@@ -867,23 +867,22 @@ struct OnlineEstimator::Impl {
     }
     return setup;
   }
-  // The setup with its tessellated fingers as disks, as Estimate reads them (warnings says so).
-  static push::Trajectory AsEstimated(const push::Trajectory& setup, const EstimatorConfig& cfg) {
-    std::string note;
-    std::optional<push::Trajectory> disks = internal::TessellatedFingersAsDisks(Empty(setup), cfg, &note);
+  // The setup with its tessellated fingers as disks, as Estimate reads them (`note` says so).
+  static push::Trajectory AsEstimated(const push::Trajectory& setup, const EstimatorConfig& cfg, std::string* note) {
+    std::optional<push::Trajectory> disks = internal::TessellatedFingersAsDisks(Empty(setup), cfg, note);
     return disks ? std::move(*disks) : setup;
   }
   Impl(const push::Trajectory& setup, Model model, const EstimatorConfig& cfg, const OnlineStreams& streams)
-      : traj(AsEstimated(setup, cfg)),
+      : traj(AsEstimated(setup, cfg, &finger_disks)),
         model(model),
         streams(streams),
         smoother(std::make_unique<FixedLagSmoother>(traj, model, cfg, &this->streams)) {
-    if (std::string note; internal::TessellatedFingersAsDisks(setup, cfg, &note)) warnings.push_back(note);
+    if (!finger_disks.empty()) warnings.push_back(finger_disks);
     // A shape that no tabletop object has: its units are read by the shape check, once the contacts
     // can judge them; until then (0.2 to 0.4 s of contact) the updates were metres off, unsaid.
     if (cfg.diagnostics && !traj.object.shape.empty()) {
       const double reach = geometry::RadiusAbout(traj.object.shape, geometry::CoreCentroid(traj.object.shape));
-      if (reach > kTabletopReach)
+      if (reach > internal::kTabletopReach)
         warnings.push_back(internal::Format(
             "object: its shape reaches %.4g m from its centroid, which no tabletop object does: a file in millimetres, "
             "centimetres or inches? The shape check %s once the contacts can judge them (3 independent contact "

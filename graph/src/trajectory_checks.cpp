@@ -1067,8 +1067,7 @@ std::optional<std::string> ShapeSizeNote(const push::Trajectory& traj) {
   const geometry::Shape& object = traj.object.shape;
   if (object.empty()) return std::nullopt;
   const double reach = geometry::RadiusAbout(object, geometry::CoreCentroid(object));
-  constexpr double kMaxReach = 1.0;  // m
-  if (!(reach > kMaxReach)) return std::nullopt;
+  if (!(reach > kTabletopReach)) return std::nullopt;
   // Positions on the shape's scale (the finger's nearest approach 0.1 to 1 object sizes, as in
   // metres): a shape file alone in millimetres against positions in metres (about 1e-3 sizes) is
   // the shape check's case, which finds its units.
@@ -1077,7 +1076,7 @@ std::optional<std::string> ShapeSizeNote(const push::Trajectory& traj) {
   // box pushed by a 5 cm finger in metres was asked to divide by 100).
   const geometry::Shape& finger = traj.finger.shape;
   if (finger.empty() || !(geometry::RadiusAbout(finger, geometry::CoreCentroid(finger)) >= 0.1)) return std::nullopt;
-  const bool milli = reach > 100.0 * kMaxReach;
+  const bool milli = reach > 100.0 * kTabletopReach;
   return Format("object: its shape reaches %.4g m from its centroid (%.4g m across) and the finger's radius is %.3g m: is "
                 "the whole file in %s? Trajectory files are in metres (shapes, positions, sigmas): a tabletop object read "
                 "in %s would be %.3g cm across. The noise model's scales do not fit such a push, and the estimate may be "
@@ -1119,52 +1118,44 @@ std::optional<push::Trajectory> DropContactStreamsOffTheFinger(const push::Traje
   // Three times the two noises combined (root sum of squares): pure noise has a median of 0.67 times it.
   const double bound = std::max(kLeastOffset, 3.0 * std::hypot(sigmas.contact, sigmas.finger_trans));
   std::string said;
-  push::Trajectory out = traj;
-  auto judge = [&](const std::vector<push::PoseSample>& poses, const geometry::Shape& finger,
-                   std::vector<push::PointSample>* contacts, const std::string& prefix) {
-    if (poses.empty() || contacts->size() < kLeastSamples || finger.empty()) return;
+  // Judged on the trajectory as given; a copy is made only for a stream left out.
+  auto off = [&](const std::vector<push::PoseSample>& poses, const geometry::Shape& finger,
+                 const std::vector<push::PointSample>& contacts, const std::string& prefix) {
+    if (poses.empty() || contacts.size() < kLeastSamples || finger.empty()) return false;
     std::vector<double> distances;
-    for (const push::PointSample& c : *contacts) {
-      // The finger's pose at the contact's time: interpolated between its samples around it (a
-      // 10 Hz tracker at 0.3 m/s moves the finger 15 mm between them), when both are near.
-      const auto next = std::lower_bound(poses.begin(), poses.end(), c.t,
-                                         [](const push::PoseSample& p, double t) { return p.t < t; });
-      geometry::Pose2 pose;
-      if (next != poses.end() && next->t == c.t) {
-        pose = next->pose;
-      } else if (next != poses.begin() && next != poses.end() && next->t - std::prev(next)->t <= 2.0 * kNearInTime) {
-        const push::PoseSample& a = *std::prev(next);
-        const double w = (c.t - a.t) / (next->t - a.t);
-        pose = {a.pose.x + w * (next->pose.x - a.pose.x), a.pose.y + w * (next->pose.y - a.pose.y),
-                a.pose.theta + w * geometry::WrapAngle(next->pose.theta - a.pose.theta)};
-      } else {
-        const push::PoseSample& at = NearestInTime(poses, c.t);
-        if (std::abs(at.t - c.t) > kNearInTime) continue;
-        pose = at.pose;
-      }
+    for (const push::PointSample& c : contacts) {
+      if (std::abs(NearestInTime(poses, c.t).t - c.t) > kNearInTime) continue;
+      // The finger's pose at the contact's time, interpolated (a 10 Hz tracker at 0.3 m/s moves
+      // the finger 15 mm between its samples).
+      const geometry::Pose2 pose = push::PoseAtClamped(poses.begin(), poses.end(), c.t);
       const geometry::Vec2 local = geometry::InverseAct(pose, c.point);  // the finger's frame
       distances.push_back(std::abs(geometry::QueryPoint(finger, local).signed_distance));
     }
-    if (distances.size() < kLeastSamples) return;
+    if (distances.size() < kLeastSamples) return false;
     const auto mid = distances.begin() + static_cast<std::ptrdiff_t>(distances.size() / 2);
     std::nth_element(distances.begin(), mid, distances.end());
     const double median = *mid;
-    if (!(median > bound)) return;
+    if (!(median > bound)) return false;
     said += (said.empty() ? "" : "; ") +
             Format("streams.%scontact_point: its %zu samples lie a median %.1f mm from the finger's boundary (the finger "
                    "pose at their times), where the contact sensor's and the finger tracker's noise (%.3g and %.3g mm) "
                    "would put them within %.1f mm: a contact sensor in another frame than the poses' (the finger's or "
                    "the object's) or with an offset; left out of the estimate",
-                   prefix.c_str(), contacts->size(), 1e3 * median, 1e3 * sigmas.contact, 1e3 * sigmas.finger_trans,
+                   prefix.c_str(), contacts.size(), 1e3 * median, 1e3 * sigmas.contact, 1e3 * sigmas.finger_trans,
                    1e3 * bound);
-    contacts->clear();
+    return true;
   };
-  judge(traj.measured.finger_pose, traj.finger.shape, &out.measured.contact_point, "");
-  for (std::size_t k = 0; k < out.extra_fingers.size(); ++k) {
-    push::ExtraFinger& f = out.extra_fingers[k];
-    judge(f.measured.finger_pose, f.finger.shape, &f.measured.contact_point, "fingers[" + std::to_string(k + 1) + "].");
+  std::vector<bool> dropped{off(traj.measured.finger_pose, traj.finger.shape, traj.measured.contact_point, "")};
+  for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k) {
+    const push::ExtraFinger& f = traj.extra_fingers[k];
+    dropped.push_back(off(f.measured.finger_pose, f.finger.shape, f.measured.contact_point,
+                          "fingers[" + std::to_string(k + 1) + "]."));
   }
   if (said.empty()) return std::nullopt;
+  push::Trajectory out = traj;
+  if (dropped[0]) out.measured.contact_point.clear();
+  for (std::size_t k = 0; k < out.extra_fingers.size(); ++k)
+    if (dropped[k + 1]) out.extra_fingers[k].measured.contact_point.clear();
   *note = said + " (contact is then gated on the force stream, else taken as always on; a stream in the world frame "
                  "of the poses, on the finger's boundary, is used)";
   return out;
@@ -1174,21 +1165,24 @@ std::optional<push::Trajectory> TessellatedFingersAsDisks(const push::Trajectory
                                                           std::string* note) {
   if (!config.tessellated_finger_as_disk) return std::nullopt;
   std::string said;
-  auto replace = [&](geometry::Shape* shape, const std::string& which) {
-    const std::optional<geometry::TessellatedDiskFit> fit = geometry::TessellatedDisk(*shape);
+  std::optional<push::Trajectory> disks;  // copied at the first tessellated finger only
+  auto replace = [&](const geometry::Shape& shape, auto&& place, const std::string& which) {
+    const std::optional<geometry::TessellatedDiskFit> fit = geometry::TessellatedDisk(shape);
     if (!fit) return;
     const geometry::Vec2 centre = fit->disk.polygons()[0].outer[0];
     said += (said.empty() ? "" : "; ") +
             Format("%s: its shape is a regular %zu-gon (a tessellated cylinder): estimated as the disk of radius %.4g mm "
                    "at (%.3f, %.3f) mm it approximates",
                    which.c_str(), fit->corners, 1e3 * fit->disk.radius(), 1e3 * centre.x(), 1e3 * centre.y());
-    *shape = fit->disk;
+    if (!disks) disks = traj;
+    place(*disks) = fit->disk;
   };
-  push::Trajectory disks = traj;
-  replace(&disks.finger.shape, "finger");
-  for (std::size_t k = 0; k < disks.extra_fingers.size(); ++k)
-    replace(&disks.extra_fingers[k].finger.shape, "finger " + std::to_string(k + 1));
-  if (said.empty()) return std::nullopt;
+  replace(traj.finger.shape, [](push::Trajectory& t) -> geometry::Shape& { return t.finger.shape; }, "finger");
+  for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k)
+    replace(traj.extra_fingers[k].finger.shape,
+            [k](push::Trajectory& t) -> geometry::Shape& { return t.extra_fingers[k].finger.shape; },
+            "finger " + std::to_string(k + 1));
+  if (!disks) return std::nullopt;
   // Why: a polygon's many short faces are each a local witness's feature, and its exact
   // C-obstacles are cached per relative angle.
   *note = said +
