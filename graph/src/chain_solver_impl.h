@@ -69,7 +69,6 @@ struct ChainSolver::Impl {
 
   ceres::Problem* problem = nullptr;
   std::vector<Block> blocks;                          // in the order they were added (time order)
-  std::unordered_map<const double*, int> index;       // block pointer -> blocks index
   std::unordered_map<const double*, int> fixed;       // constant or unused: size
   std::vector<Residual> residuals;
   std::vector<const double*> param_ptrs;

@@ -175,8 +175,8 @@ struct FixedLagSmoother {
       for (double* b : builder.Blocks(steps[k])) leaving[b] = static_cast<int>(k);
     // A block is eliminated with the oldest leaving step it touches.
     std::vector<std::vector<ceres::ResidualBlockId>> blocks(steps.size());
+    std::vector<double*> ps;
     auto assign = [&](ceres::ResidualBlockId id) {
-      std::vector<double*> ps;
       problem->GetParameterBlocksForResidualBlock(id, &ps);
       int first = -1;
       for (double* p : ps) {
@@ -199,37 +199,47 @@ struct FixedLagSmoother {
   // blocks they share with other steps; returns the marginal prior added (nullptr: none).
   ceres::ResidualBlockId Marginalize(int s, const std::vector<ceres::ResidualBlockId>& rbs) {
     std::vector<double*> removed = builder.Blocks(s);
+    // `order` (the removed step's blocks, then the separator's) and their offsets: a few blocks,
+    // found by a linear search (a std::map's nodes were a tenth of the marginalization's time).
     std::vector<double*> order(removed);
-    std::map<double*, int> offset;
+    std::vector<int> order_sizes, order_offsets;
     int dim = 0;
-    std::vector<int> order_sizes;  // of `order`
-    for (double* b : removed) { offset[b] = dim; order_sizes.push_back(problem->ParameterBlockSize(b)); dim += order_sizes.back(); }
+    for (double* b : removed) {
+      order_offsets.push_back(dim);
+      order_sizes.push_back(problem->ParameterBlockSize(b));
+      dim += order_sizes.back();
+    }
+    auto offset_of = [&](const double* p) {
+      const auto it = std::find(order.begin(), order.end(), p);
+      return it == order.end() ? -1 : order_offsets[static_cast<std::size_t>(it - order.begin())];
+    };
     const int removed_dim = dim;
-    std::vector<std::vector<double*>> rb_params;
-    for (ceres::ResidualBlockId id : rbs) {
-      std::vector<double*> ps;
-      problem->GetParameterBlocksForResidualBlock(id, &ps);
+    std::vector<std::vector<double*>>& rb_params = scratch_params_;
+    if (rb_params.size() < rbs.size()) rb_params.resize(rbs.size());
+    for (std::size_t k = 0; k < rbs.size(); ++k) {
+      std::vector<double*>& ps = rb_params[k];
+      problem->GetParameterBlocksForResidualBlock(rbs[k], &ps);
       for (double* p : ps) {
-        if (!offset.count(p)) {
-          offset[p] = dim;
+        if (offset_of(p) < 0) {
           order.push_back(p);
+          order_offsets.push_back(dim);
           order_sizes.push_back(problem->ParameterBlockSize(p));
           dim += order_sizes.back();
         }
       }
-      rb_params.push_back(ps);
     }
     // The factors' whitened Jacobians stacked, [A | r] (rows of every factor; the robust loss as
     // the solver weighs it, sqrt(rho')), the removed step's columns first; filled in place.
     int rows = 0;
     for (ceres::ResidualBlockId id : rbs) rows += problem->GetCostFunctionForResidualBlock(id)->num_residuals();
-    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(rows, dim + 1);
+    Eigen::MatrixXd& A = scratch_A_;
+    A.setZero(rows, dim + 1);
     {
       int row = 0;
       std::size_t k = 0;
-      Eigen::VectorXd r;
-      std::vector<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> J;
-      std::vector<double*> jp;
+      Eigen::VectorXd& r = scratch_r_;
+      std::vector<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>& J = scratch_J_;
+      std::vector<double*>& jp = scratch_jp_;
       for (ceres::ResidualBlockId id : rbs) {
         const std::vector<double*>& ps = rb_params[k++];
         const ceres::CostFunction* cost = problem->GetCostFunctionForResidualBlock(id);
@@ -258,7 +268,7 @@ struct FixedLagSmoother {
           loss->Evaluate(r.squaredNorm(), rho);
           scale = std::sqrt(std::max(rho[1], 0.0));
         }
-        for (std::size_t q = 0; q < ps.size(); ++q) A.block(row, offset[ps[q]], m, J[q].cols()) += scale * J[q];
+        for (std::size_t q = 0; q < ps.size(); ++q) A.block(row, offset_of(ps[q]), m, J[q].cols()) += scale * J[q];
         A.col(dim).segment(row, m) = scale * r;
         row += m;
       }
@@ -290,10 +300,12 @@ struct FixedLagSmoother {
     }
     // The removed step's columns: Q^T A_r P = [R11 R12; 0 0], rank k where |R_ii| falls below
     // 1e-6 of the largest (the square root of the eigenvalue cutoff 1e-12 used before).
-    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> removed_qr(A.leftCols(removed_dim));
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd>& removed_qr = scratch_removed_qr_;
+    removed_qr.compute(A.leftCols(removed_dim));
     removed_qr.setThreshold(kRemovedRankCutoff);
     const int rank = static_cast<int>(removed_qr.rank());
-    Eigen::MatrixXd rest = A.rightCols(sep_dim + 1);  // [A_s | r], rotated by Q^T below
+    Eigen::MatrixXd& rest = scratch_rest_;
+    rest = A.rightCols(sep_dim + 1);  // [A_s | r], rotated by Q^T below
     rest.applyOnTheLeft(removed_qr.householderQ().transpose());
     const Eigen::MatrixXd R = removed_qr.matrixR().topRows(rank).triangularView<Eigen::Upper>();  // rank x removed_dim
     const std::vector<double*> sep(order.begin() + removed.size(), order.end());
@@ -336,7 +348,8 @@ struct FixedLagSmoother {
     if (sep_dim == 0 || rows <= rank) return nullptr;
     // The rows below the rank hold the separator alone: T2 dx_s + c2. Compressed to at most
     // sep_dim rows by a second QR, rank-revealing at 1e-5 (the eigenvalue cutoff 1e-10 before).
-    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> separator_qr(rest.bottomLeftCorner(rows - rank, sep_dim));
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd>& separator_qr = scratch_separator_qr_;
+    separator_qr.compute(rest.bottomLeftCorner(rows - rank, sep_dim));
     separator_qr.setThreshold(kSeparatorRankCutoff);
     const int kept = static_cast<int>(separator_qr.rank());
     if (kept == 0) return nullptr;
@@ -352,6 +365,13 @@ struct FixedLagSmoother {
     return problem->AddResidualBlock(new MarginalPriorFactor(sep_sizes, x_bar, std::move(S), std::move(r0)), nullptr, sep);
   }
   static constexpr double kRemovedRankCutoff = 1e-6, kSeparatorRankCutoff = 1e-5;
+  // Marginalize's buffers, kept between steps (their allocations were a fifth of its time).
+  std::vector<std::vector<double*>> scratch_params_;
+  Eigen::MatrixXd scratch_A_, scratch_rest_;
+  Eigen::VectorXd scratch_r_;
+  std::vector<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> scratch_J_;
+  std::vector<double*> scratch_jp_;
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> scratch_removed_qr_, scratch_separator_qr_;
 
   // The window's length in steps (0: in time, window_duration).
   int WindowSteps() const {
