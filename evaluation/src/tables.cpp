@@ -252,23 +252,38 @@ std::vector<Table> MakeTables(std::vector<EvaluationRow> rows, const std::string
     for (const EvaluationRow& r : rows) {
       if (r.error.empty()) ranked.push_back(&r);
     }
-    std::stable_sort(ranked.begin(), ranked.end(), [](const EvaluationRow* a, const EvaluationRow* b) { return a->health > b->health; });
+    // A push too short for any judged factor type to reach 20 degrees of freedom has no score (0,
+    // no worst factor): listed as such after the scored ones and left out of the medians (a
+    // 2-sample push ranked as the healthiest, and pulled its group's median to 0).
+    auto scored = [](const EvaluationRow& r) { return r.health > 0.0 || !r.worst_factor.empty(); };
+    std::stable_sort(ranked.begin(), ranked.end(), [&](const EvaluationRow* a, const EvaluationRow* b) {
+      if (scored(*a) != scored(*b)) return scored(*a);
+      return a->health > b->health;
+    });
     for (std::size_t k = 0; k < ranked.size() && k < 10; ++k) {
       const EvaluationRow& r = *ranked[k];
       std::string notes;
       for (const std::string& n : r.notes) notes += (notes.empty() ? "" : "; ") + n;
       for (char& c : notes) c = c == '|' ? '/' : c;
-      t.rows.push_back({r.group, r.name, Fmt(r.health, 3), r.worst_factor, notes});
+      if (!scored(r)) {
+        notes = "not scored: too few samples (no judged factor type has 20 degrees of freedom)" + (notes.empty() ? "" : "; " + notes);
+      }
+      t.rows.push_back({r.group, r.name, scored(r) ? Fmt(r.health, 3) : "n/a", r.worst_factor, notes});
     }
     for (const auto& [g, s] : groups) {
       const Agg a{&s};
       std::vector<double> scores;
+      int unscored = 0;
       for (const EvaluationRow& r : rows) {
-        if (r.group == g && r.error.empty()) scores.push_back(r.health);
+        if (r.group != g || !r.error.empty()) continue;
+        if (scored(r)) scores.push_back(r.health);
+        else ++unscored;
       }
       std::sort(scores.begin(), scores.end());
-      const double median = scores.empty() ? 0.0 : scores[scores.size() / 2];
-      std::string line = g + ": median score " + Fmt(median, 3) + " over " + count(g) + " trajectories";
+      std::string line = scores.empty() ? g + ": no trajectory scored"
+                                        : g + ": median score " + Fmt(scores[scores.size() / 2], 3) + " over " +
+                                              std::to_string(scores.size()) + (scores.size() == 1 ? " trajectory" : " trajectories");
+      if (unscored > 0) line += " (" + std::to_string(unscored) + " of " + count(g) + " too short to score, left out)";
       const double group_aligned = a.Get("shape/group_aligned/sum"), run_aligned = a.Get("shape/run_aligned/sum");
       if (group_aligned > 0) line += "; shape aligned for the group (all its recordings together) in " + Fmt(group_aligned, 6);
       if (run_aligned > 0) line += "; shape aligned by the estimate itself in " + Fmt(run_aligned, 6);

@@ -196,8 +196,8 @@ void CheckPoint(const Vec2& p) {
   if (!std::isfinite(p.x()) || !std::isfinite(p.y()))
     throw GeometryError("query point is not finite: (" + std::to_string(p.x()) + ", " + std::to_string(p.y()) + ")");
   if (std::abs(p.x()) > kMaxQueryCoordinate || std::abs(p.y()) > kMaxQueryCoordinate) {
-    char text[160];
-    std::snprintf(text, sizeof text, "query point (%g, %g) is outside the supported range +-%g (docs/geometry.md, Limits)",
+    char text[200];
+    std::snprintf(text, sizeof text, "query point (%.17g, %.17g) is outside the supported range +-%g (docs/geometry.md, Limits)",
                   p.x(), p.y(), kMaxQueryCoordinate);
     throw GeometryError(text);
   }

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <sstream>
 
 namespace pushgraph::geometry {
@@ -63,7 +64,7 @@ void CleanRing(Ring* ring, int polygon, int ring_index) {
       Fail("coordinate is not finite", polygon, ring_index, static_cast<int>(i));
     if (std::abs((*ring)[i].x()) > kMaxCoordinate || std::abs((*ring)[i].y()) > kMaxCoordinate) {
       std::ostringstream text;
-      text << "coordinate (" << (*ring)[i].x() << ", " << (*ring)[i].y() << ") is outside the supported range +-"
+      text << std::setprecision(17) << "coordinate (" << (*ring)[i].x() << ", " << (*ring)[i].y() << ") is outside the supported range +-"
            << kMaxCoordinate << " (scale the shape: docs/geometry.md, Limits)";
       Fail(text.str(), polygon, ring_index, static_cast<int>(i));
     }

@@ -614,6 +614,25 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
   }
   if (rep.faces == 0) throw IoError(path + ": the mesh has no faces");
   if (projected.empty()) {
+    // No face spans an area in 3-D (Newell's normal of every face zero: collinear or repeated
+    // vertices): no up axis would read it, and --up must not be suggested.
+    bool any_area = false;
+    for (std::size_t f = 0; f < faces.size() && !any_area; ++f) {
+      double n[3] = {0.0, 0.0, 0.0};
+      const std::vector<int>& face = faces[f];
+      for (std::size_t k = 0; k < face.size(); ++k) {
+        const double* a = &coordinates[3 * static_cast<std::size_t>(face[k])];
+        const double* b = &coordinates[3 * static_cast<std::size_t>(face[(k + 1) % face.size()])];
+        n[0] += (a[1] - b[1]) * (a[2] + b[2]);
+        n[1] += (a[2] - b[2]) * (a[0] + b[0]);
+        n[2] += (a[0] - b[0]) * (a[1] + b[1]);
+      }
+      any_area = n[0] != 0.0 || n[1] != 0.0 || n[2] != 0.0;
+    }
+    if (!any_area) {
+      throw IoError(path + ": every face is degenerate (its vertices collinear or repeated: zero area in 3-D), so "
+                           "the mesh has no footprint along any up axis");
+    }
     const char* axis_names[3] = {"x", "y", "z"};
     const int up = options.up == UpAxis::kX ? 0 : options.up == UpAxis::kY ? 1 : 2;
     if (flat_axis >= 0 && flat_axis != up) {

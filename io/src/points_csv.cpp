@@ -9,7 +9,9 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <sstream>
+#include <stdexcept>
 #include <string_view>
 
 namespace pushgraph::io {
@@ -52,6 +54,8 @@ std::vector<double> ParseNumberList(const std::string& text, std::size_t count, 
     if (!ParseFast(item, &value)) {
       try {
         value = std::stod(item, &used);
+      } catch (const std::out_of_range&) {
+        throw IoError(what + ": '" + item + "' is outside the range of a double (about 1e-308 to 1e308)");
       } catch (const std::exception&) {
         used = 0;
       }
@@ -101,7 +105,7 @@ std::vector<geometry::Vec2> ParsePointsCsv(const std::string& text, const std::s
     // The queries' own limit, checked here where the line is known.
     if (std::abs(v[0]) > geometry::kMaxQueryCoordinate || std::abs(v[1]) > geometry::kMaxQueryCoordinate) {
       std::ostringstream text;
-      text << where << ": point (" << v[0] << ", " << v[1] << ") is outside the supported range +-"
+      text << std::setprecision(17) << where << ": point (" << v[0] << ", " << v[1] << ") is outside the supported range +-"
            << geometry::kMaxQueryCoordinate << " (docs/geometry.md, Limits)";
       throw IoError(text.str());
     }

@@ -42,18 +42,24 @@ Ellipsoid PaperEllipsoid(const Summary& summary) {
   return e;
 }
 
+// Both maps depend on their argument's direction only; it is divided by its largest component
+// first, so that no square overflows or underflows (a twist of 1e154 gave a zero load, one of
+// 1e-160 lost five digits).
 Load EllipsoidLoad(const Ellipsoid& ellipsoid, const Twist& twist) {
-  const Eigen::Vector3d xi(twist.vx, twist.vy, twist.omega);
-  if (!xi.allFinite() || xi.norm() == 0.0) throw LimitSurfaceError("EllipsoidLoad: the twist must be finite and non-zero");
+  const Eigen::Vector3d raw(twist.vx, twist.vy, twist.omega);
+  const double largest = raw.cwiseAbs().maxCoeff();
+  if (!raw.allFinite() || largest == 0.0) throw LimitSurfaceError("EllipsoidLoad: the twist must be finite and non-zero");
+  const Eigen::Vector3d xi = raw / largest;
   const Eigen::Vector3d direction = ellipsoid.A.ldlt().solve(xi);
   const Eigen::Vector3d F = direction / std::sqrt(xi.dot(direction));
   return {F.head<2>(), F.z()};
 }
 
 Twist EllipsoidTwist(const Ellipsoid& ellipsoid, const Load& load) {
-  const Eigen::Vector3d F = AsVector(load);
-  if (!F.allFinite() || F.norm() == 0.0) throw LimitSurfaceError("EllipsoidTwist: the load must be finite and non-zero");
-  const Eigen::Vector3d xi = (ellipsoid.A * F).normalized();
+  const Eigen::Vector3d raw = AsVector(load);
+  const double largest = raw.cwiseAbs().maxCoeff();
+  if (!raw.allFinite() || largest == 0.0) throw LimitSurfaceError("EllipsoidTwist: the load must be finite and non-zero");
+  const Eigen::Vector3d xi = (ellipsoid.A * (raw / largest)).stableNormalized();
   return {xi.x(), xi.y(), xi.z()};
 }
 

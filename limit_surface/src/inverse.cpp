@@ -37,8 +37,13 @@ InverseResult TwistForLoad(const Support& support, const Load& load) {
     throw LimitSurfaceError("TwistForLoad: the load must be finite");
   const double c = Summarize(support).c;
   const ScaledProblem problem(support, c);
-  const Eigen::Vector3d target = problem.ToScaled(load);
-  if (target.norm() == 0.0) throw LimitSurfaceError("TwistForLoad: the load is zero");
+  const Eigen::Vector3d raw_target = problem.ToScaled(load);
+  // Only the load's direction matters: divided by its largest component first (a load of 1e155
+  // overflowed its norm and came back "twist is zero"; one of 1e-300 underflowed to "zero").
+  const double largest = raw_target.cwiseAbs().maxCoeff();
+  if (!(largest > 0.0)) throw LimitSurfaceError("TwistForLoad: the load is zero");
+  if (!std::isfinite(largest)) throw LimitSurfaceError("TwistForLoad: the load is too large (its torque / c overflows)");
+  const Eigen::Vector3d target = raw_target / largest;
   const Eigen::Vector3d f = target.normalized();
   // Orthonormal basis B of the plane orthogonal to f.
   Eigen::Matrix<double, 3, 2> B;
@@ -82,7 +87,7 @@ InverseResult TwistForLoad(const Support& support, const Load& load) {
   const Eigen::Vector3d unit = xi.normalized();
   result.twist = problem.ToTwist(unit);
   result.surface_load = SustainingLoad(support, result.twist);
-  result.load_ratio = target.norm() / problem.ToScaled(result.surface_load).norm();
+  result.load_ratio = largest * (target.norm() / problem.ToScaled(result.surface_load).norm());
   return result;
 }
 

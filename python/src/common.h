@@ -13,6 +13,35 @@
 #include <string>
 #include <vector>
 
+// Every float argument of the module (a radius, a mass, mu, a resolution) refuses booleans:
+// pybind11's own caster takes True as 1.0 (`Shape.disk(True)` was a disk of radius 1 m, and
+// `LimitSurface(box, 1.0, True)` used mu = 1, without a word). Otherwise as pybind11's: floats,
+// ints and objects with __float__ or __index__. Declared before any binding file converts a
+// double (every one includes this header first).
+namespace pybind11::detail {
+template <>
+struct type_caster<double> {
+  PYBIND11_TYPE_CASTER(double, const_name("float"));
+  bool load(handle src, bool convert) {
+    if (!src || PyBool_Check(src.ptr())) return false;
+    if (PyFloat_Check(src.ptr())) {
+      value = PyFloat_AsDouble(src.ptr());
+      return true;
+    }
+    if (!convert) return false;
+    if (!PyLong_Check(src.ptr()) && std::string(str(type::handle_of(src).attr("__name__"))) == "bool_") return false;  // numpy.bool_
+    const double d = PyFloat_AsDouble(src.ptr());
+    if (d == -1.0 && PyErr_Occurred()) {
+      PyErr_Clear();
+      return false;
+    }
+    value = d;
+    return true;
+  }
+  static handle cast(double src, return_value_policy /*policy*/, handle /*parent*/) { return PyFloat_FromDouble(src); }
+};
+}  // namespace pybind11::detail
+
 namespace pushgraph::python {
 
 namespace py = pybind11;

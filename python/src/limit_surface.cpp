@@ -55,7 +55,7 @@ of the centre of pressure.
     ls = pushgraph.LimitSurface(pushgraph.Shape.box(0.09, 0.09), mass=0.8, mu=0.3)
     ls.summary["c"]                        # tau_max / f_max (m)
     loads = ls.sustaining_load(twists)     # (N, 3) -> (N, 3), exact
-    twists = ls.twist_for_load(loads)      # (N, 3) unit twists in (vx, vy, c omega)
+    twists = ls.twist_for_load(loads)      # (N, 3) twists (vx, vy, omega), |(vx, vy, c omega)| = 1
 )doc")
       .def(py::init([](const geometry::Shape& shape, double mass, double mu, double gravity, const py::object& points) {
              SupportSpec spec;
@@ -114,7 +114,9 @@ of the centre of pressure.
               out[2] = r.twist.omega;
             });
           },
-          "loads"_a, "The exact surface's twist direction for each load: unit length in (vx, vy, c omega).")
+          "loads"_a,
+          "The exact surface's twist direction for each load (N, 3) -> (N, 3): (vx, vy, omega), scaled so\n"
+          "that (vx, vy, c * omega) has unit length (c = summary['c']). Only the load's direction matters.")
       .def_property_readonly("ellipsoid",
                              [](const PyLimitSurface& ls) {
                                py::array_t<double> a = NewArray({3, 3});
@@ -133,7 +135,7 @@ of the centre of pressure.
               out[2] = l.torque;
             });
           },
-          "twists"_a)
+          "twists"_a, "The paper's ellipsoidal surface (Eq. 3) at each twist's normal: (N, 3) -> (N, 3) loads.")
       .def(
           "ellipsoid_twist",
           [](const PyLimitSurface& ls, const py::handle& loads) {
@@ -144,7 +146,9 @@ of the centre of pressure.
               out[2] = t.omega;
             });
           },
-          "loads"_a)
+          "loads"_a,
+          "The ellipsoid's twist direction for each load (Eq. 4, the surface normal): (N, 3) -> (N, 3)\n"
+          "twists (vx, vy, omega) of unit length. Only the load's direction matters.")
       .def(
           "ellipsoid_error",
           [](const PyLimitSurface& ls, int samples, std::uint64_t seed) {

@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -305,6 +307,47 @@ TEST_F(Evaluation, TablesFromSimulatedPushesAndShardsMergeBitIdentically) {
   std::ofstream(appended, std::ios::app) << "{\"index\": 2, \"na";
   EXPECT_EQ(ReadRows(appended, &header, /*cut_last_line_ok=*/true).size(), 1u);
   EXPECT_THROW(ReadRows(appended, &header), EvaluationError);
+}
+
+// A push too short for any judged factor type to reach 20 degrees of freedom has no score: "n/a",
+// after the scored rows, left out of the group's median (it ranked as the healthiest, score 0,
+// and pulled the median to 0).
+TEST_F(Evaluation, APushTooShortToScoreIsNotRankedOrCounted) {
+  EvaluationOptions o;
+  o.protocols = ParseProtocols("fig5");
+  std::vector<EvaluationRow> rows(4);
+  const char* names[] = {"short", "good", "bad", "short2"};
+  const double health[] = {0.0, 1.2, 3.0, 0.0};
+  const char* worst[] = {"", "object_pose", "force", ""};
+  for (int i = 0; i < 4; ++i) {
+    rows[i].index = i;
+    rows[i].name = names[i];
+    rows[i].group = "g";
+    rows[i].steps = 10;
+    rows[i].health = health[i];
+    rows[i].worst_factor = worst[i];
+  }
+  const std::vector<Table> tables = MakeTables(rows, o.SettingsJson());
+  const auto it = std::find_if(tables.begin(), tables.end(), [](const Table& t) { return t.id == "diagnostics"; });
+  ASSERT_NE(it, tables.end());
+  ASSERT_EQ(it->rows.size(), 4u);
+  EXPECT_EQ(it->rows[0][1], "bad");
+  EXPECT_EQ(it->rows[1][1], "good");
+  for (int k : {2, 3}) {
+    EXPECT_EQ(it->rows[k][2], "n/a");
+    EXPECT_EQ(it->rows[k][4].rfind("not scored: too few samples", 0), 0u) << it->rows[k][4];
+  }
+  bool median_said = false;
+  for (const std::string& n : it->notes) {
+    median_said |= n.rfind("g: median score 3 over 2 trajectories (2 of 4 too short to score, left out)", 0) == 0;
+  }
+  EXPECT_TRUE(median_said) << TableMarkdown(*it);
+  rows.erase(rows.begin() + 1, rows.begin() + 3);  // none scored
+  const std::vector<Table> none = MakeTables(rows, o.SettingsJson());
+  const auto d = std::find_if(none.begin(), none.end(), [](const Table& t) { return t.id == "diagnostics"; });
+  ASSERT_NE(d, none.end());
+  EXPECT_NE(TableMarkdown(*d).find("g: no trajectory scored (2 of 2 too short to score, left out)"), std::string::npos)
+      << TableMarkdown(*d);
 }
 
 TEST_F(Evaluation, RealMitRecordingWithFrozenForceHasNoForceRows) {

@@ -435,6 +435,14 @@ TEST_F(Footprint, ClearErrors) {
   io::FootprintOptions up_y;
   up_y.up = io::UpAxis::kY;
   expect_error(Write("flat.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"), up_y, "zero area");
+  // Collinear faces have no footprint along any axis: said so, not "--up y reads it" (which
+  // then failed too).
+  for (const io::UpAxis up : {io::UpAxis::kX, io::UpAxis::kY, io::UpAxis::kZ}) {
+    io::FootprintOptions o;
+    o.up = up;
+    expect_error(Write("line.obj", "v 0 0 0\nv 0.1 0 0\nv 0.2 0 0\nf 1 2 3\n"), o,
+                 "every face is degenerate (its vertices collinear or repeated: zero area in 3-D)");
+  }
   expect_error(Write("badidx.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"), {}, "");
   io::FootprintOptions bad_scale;
   bad_scale.scale = -1;

@@ -93,6 +93,8 @@ TEST_F(LimitSurfaceCli, BadInputIsAOneLineError) {
   const std::string rounded = Write("rounded.json", R"({"polygons": [{"outer": [[0,0],[1,0],[1,1]]}], "radius": 0.1})");
   ExpectOneLineError(rounded + " --mass 1 --mu 0.3", "rounded");
   EXPECT_NE(Exec(square_ + " --mu 0.3").status, 0);  // --mass is required
+  // --samples is read by --ellipsoid alone (it was ignored without it).
+  ExpectOneLineError(square_ + " --mass 1 --mu 0.3 --samples 10", "--ellipsoid");
 }
 
 // An OBJ mesh is read as its footprint (it was a raw JSON parse error), and a shape in other

@@ -97,6 +97,36 @@ TEST(LimitSurfaceEllipsoid, PaperEquationsThreeAndFour) {
   EXPECT_LT(TwistAngle(EllipsoidTwist(e, load), twist, 1.0), 1e-14);
 }
 
+// Only a twist's or a load's direction matters: the same answer from 1e-300 to 1e300 (the
+// ellipsoid maps gave zero loads and twists from about 1e154 on and lost five digits at 1e-160;
+// the inverse called a load of 1e155 "twist is zero" and one of 1e-300 "the load is zero").
+TEST(LimitSurfaceInverse, OnlyTheDirectionMattersAtAnyMagnitude) {
+  const Support s = UniformSupport(Shape::Box(0.1, 0.1), 1.0, 0.3);
+  const Ellipsoid e = PaperEllipsoid(Summarize(s));
+  const Twist twist{1.0, -0.3, 2.0};
+  const Load at_one = EllipsoidLoad(e, twist);
+  const Load load{Vec2(0.7, -0.2), 0.004};
+  const Twist twist_at_one = EllipsoidTwist(e, load);
+  const InverseResult inverse_at_one = TwistForLoad(s, load);
+  for (double scale : {1e-300, 1e-200, 1e-160, 1e-20, 1e20, 1e154, 1e200, 1e300}) {
+    SCOPED_TRACE(scale);
+    const Load l = EllipsoidLoad(e, {scale * twist.vx, scale * twist.vy, scale * twist.omega});
+    EXPECT_NEAR(l.force.x(), at_one.force.x(), 1e-15 * std::abs(at_one.force.x()));
+    EXPECT_NEAR(l.force.y(), at_one.force.y(), 1e-15 * std::abs(at_one.force.y()));
+    EXPECT_NEAR(l.torque, at_one.torque, 1e-15 * std::abs(at_one.torque));
+    const Twist t = EllipsoidTwist(e, {scale * load.force, scale * load.torque});
+    EXPECT_NEAR(t.vx, twist_at_one.vx, 1e-15);
+    EXPECT_NEAR(t.vy, twist_at_one.vy, 1e-15);
+    EXPECT_NEAR(t.omega, twist_at_one.omega, 1e-15);
+    const InverseResult r = TwistForLoad(s, {scale * load.force, scale * load.torque});
+    EXPECT_TRUE(r.converged);
+    EXPECT_LT(TwistAngle(r.twist, inverse_at_one.twist, Summarize(s).c), 1e-9);
+    EXPECT_NEAR(r.load_ratio / inverse_at_one.load_ratio, scale, 1e-9 * scale);
+  }
+  EXPECT_THROW(EllipsoidLoad(e, {0.0, 0.0, 0.0}), LimitSurfaceError);
+  EXPECT_THROW(EllipsoidTwist(e, {Vec2(INFINITY, 0.0), 0.0}), LimitSurfaceError);
+}
+
 TEST(LimitSurfaceEllipsoid, ErrorMatchesTheNote) {
   // Note: ~5 degrees mean (max 9 to 10) for a disk or square, ~7 (max 21) for a 5:1 rectangle;
   // the exact surface lies at 0.875 to 1.03 of the ellipsoid's radius.

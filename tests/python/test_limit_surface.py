@@ -48,3 +48,32 @@ def test_ellipsoid_and_bad_input():
         pg.LimitSurface(pg.Shape.disk(0.05), -1.0, 0.5)
     points = pg.LimitSurface(pg.Shape.box(0.1, 0.1), 1.0, 0.5, points=[[0.05, 0, 1.0], [-0.05, 0, 1.0]])
     assert points.summary["c"] == pytest.approx(0.05, rel=1e-12)
+
+
+def test_twist_for_load_columns_and_any_magnitude():
+    # twist_for_load returns (vx, vy, omega) with |(vx, vy, c omega)| = 1 (docs/python.md); only a
+    # direction matters, so loads and twists of 1e-300 to 1e300 give the same answers (the
+    # ellipsoid maps returned zeros from about 1e154 on; the inverse called 1e155 "twist is zero").
+    ls = pg.LimitSurface(pg.Shape.box(0.1, 0.1), 1.0, 0.3)
+    c = ls.summary["c"]
+    back = ls.twist_for_load([[1.0, 1.0, 1.0]])[0]
+    assert math.hypot(back[0], back[1], c * back[2]) == pytest.approx(1.0, abs=1e-14)
+    twist = np.array([1.0, 0.0, 1.0])
+    load = np.array([0.7, -0.2, 0.004])
+    at_one = (ls.ellipsoid_load([twist])[0], ls.ellipsoid_twist([load])[0], ls.twist_for_load([load])[0])
+    for scale in (1e-300, 1e-160, 1e154, 1e300):
+        np.testing.assert_allclose(ls.ellipsoid_load([scale * twist])[0], at_one[0], rtol=1e-15)
+        np.testing.assert_allclose(ls.ellipsoid_twist([scale * load])[0], at_one[1], atol=1e-15)
+        np.testing.assert_allclose(ls.twist_for_load([scale * load])[0], at_one[2], atol=1e-9)
+
+
+def test_booleans_are_not_numbers():
+    # A float argument given True was read as 1.0 (a 1 m disk, mu = 1) without a word.
+    box = pg.Shape.box(0.1, 0.1)
+    for call in (lambda: pg.Shape.disk(True), lambda: pg.LimitSurface(box, 1.0, True),
+                 lambda: pg.LimitSurface(box, np.bool_(True), 0.3), lambda: pg.Shape.box(True, 1.0)):
+        with pytest.raises(TypeError):
+            call()
+    # Ints and NumPy scalars still convert.
+    assert pg.LimitSurface(box, 1, np.float32(0.5)).summary["f_max"] == pytest.approx(0.5 * 9.80665, rel=1e-7)
+    assert pg.Shape.disk(np.int64(2)).radius == 2.0

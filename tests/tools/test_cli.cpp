@@ -76,6 +76,12 @@ TEST_F(CliTest, DistanceBadInputNamesFileAndLine) {
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.err.find("far.csv:4"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("outside the supported range"), std::string::npos) << r.err;
+  // The value as read, not rounded to 6 digits (1.0000001e12 was printed "1e+12", in range).
+  r = Exec("distance " + shape + " " + Write("edge.csv", "x,y\n1.0000001e12,0\n"));
+  EXPECT_NE(r.err.find("point (1000000100000, 0) is outside the supported range"), std::string::npos) << r.err;
+  // Beyond a double's range is not "not a number".
+  r = Exec("distance " + shape + " " + Write("huge.csv", "x,y\n1e400,0\n"));
+  EXPECT_NE(r.err.find("huge.csv:2: point: '1e400' is outside the range of a double"), std::string::npos) << r.err;
 
   // Spaces around a number and a spreadsheet's UTF-8 byte order mark are layout: the same rows
   // as a plain file ("0.01 ,0.02" was refused while " 0.01,0.02" was read; a BOM failed the
@@ -285,6 +291,11 @@ TEST_F(CliTest, OutputsThatAreInputsAreRefusedAndInputsKept) {
   EXPECT_NE(degrees.err.find("THETA 90 is taken as radians"), std::string::npos) << degrees.err;
   EXPECT_NE(degrees.err.find("for degrees give 1.5707963267948966"), std::string::npos) << degrees.err;
   EXPECT_EQ(Exec("footprint " + shape + " --transform 0,0,1.5 -o " + (dir_ / "t2.json").string() + " -q").err, "");
+  // The mesh options on a shape JSON are said to be ignored (they were, without a word).
+  const ToolRun up = Exec("footprint " + shape + " --up y -o " + (dir_ / "up.json").string() + " -q");
+  EXPECT_EQ(up.status, 0) << up.err;
+  EXPECT_NE(up.err.find("--up reads meshes; " + shape + " is a shape JSON (a footprint already): ignored"), std::string::npos)
+      << up.err;
   EXPECT_EQ(Exec("footprint " + shape + " --transform 0,0,6.2832 -o " + (dir_ / "t3.json").string() + " -q").err, "");
   const ToolRun millimetres = Exec("footprint " + shape + " --transform 20,0,0 -o " + (dir_ / "t4.json").string() + " -q");
   EXPECT_NE(millimetres.err.find("taken as metres"), std::string::npos) << millimetres.err;

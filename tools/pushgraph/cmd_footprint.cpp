@@ -25,8 +25,8 @@ void RegisterFootprint(CLI::App& app) {
   };
   auto args = std::make_shared<Args>();
   cmd->add_option("MESH", args->mesh, "Mesh file (Wavefront OBJ, STL, PLY or OFF), or a shape JSON to transform")->required();
-  cmd->add_option("--up", args->up, "Axis to project along: x, y or z")->capture_default_str();
-  cmd->add_option("--object", args->object, "Only this object/group of the file (default: all together)");
+  CLI::Option* up = cmd->add_option("--up", args->up, "Axis to project along: x, y or z")->capture_default_str();
+  CLI::Option* object = cmd->add_option("--object", args->object, "Only this object/group of the file (default: all together)");
   cmd->add_option("--scale", args->scale, "Multiply coordinates, e.g. 0.001 for millimetres")
       ->check(FiniteNumber(0.0, false, "> 0"))
       ->capture_default_str();
@@ -35,7 +35,7 @@ void RegisterFootprint(CLI::App& app) {
                   "Then place the shape at the pose X,Y,THETA (m, m, rad), e.g. the shape_transform of RESULT.json");
   cmd->add_option("-o,--output", args->output, "Write the shape JSON here (default: stdout)");
   cmd->add_flag("-q,--quiet", args->quiet, "Do not print the summary on stderr");
-  cmd->callback([args] {
+  cmd->callback([args, up, object] {
     CheckOutputsAreNew({{"MESH", args->mesh}}, {{"-o", args->output}});
     io::FootprintOptions options;
     options.up = io::ParseUpAxis(args->up);
@@ -45,6 +45,14 @@ void RegisterFootprint(CLI::App& app) {
     const bool json = std::filesystem::path(args->mesh).extension() == ".json";
     geometry::Shape shape;
     if (json) {
+      // A shape JSON is a footprint already: the mesh reading's options do not apply (they were
+      // ignored without a word).
+      for (const CLI::Option* given : {up, object}) {
+        if (given->count() > 0) {
+          std::cerr << "footprint: warning: " << given->get_name() << " reads meshes; " << args->mesh
+                    << " is a shape JSON (a footprint already): ignored\n";
+        }
+      }
       shape = geometry::TransformShape(geometry::LoadShapeJson(args->mesh), geometry::Pose2{}, args->scale);
     } else {
       shape = io::MeshFootprint(args->mesh, options, &report);

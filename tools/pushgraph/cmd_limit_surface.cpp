@@ -85,9 +85,10 @@ void RegisterLimitSurface(CLI::App& app) {
                   "Body twist VX,VY,W of the centroid (m/s, m/s, rad/s), shape axes; repeatable")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
-  cmd->add_flag("--ellipsoid", options->ellipsoid,
-                "Also report the direction error of the paper's ellipsoid and of a fitted one");
-  cmd->add_option("--samples", options->samples, "Random twists for --ellipsoid (default 4000)");
+  CLI::Option* ellipsoid = cmd->add_flag("--ellipsoid", options->ellipsoid,
+                                         "Also report the direction error of the paper's ellipsoid and of a fitted one");
+  // Refused without --ellipsoid, which alone reads it (it was ignored without a word).
+  cmd->add_option("--samples", options->samples, "Random twists for --ellipsoid (default 4000)")->needs(ellipsoid);
   cmd->footer(
       "Prints one JSON object: area, centroid, normal_force (m g), f_max (mu m g), tau_max, c = tau_max/f_max,\n"
       "twists: [{twist: [vx, vy, w], force: [fx, fy], torque}], the load that must be applied to keep the\n"

@@ -15,7 +15,7 @@
 namespace pushgraph::limit_surface {
 
 struct InverseResult {
-  Twist twist;                 ///< unit length in (vx, vy, c omega)
+  Twist twist;                 ///< (vx, vy, omega) with |(vx, vy, c omega)| = 1
   Load surface_load;           ///< SustainingLoad(twist): on the surface, parallel to the query
   double load_ratio = 0.0;     ///< |query| / |surface_load| (scaled metric)
   double angle_residual = 0.0; ///< radians between surface_load and the query (scaled metric)
