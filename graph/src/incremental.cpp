@@ -618,16 +618,25 @@ struct FixedLagSmoother {
 
 // Replay: the update times come from the recorded object stream.
 struct IncrementalEstimator::Impl {
-  // The trajectory with its tessellated fingers as disks, as Estimate reads it (nullopt: none).
-  std::string finger_disks;
-  std::optional<push::Trajectory> disk_fingers;
+  // The trajectory as Estimate reads it, its tessellated fingers as disks and a contact stream
+  // off its finger left out (nullopt: neither applies), and what was said of each.
+  std::string finger_disks, contact_note;
+  std::optional<push::Trajectory> prepared;
   FixedLagSmoother smoother;
   std::vector<double> triggers;
   std::size_t next_trigger = 0;
 
+  static std::optional<push::Trajectory> Prepare(const push::Trajectory& traj, const EstimatorConfig& cfg,
+                                                 std::string* disks_note, std::string* contacts_note) {
+    std::optional<push::Trajectory> disks = internal::TessellatedFingersAsDisks(traj, cfg, disks_note);
+    std::optional<push::Trajectory> without_contacts =
+        internal::DropContactStreamsOffTheFinger(disks ? *disks : traj, cfg.measurement, contacts_note);
+    return without_contacts ? std::move(without_contacts) : std::move(disks);
+  }
+
   Impl(const push::Trajectory& traj, Model model, const EstimatorConfig& cfg)
-      : disk_fingers(internal::TessellatedFingersAsDisks(traj, cfg, &finger_disks)),
-        smoother(disk_fingers ? *disk_fingers : traj, model, cfg, nullptr) {
+      : prepared(Prepare(traj, cfg, &finger_disks, &contact_note)),
+        smoother(prepared ? *prepared : traj, model, cfg, nullptr) {
     const auto& obj = traj.measured.object_pose;
     const auto& steps = smoother.builder.steps();
     double period = MedianObjectPeriod(obj);
@@ -678,7 +687,8 @@ int IncrementalEstimator::TotalSteps() const { return static_cast<int>(impl_->sm
 EstimationResult IncrementalEstimator::Finish() {
   if (!Done()) throw GraphError("IncrementalEstimator::Finish called before the last update");
   EstimationResult r = impl_->smoother.Finish();
-  if (impl_->disk_fingers) r.warnings.insert(r.warnings.begin(), impl_->finger_disks);
+  if (!impl_->contact_note.empty()) r.warnings.insert(r.warnings.begin(), impl_->contact_note);
+  if (!impl_->finger_disks.empty()) r.warnings.insert(r.warnings.begin(), impl_->finger_disks);
   return r;
 }
 
@@ -714,6 +724,54 @@ struct OnlineEstimator::Impl {
   // (another tracker's frame) gave an object 1.87 m off, and no word (helper-27 N0b).
   std::vector<bool> reach_checked;        // per finger
   std::vector<std::size_t> touch_scanned;  // per finger: force samples looked at
+
+  // The batch's check that the contact points lie on their finger (Estimate's
+  // DropContactStreamsOffTheFinger), once kContactCheckSamples contacts have come: a stream off
+  // it (another frame, an offset) is left out from then on and the steps so far solved again
+  // without it, before the shape check reads the contacts. Online it was used as given: a
+  // tactile stream 5 cm off moved the object estimate with it, and the shape check blamed the
+  // shape.
+  static constexpr std::size_t kContactCheckSamples = 10;
+
+  // A new smoother on traj as it now is: the next update solves every step so far. The updates
+  // so far stay in the result's count and update_times_s.
+  void RestartSmoother() {
+    auto fresh = std::make_unique<FixedLagSmoother>(traj, model, smoother->cfg, &streams);
+    fresh->stats.updates = smoother->stats.updates;
+    fresh->stats.update_times_s = smoother->stats.update_times_s;
+    fresh->stats.max_update_time_s = smoother->stats.max_update_time_s;
+    fresh->total_update_time = smoother->total_update_time;
+    smoother = std::move(fresh);
+  }
+  bool contacts_judged = false;
+  bool contacts_left_out = false;
+
+  void CheckContacts(double until) {
+    if (contacts_judged || !streams.contact_point) return;
+    std::size_t samples = traj.measured.contact_point.size();
+    for (const push::ExtraFinger& f : traj.extra_fingers) samples = std::max(samples, f.measured.contact_point.size());
+    if (samples < kContactCheckSamples) return;
+    contacts_judged = true;
+    std::string note;
+    std::optional<push::Trajectory> without = internal::DropContactStreamsOffTheFinger(traj, smoother->cfg.measurement, &note);
+    if (!without) return;
+    std::string text = internal::Format("contact check (OnlineEstimator, on the samples up to %.3f s into the data, t = %s s): ",
+                                        until - first_t, Precise(until).c_str());
+    bool every_stream = without->measured.contact_point.empty();
+    for (const push::ExtraFinger& f : without->extra_fingers) every_stream = every_stream && f.measured.contact_point.empty();
+    if (!every_stream) {
+      // One OnlineStreams flag gates every finger's contacts: a stream cannot be left out alone.
+      warnings.push_back(text + note + "; OnlineEstimator uses it as given (the other fingers' contact streams are kept, "
+                                       "and their gating is shared): estimate the recording with `pushgraph estimate`");
+      return;
+    }
+    traj.measured.contact_point.clear();
+    for (push::ExtraFinger& f : traj.extra_fingers) f.measured.contact_point.clear();
+    streams.contact_point = false;
+    contacts_left_out = true;
+    RestartSmoother();
+    warnings.push_back(text + note + "; from this update on, every step so far solved again without it");
+  }
 
   void CheckTouchingFingersAreNear() {
     const EstimatorConfig& cfg = smoother->cfg;
@@ -839,13 +897,7 @@ struct OnlineEstimator::Impl {
             ". Read so from this update on: every step so far is solved again at that scale (align_shape \"off\" "
             "keeps the shape as given); the setup's shape scaled by %g saves this", scale);
         traj.object.shape = geometry::TransformShape(traj.object.shape, geometry::Pose2{}, scale, false);
-        // The updates so far stay in the result's count and update_times_s.
-        auto fresh = std::make_unique<FixedLagSmoother>(traj, model, smoother->cfg, &streams);
-        fresh->stats.updates = smoother->stats.updates;
-        fresh->stats.update_times_s = smoother->stats.update_times_s;
-        fresh->stats.max_update_time_s = smoother->stats.max_update_time_s;
-        fresh->total_update_time = smoother->total_update_time;
-        smoother = std::move(fresh);
+        RestartSmoother();
         alignment.aligned = alignment.units_only = alignment.suggested = true;
         alignment.transform = ShapeTransform{};
         alignment.transform.scale = scale;
@@ -1079,6 +1131,7 @@ bool OnlineEstimator::AddContactPoint(double t, int finger, const geometry::Vec2
   Impl& m = *impl_;
   const int stream = m.FingerStream(finger, 1, "AddContactPoint");
   if (!m.Accept(stream, "contact_point", t, point.allFinite())) return false;
+  if (m.contacts_left_out) return false;  // the contact check left the stream out
   (finger == 0 ? m.traj.measured.contact_point : m.traj.extra_fingers[finger - 1].measured.contact_point).push_back({t, point});
   return true;
 }
@@ -1165,8 +1218,10 @@ double OnlineEstimator::Update(double until) {
   // step can be closer than that to a solved one.
   m.last_update_t = until;  // later samples must come more than 1e-9 s after it (Accept)
   until += 1e-9;
-  // The shape check first: it may start the smoother again with the shape in its units.
+  // The contact and shape checks first: either may start the smoother again (without the
+  // contact stream, with the shape in its units).
   const auto start = std::chrono::steady_clock::now();
+  m.CheckContacts(until);
   m.CheckShape(until, false);
   const double checked = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   m.smoother->builder.AppendSteps(until);

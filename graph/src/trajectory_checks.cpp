@@ -1402,6 +1402,21 @@ void CheckStreamTimeUnits(const push::Trajectory& traj) {
                               static_cast<std::size_t>(inside), s.size()));
   };
   ForEachFingerStream(traj, check);
+  // The object's stream in another unit than the finger's (an object tracker in milliseconds
+  // beside the rest in seconds ran over 1080 s, 23 mm off, with a hint about the finger stream).
+  const auto& finger = traj.measured.finger_pose;
+  if (finger.size() < 2) return;
+  const double f0 = finger.front().t, f1 = finger.back().t;
+  if (!(f1 > f0)) return;
+  const auto inside = std::count_if(object.begin(), object.end(), [&](const push::PoseSample& a) { return a.t >= f0 && a.t <= f1; });
+  // At most one row (or a tenth) inside: a short push has few camera frames, and a time stamp
+  // of 0 stays 0 in any unit.
+  if (span >= 100.0 * (f1 - f0) && object.size() >= 3 &&
+      static_cast<std::size_t>(inside) <= std::max<std::size_t>(1, object.size() / 10))
+    throw GraphError(Format("trajectory: streams.object_pose runs from %.6g to %.6g s, %.0f times as long as "
+                            "streams.finger_pose (%.6g to %.6g s), and only %zu of its %zu rows fall within the finger's "
+                            "time: are its time stamps in another unit (milliseconds?) than the finger's?",
+                            t0, t1, span / (f1 - f0), f0, f1, static_cast<std::size_t>(inside), object.size()));
 }
 
 std::optional<std::string> StreamCoverageNote(const push::Trajectory& traj) {

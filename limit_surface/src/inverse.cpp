@@ -38,12 +38,14 @@ InverseResult TwistForLoad(const Support& support, const Load& load) {
   const double c = Summarize(support).c;
   const ScaledProblem problem(support, c);
   const Eigen::Vector3d raw_target = problem.ToScaled(load);
-  // Only the load's direction matters: divided by its largest component first (a load of 1e155
-  // overflowed its norm and came back "twist is zero"; one of 1e-300 underflowed to "zero").
+  // Only the load's direction matters: one whose squares would leave the double range is divided
+  // by its largest component first (a load of 1e155 overflowed its norm and came back "twist is
+  // zero"; one of 1e-300 underflowed to "zero"). Others are used as given, bit for bit.
   const double largest = raw_target.cwiseAbs().maxCoeff();
   if (!(largest > 0.0)) throw LimitSurfaceError("TwistForLoad: the load is zero");
   if (!std::isfinite(largest)) throw LimitSurfaceError("TwistForLoad: the load is too large (its torque / c overflows)");
-  const Eigen::Vector3d target = raw_target / largest;
+  const double scale = largest > 1e100 || largest < 1e-100 ? largest : 1.0;
+  const Eigen::Vector3d target = raw_target / scale;
   const Eigen::Vector3d f = target.normalized();
   // Orthonormal basis B of the plane orthogonal to f.
   Eigen::Matrix<double, 3, 2> B;
@@ -87,7 +89,7 @@ InverseResult TwistForLoad(const Support& support, const Load& load) {
   const Eigen::Vector3d unit = xi.normalized();
   result.twist = problem.ToTwist(unit);
   result.surface_load = SustainingLoad(support, result.twist);
-  result.load_ratio = largest * (target.norm() / problem.ToScaled(result.surface_load).norm());
+  result.load_ratio = scale * (target.norm() / problem.ToScaled(result.surface_load).norm());
   return result;
 }
 

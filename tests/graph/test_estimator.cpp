@@ -279,6 +279,12 @@ TEST(Estimator, GroundTruthOverPartOfThePushIsSaid) {
   EXPECT_TRUE(HasWarning(r, "metrics: ground_truth.object_pose (" + std::to_string(truth.size()) + " samples, t = "))
       << ::testing::PrintToString(r.warnings);
   EXPECT_TRUE(HasWarning(r, "the metrics score those steps only")) << ::testing::PrintToString(r.warnings);
+  // Ground truth without the object's stream: its metrics are absent, and said so.
+  push::Trajectory no_object = t;
+  no_object.ground_truth->object_pose.clear();
+  const EstimationResult n = Estimate(no_object, Model::kCp, Mode::kBatch, config);
+  EXPECT_EQ(n.metrics.count("object_position_rms"), 0u);
+  EXPECT_TRUE(HasWarning(n, "metrics: the input's ground_truth has no object_pose")) << ::testing::PrintToString(n.warnings);
 }
 
 // A contact sensor in another frame or with an offset (every point 5 cm off the finger): its
@@ -306,6 +312,17 @@ TEST(Estimator, AContactStreamOffTheFingerIsLeftOutAndSaid) {
     for (std::size_t i = 0; i < r.states.size(); ++i)
       EXPECT_LT((r.states[i].object_pose.translation() - without.states[i].object_pose.translation()).norm(), 1e-9) << i;
   }
+  // IncrementalEstimator used directly leaves it out too, and says so (it used it as given).
+  IncrementalEstimator direct(off, Model::kQs, config);
+  while (!direct.Done()) direct.Update();
+  const EstimationResult replay = direct.Finish();
+  EXPECT_TRUE(HasWarning(replay, "streams.contact_point: its")) << ::testing::PrintToString(replay.warnings);
+  IncrementalEstimator direct_none(none, Model::kQs, config);
+  while (!direct_none.Done()) direct_none.Update();
+  const EstimationResult replay_none = direct_none.Finish();
+  ASSERT_EQ(replay.states.size(), replay_none.states.size());
+  for (std::size_t i = 0; i < replay.states.size(); ++i)
+    EXPECT_LT((replay.states[i].object_pose.translation() - replay_none.states[i].object_pose.translation()).norm(), 1e-9) << i;
   // Within the noise's reach (3 times the two sigmas combined, 21 mm here) a stream is used as it is.
   push::Trajectory near = t;
   for (push::PointSample& c : near.measured.contact_point) c.point += geometry::Vec2(0.012, 0.0);
@@ -924,6 +941,11 @@ TEST(Estimator, BadTrajectoriesGetClearErrors) {
   for (auto& f : force_ms.measured.force) f.t *= 1000.0;
   EXPECT_NE(message(force_ms).find("trajectory: streams.force runs from 0 to"), std::string::npos) << message(force_ms);
   EXPECT_NE(message(force_ms).find("in another unit (milliseconds?)"), std::string::npos) << message(force_ms);
+  // And the object's stream in milliseconds beside the rest in seconds (it ran over 1080 s).
+  auto object_ms = t;
+  for (auto& o : object_ms.measured.object_pose) o.t *= 1000.0;
+  EXPECT_NE(message(object_ms).find("trajectory: streams.object_pose runs from 0 to"), std::string::npos) << message(object_ms);
+  EXPECT_NE(message(object_ms).find("than the finger's?"), std::string::npos) << message(object_ms);
   // The same contact twice at one time (a sample added twice; several contacts at one time are
   // allowed): it was estimated as two contacts at one point.
   auto twice = t;

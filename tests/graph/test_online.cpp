@@ -47,6 +47,10 @@ void Feed(const push::Trajectory& t, OnlineEstimator& online, const std::functio
   }
 }
 
+bool HasWarning(const EstimationResult& r, const std::string& text) {
+  return std::any_of(r.warnings.begin(), r.warnings.end(), [&](const std::string& w) { return w.find(text) != std::string::npos; });
+}
+
 double WorstTranslationGap(const EstimationResult& a, const EstimationResult& b) {
   double worst = 0.0;
   for (std::size_t i = 0; i < a.states.size(); ++i) {
@@ -349,6 +353,44 @@ TEST(Online, LeavesOutForcesWithoutAScale) {
   const EstimationResult r = online.Finish();
   EXPECT_EQ(r.warnings.size(), 1u);
   for (const StateEstimate& s : r.states) EXPECT_FALSE(s.force || s.force_cov);
+}
+
+// A contact stream 5 cm off its finger (another frame, an offset), fed sample by sample: the
+// batch's check leaves it out once 10 contacts have come, the steps so far are solved again
+// without it, later contact samples are refused (false), and Finish() says so; the estimate is
+// near the one without a contact stream. A stream on the finger is used.
+TEST(Online, AContactStreamOffTheFingerIsLeftOut) {
+  const push::Trajectory t = GeneratePush(OffsetPush(4, 0.6));
+  ASSERT_GT(t.measured.contact_point.size(), 30u);
+  EstimatorConfig config;
+  config.covariance = false;
+  auto run = [&](const push::Trajectory& input, int* refused) {
+    OnlineEstimator online(SetupOf(input), Model::kQs, config, StreamsOf(input));
+    const std::vector<Arrival> arrivals = ArrivalOrder(input);
+    for (std::size_t k = 0; k < arrivals.size(); ++k) {
+      if (!Deliver(arrivals[k], input, online) && arrivals[k].stream == 2) ++*refused;
+      if ((k + 1 == arrivals.size() || arrivals[k + 1].t > arrivals[k].t + 1e-9) && online.UpdateDue()) online.Update();
+    }
+    return online.Finish();
+  };
+  push::Trajectory off = t;
+  for (push::PointSample& c : off.measured.contact_point) c.point += geometry::Vec2(0.05, 0.0);
+  push::Trajectory none = t;
+  none.measured.contact_point.clear();
+  int refused_off = 0, refused_on = 0, refused_none = 0;
+  const EstimationResult r = run(off, &refused_off);
+  const EstimationResult kept = run(t, &refused_on);
+  const EstimationResult without = run(none, &refused_none);
+  EXPECT_TRUE(HasWarning(r, "contact check (OnlineEstimator, on the samples up to")) << ::testing::PrintToString(r.warnings);
+  EXPECT_TRUE(HasWarning(r, "streams.contact_point: its ")) << ::testing::PrintToString(r.warnings);
+  EXPECT_TRUE(HasWarning(r, "every step so far solved again without it")) << ::testing::PrintToString(r.warnings);
+  EXPECT_GT(refused_off, 10);
+  EXPECT_EQ(refused_on, 0);
+  EXPECT_FALSE(HasWarning(kept, "contact check")) << ::testing::PrintToString(kept.warnings);
+  const double rms = r.metrics.at("object_position_rms"), rms_without = without.metrics.at("object_position_rms");
+  std::printf("[online] contact stream 5 cm off: object RMS %.3f mm (without the stream %.3f mm, on the finger %.3f mm)\n",
+              1e3 * rms, 1e3 * rms_without, 1e3 * kept.metrics.at("object_position_rms"));
+  EXPECT_LT(rms, 1.25 * rms_without + 2e-4);
 }
 
 // A corrupted force sample (1e5 N) arriving online is a sensor fault as in batch: AddForce

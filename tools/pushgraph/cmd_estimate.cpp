@@ -95,7 +95,12 @@ void RunEstimate(const EstimateOptions& o) {
     object_up = ChooseObjectReading(o.object, object_readings, config, &traj, &mesh_warnings);
     result = graph::Estimate(traj, model, mode, config);
   } catch (const graph::GraphError& e) {
-    throw CliError(o.input + ": " + e.what());
+    // A config value judged against the trajectory (c against the object's reach) is the config
+    // file's error: it was named after the trajectory.
+    const std::string what = e.what();
+    constexpr const char* kConfig = "config: ";
+    if (!o.config.empty() && what.rfind(kConfig, 0) == 0) throw CliError(o.config + ": " + what.substr(8));
+    throw CliError(o.input + ": " + what);
   }
   // The library names the shape file SHAPE_FILE in its "to save it" commands; here it is known,
   // and so is the axis it was read along (a y-up export in millimetres: "--scale 0.001" alone

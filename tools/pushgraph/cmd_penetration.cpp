@@ -43,7 +43,8 @@ void RegisterPenetration(CLI::App& app) {
     out["depth"] = r.depth;
     // false only for --fast (an estimate); rounded fingers' depths are exact (docs/geometry.md).
     if (r.intersecting) out["depth_exact"] = r.depth_exact;
-    out["direction"] = r.intersecting ? nlohmann::json{r.normal.x(), r.normal.y()} : nlohmann::json(nullptr);
+    // + 0.0: no "-0.0" in the output.
+    out["direction"] = r.intersecting ? nlohmann::json{r.normal.x() + 0.0, r.normal.y() + 0.0} : nlohmann::json(nullptr);
     std::cout << DumpJson(out) << "\n";
   });
 }

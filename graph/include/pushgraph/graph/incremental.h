@@ -115,7 +115,9 @@ class OnlineEstimator {
   OnlineEstimator(const OnlineEstimator&) = delete;
   OnlineEstimator& operator=(const OnlineEstimator&) = delete;
 
-  /// Each returns false when the sample came too late (at or before the last update) and was dropped.
+  /// Each returns false when the sample came too late (at or before the last update) and was dropped;
+  /// AddContactPoint also once the contact check left the stream out (its points off the finger:
+  /// another frame or an offset; Finish() says so).
   /// Without a finger index: finger 0 (Trajectory::finger).
   bool AddObjectPose(double t, const geometry::Pose2& pose);
   bool AddFingerPose(double t, const geometry::Pose2& pose);
