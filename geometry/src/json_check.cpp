@@ -2,6 +2,9 @@
 // with the keys seen so far.
 #include <pushgraph/geometry/json_check.h>
 
+#include <algorithm>
+#include <cctype>
+
 #include <nlohmann/json.hpp>
 
 #include <set>
@@ -82,7 +85,33 @@ std::string FindDuplicateJsonKey(const std::string& text) {
   return finder.found;
 }
 
-std::string JsonSyntaxErrorText(const std::string& what) {
+namespace {
+
+// "number overflow parsing '1e999'": the token's first place in `text` where it stands alone, as
+// " at line L, column C" ("" when not found).
+std::string OverflowPlace(const std::string& what, const std::string& text) {
+  const std::string key = "number overflow parsing '";
+  const std::size_t at = what.find(key);
+  if (at == std::string::npos || text.empty()) return "";
+  const std::size_t begin = at + key.size(), end = what.find('\'', begin);
+  if (end == std::string::npos || end == begin) return "";
+  const std::string token = what.substr(begin, end - begin);
+  auto part_of_number = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '-' || c == '+'; };
+  for (std::size_t p = text.find(token); p != std::string::npos; p = text.find(token, p + 1)) {
+    if ((p > 0 && part_of_number(text[p - 1])) || (p + token.size() < text.size() && part_of_number(text[p + token.size()]))) continue;
+    const std::size_t line = 1 + static_cast<std::size_t>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(p), '\n'));
+    const std::size_t line_start = p == 0 ? std::string::npos : text.rfind('\n', p - 1);
+    const std::size_t column = line_start == std::string::npos ? p + 1 : p - line_start;
+    return " at line " + std::to_string(line) + ", column " + std::to_string(column) +
+           " (beyond a double's range, about 1e308)";
+  }
+  return "";
+}
+
+}  // namespace
+
+std::string JsonSyntaxErrorText(const std::string& what, const std::string& text) {
+  if (const std::string place = OverflowPlace(what, text); !place.empty()) return what + place;
   // "invalid literal" (NaN, Infinity), or "expected digit after '-'" (-Infinity).
   const bool literal = what.find("invalid literal") != std::string::npos || what.find("after '-'") != std::string::npos;
   const std::size_t last = what.find("last read: '");

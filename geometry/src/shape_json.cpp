@@ -72,7 +72,7 @@ Shape ParseShapeJson(const std::string& text, const std::string& source) {
   try {
     doc = json::parse(text);
   } catch (const json::exception& e) {  // syntax errors, and numbers that overflow a double
-    Fail(source, "malformed JSON: " + JsonSyntaxErrorText(e.what()) + MeshFileHint(text));
+    Fail(source, "malformed JSON: " + JsonSyntaxErrorText(e.what(), text) + MeshFileHint(text));
   }
   if (const std::string dup = FindDuplicateJsonKey(text); !dup.empty()) Fail(source, dup);
   if (!doc.is_object()) Fail(source, "top level must be an object with \"polygons\"");

@@ -147,7 +147,7 @@ EstimatorConfig ParseEstimatorConfig(const std::string& json_text, const std::st
   try {
     j = Json::parse(json_text);
   } catch (const Json::exception& e) {  // syntax errors, and numbers that overflow a double (1e999)
-    throw GraphError(source + ": invalid JSON: " + geometry::JsonSyntaxErrorText(e.what()));
+    throw GraphError(source + ": invalid JSON: " + geometry::JsonSyntaxErrorText(e.what(), json_text));
   }
   if (const std::string dup = geometry::FindDuplicateJsonKey(json_text); !dup.empty()) throw GraphError(source + ": " + dup);
   if (!j.is_object()) throw GraphError(source + ": the configuration must be a JSON object");

@@ -240,7 +240,7 @@ Raw ReadJson(const std::string& path) {
   try {
     doc = nlohmann::json::parse(text);
   } catch (const nlohmann::json::exception& e) {
-    throw IoError(path + ": malformed JSON: " + geometry::JsonSyntaxErrorText(e.what()));
+    throw IoError(path + ": malformed JSON: " + geometry::JsonSyntaxErrorText(e.what(), text));
   }
   if (const std::string dup = geometry::FindDuplicateJsonKey(text); !dup.empty()) throw IoError(path + ": " + dup);
   if (!doc.is_object()) throw IoError(path + ": top level must be an object with tip_pose, object_pose, ft_wrench");

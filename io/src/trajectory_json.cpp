@@ -342,7 +342,7 @@ Trajectory ParseTrajectoryJson(const std::string& text, const std::string& sourc
   try {
     doc = json::parse(text);
   } catch (const json::exception& e) {
-    throw IoError(source + ": malformed JSON: " + geometry::JsonSyntaxErrorText(e.what()));
+    throw IoError(source + ": malformed JSON: " + geometry::JsonSyntaxErrorText(e.what(), text));
   }
   if (const std::string dup = geometry::FindDuplicateJsonKey(text); !dup.empty()) throw IoError(source + ": " + dup);
   const Reader r(source, notes);

@@ -163,6 +163,9 @@ TEST(TrajectoryJson, BadInputNamesFileAndPath) {
   // A row with a finger index in a one-finger file: said why it is too long.
   ExpectError(Doc(R"({"force": [[0.0, 0, 1.0, 0.0]]})"), "with one finger the rows carry no finger index");
   ExpectError(Doc(R"({"force": [[0, 1e999, 2]]})"), "malformed JSON");
+  // Where: the parser's "number overflow parsing '1e999'" had no place.
+  ExpectError("{\"format\": \"pushgraph-trajectory-1\",\n \"streams\": {\"force\": [[0, 1e9999, 2]]}}",
+              "number overflow parsing '1e9999' at line 2, column 28 (beyond a double's range");
   ExpectError(Doc(R"({"force": [[0, 1, 2], [0, 1, 2]]})"), "same time stamp");
   // Less than a nanosecond apart: the same time stamp too (1e-12 s apart and 3 cm different was
   // read as a 30 km/s jump); a microsecond apart is two samples.

@@ -17,7 +17,9 @@ std::string FindDuplicateJsonKey(const std::string& text);
 
 /// A JSON parser's syntax error `what`, with what it most likely means added where the parser's
 /// own words do not say: NaN or Infinity written as numbers (JSON has neither; Python's json.dump
-/// writes them), which the parser calls an "invalid literal".
-std::string JsonSyntaxErrorText(const std::string& what);
+/// writes them), which the parser calls an "invalid literal". Given the parsed `text`, a number
+/// beyond a double's range ("number overflow parsing '1e999'", which carries no place) is given
+/// its line and column.
+std::string JsonSyntaxErrorText(const std::string& what, const std::string& text = "");
 
 }  // namespace pushgraph::geometry
