@@ -1,5 +1,6 @@
 // MIT pushing dataset reader (HDF5 C++ API and JSON), with the repairs listed in mit_push.h.
 #include <pushgraph/io/mit_push.h>
+#include <pushgraph/geometry/types.h>
 
 #include <pushgraph/geometry/json_check.h>
 #include <pushgraph/io/trajectory_json.h>  // IoError
@@ -316,6 +317,18 @@ void Clean(std::vector<Row>* rows, const std::string& path, const char* name, Mi
     where << path << ": dataset '" << name << "' sample " << i << " (in time order): time " << t;
     if (std::abs(t) > push::kMaxTimeStamp)
       throw IoError(where.str() + " s is out of the supported range (|t| <= 1e11 s): a corrupted time stamp?");
+    // Values the estimator refuses, refused here too (a byte flip's x = 7.7e307 m was written to
+    // the trajectory file without a word): positions within 1e6 m, forces within 1e9 N.
+    const bool wrench = std::string(name) == "ft_wrench";
+    const double bound = wrench ? 1e9 : geometry::kMaxCoordinate;
+    for (int c = 1; c <= 2; ++c) {
+      if (std::abs((*rows)[i][c]) > bound) {
+        where << " s: " << (wrench ? (c == 1 ? "fx " : "fy ") : (c == 1 ? "x " : "y ")) << (*rows)[i][c]
+              << " is out of the supported range (" << (wrench ? "forces within 1e9 N" : "positions within 1e6 m")
+              << "): a corrupted value?";
+        throw IoError(where.str());
+      }
+    }
     if (i > 0 && t - (*rows)[i - 1][0] > jump) {
       where << " s follows " << (*rows)[i - 1][0] << " s: a clock jump of more than max(10 s, 1000 median periods) "
             << "(a corrupted time stamp?)";
