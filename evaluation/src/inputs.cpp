@@ -15,6 +15,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -250,10 +251,11 @@ InputKind DetectInputKind(const std::string& path) {
   in.clear();
   in.seekg(0);
   nlohmann::json doc;
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   try {
-    doc = nlohmann::json::parse(in);
+    doc = nlohmann::json::parse(text);
   } catch (const nlohmann::json::exception& e) {
-    throw EvaluationError(path + ": neither an HDF5 file nor valid JSON (" + geometry::JsonSyntaxErrorText(e.what()) + ")");
+    throw EvaluationError(path + ": neither an HDF5 file nor valid JSON (" + geometry::JsonSyntaxErrorText(e.what(), text) + ")");
   } catch (const std::exception& e) {
     throw EvaluationError(path + ": cannot read the file (" + e.what() + ")");
   }

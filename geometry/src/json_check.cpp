@@ -97,7 +97,19 @@ std::string OverflowPlace(const std::string& what, const std::string& text) {
   if (end == std::string::npos || end == begin) return "";
   const std::string token = what.substr(begin, end - begin);
   auto part_of_number = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '-' || c == '+'; };
-  for (std::size_t p = text.find(token); p != std::string::npos; p = text.find(token, p + 1)) {
+  // Outside string literals only (a "comment": "1e999" before the number is text).
+  bool in_string = false;
+  for (std::size_t p = 0; p < text.size(); ++p) {
+    if (in_string) {
+      if (text[p] == '\\') ++p;
+      else if (text[p] == '"') in_string = false;
+      continue;
+    }
+    if (text[p] == '"') {
+      in_string = true;
+      continue;
+    }
+    if (text.compare(p, token.size(), token) != 0) continue;
     if ((p > 0 && part_of_number(text[p - 1])) || (p + token.size() < text.size() && part_of_number(text[p + token.size()]))) continue;
     const std::size_t line = 1 + static_cast<std::size_t>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(p), '\n'));
     const std::size_t line_start = p == 0 ? std::string::npos : text.rfind('\n', p - 1);

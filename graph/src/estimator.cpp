@@ -507,7 +507,8 @@ std::string SizeMismatchText(const RegistrationResult& r) {
 // 1.6 s gap in a 2 cm/s push: the batch QS object slid 52 mm along its edge (0.5 m/s) to put the
 // contact at a corner, 20.6 mm RMS against the tracker's 2.6, sigmas of 0.2 mm, and no word; the
 // incremental mode stayed at 1.0 mm.
-static std::optional<std::string> UnobservedRunawayNote(const push::Trajectory& traj, const std::vector<StateEstimate>& states) {
+static std::optional<std::string> UnobservedRunawayNote(const push::Trajectory& traj, const std::vector<StateEstimate>& states,
+                                                        Model model, Mode mode) {
   constexpr double kSpeedRatio = 5.0, kSpeedFloor = 0.02;  // m/s
   const auto& object = traj.measured.object_pose;
   if (object.size() < 3 || states.size() < 3) return std::nullopt;
@@ -540,10 +541,17 @@ static std::optional<std::string> UnobservedRunawayNote(const push::Trajectory& 
         said.empty() ? "" : "; ", a, b, object_speed, at, finger_speed);
   }
   if (said.empty()) return std::nullopt;
-  return "object unobserved: " + said +
-         ": a pushed object cannot outrun its pusher, so the estimate there is a local minimum of the pushing model and "
-         "its sigmas understate the error; estimate with --mode incremental (the fixed-lag smoother follows the push "
-         "through the gap) or give the tracker's samples in that stretch";
+  std::string why;
+  if (model == Model::kCp || model == Model::kSdf) {
+    why = "; CP and SDF have no pushing model to hold the object's motion to the finger's there (--model qs has one)";
+  } else if (mode == Mode::kBatch) {
+    why = "; it is a local minimum of the pushing model (D holds the object's direction of motion, not its speed): "
+          "--mode incremental, whose fixed-lag smoother follows the push through the gap, may not fall into it";
+  } else {
+    why = "; the fixed-lag smoother lost the object there (--mode batch solves the whole push at once)";
+  }
+  return "object unobserved: " + said + ": a pushed object cannot outrun its pusher, so the estimate there is wrong and its "
+         "sigmas understate the error" + why + "; samples of the tracker in that stretch would settle it";
 }
 
 // The noise model's scales set far (100 times or more) from their defaults: they then outweigh
@@ -708,7 +716,7 @@ EstimationResult Estimate(const push::Trajectory& given, Model model, Mode mode,
           r.states.size(), r.states.front().t, r.states.back().t));
     }
   }
-  if (const std::optional<std::string> runaway = UnobservedRunawayNote(input, r.states)) r.warnings.push_back(*runaway);
+  if (const std::optional<std::string> runaway = UnobservedRunawayNote(input, r.states, model, mode)) r.warnings.push_back(*runaway);
   if (trajectory.ground_truth && trajectory.ground_truth->object_pose.empty()) {
     // The object's metrics were left out with no word (a hostile user's file).
     r.warnings.push_back("metrics: the input's ground_truth has no object_pose, so the object's metrics (object_position_rms, "

@@ -726,12 +726,19 @@ struct OnlineEstimator::Impl {
   std::vector<std::size_t> touch_scanned;  // per finger: force samples looked at
 
   // The batch's check that the contact points lie on their finger (Estimate's
-  // DropContactStreamsOffTheFinger), once kContactCheckSamples contacts have come: a stream off
-  // it (another frame, an offset) is left out from then on and the steps so far solved again
-  // without it, before the shape check reads the contacts. Online it was used as given: a
-  // tactile stream 5 cm off moved the object estimate with it, and the shape check blamed the
-  // shape.
+  // DropContactStreamsOffTheFinger), per finger, once kContactCheckSamples of its contacts have a
+  // finger pose within kNearInTime (contacts older than `until` - kNearInTime: every pose near
+  // them has come). With one finger a stream off it (another frame, an offset) is left out from
+  // then on and the steps so far solved again without it, before the shape check reads the
+  // contacts; with several (one OnlineStreams flag gates them all) it is said. Online it was used
+  // as given: a tactile stream 5 cm off moved the object estimate with it, and the shape check
+  // blamed the shape.
   static constexpr std::size_t kContactCheckSamples = 10;
+  static constexpr double kNearInTime = 0.05;  // s, as the batch check
+  enum class ContactVerdict { kUndecided, kOnFinger, kOff };
+  std::vector<ContactVerdict> contact_verdict;  // per finger
+  std::vector<std::size_t> contacts_scanned, contacts_judgeable;  // per finger
+  bool contacts_left_out = false;
 
   // A new smoother on traj as it now is: the next update solves every step so far. The updates
   // so far stay in the result's count and update_times_s.
@@ -743,34 +750,61 @@ struct OnlineEstimator::Impl {
     fresh->total_update_time = smoother->total_update_time;
     smoother = std::move(fresh);
   }
-  bool contacts_judged = false;
-  bool contacts_left_out = false;
 
-  void CheckContacts(double until) {
-    if (contacts_judged || !streams.contact_point) return;
-    std::size_t samples = traj.measured.contact_point.size();
-    for (const push::ExtraFinger& f : traj.extra_fingers) samples = std::max(samples, f.measured.contact_point.size());
-    if (samples < kContactCheckSamples) return;
-    contacts_judged = true;
-    std::string note;
-    std::optional<push::Trajectory> without = internal::DropContactStreamsOffTheFinger(traj, smoother->cfg.measurement, &note);
-    if (!without) return;
-    std::string text = internal::Format("contact check (OnlineEstimator, on the samples up to %.3f s into the data, t = %s s): ",
-                                        until - first_t, Precise(until).c_str());
-    bool every_stream = without->measured.contact_point.empty();
-    for (const push::ExtraFinger& f : without->extra_fingers) every_stream = every_stream && f.measured.contact_point.empty();
-    if (!every_stream) {
-      // One OnlineStreams flag gates every finger's contacts: a stream cannot be left out alone.
-      warnings.push_back(text + note + "; OnlineEstimator uses it as given (the other fingers' contact streams are kept, "
-                                       "and their gating is shared): estimate the recording with `pushgraph estimate`");
+  // `until`: the update's time; `last`: Finish()'s look at what is left undecided (5 contacts
+  // suffice, as in batch, and nothing is solved again).
+  void CheckContacts(double until, bool last) {
+    if (contacts_left_out || !streams.contact_point) return;
+    if (contact_verdict.size() != static_cast<std::size_t>(fingers)) {
+      contact_verdict.assign(fingers, ContactVerdict::kUndecided);
+      contacts_scanned.assign(fingers, 0);
+      contacts_judgeable.assign(fingers, 0);
+    }
+    for (int k = 0; k < fingers; ++k) {
+      if (contact_verdict[k] != ContactVerdict::kUndecided) continue;
+      const auto& poses = k == 0 ? traj.measured.finger_pose : traj.extra_fingers[k - 1].measured.finger_pose;
+      const auto& contacts = k == 0 ? traj.measured.contact_point : traj.extra_fingers[k - 1].measured.contact_point;
+      // Count once each contact whose nearby poses have all come.
+      std::size_t& scanned = contacts_scanned[k];
+      while (scanned < contacts.size() && (last || contacts[scanned].t <= until - kNearInTime)) {
+        const double t = contacts[scanned].t;
+        const auto after = std::lower_bound(poses.begin(), poses.end(), t, [](const push::PoseSample& p, double x) { return p.t < x; });
+        const bool near = (after != poses.end() && after->t - t <= kNearInTime) ||
+                          (after != poses.begin() && t - std::prev(after)->t <= kNearInTime);
+        contacts_judgeable[k] += near;
+        ++scanned;
+      }
+      if (contacts_judgeable[k] < (last ? std::size_t{5} : kContactCheckSamples)) continue;
+      // Finger k alone, its contacts so far.
+      push::Trajectory view;
+      view.finger.shape = k == 0 ? traj.finger.shape : traj.extra_fingers[k - 1].finger.shape;
+      view.measured.finger_pose = poses;
+      view.measured.contact_point.assign(contacts.begin(), contacts.begin() + static_cast<std::ptrdiff_t>(scanned));
+      std::string note;
+      const bool off = internal::DropContactStreamsOffTheFinger(view, smoother->cfg.measurement, &note).has_value();
+      contact_verdict[k] = off ? ContactVerdict::kOff : ContactVerdict::kOnFinger;
+      if (!off) continue;
+      if (k > 0) {
+        const std::string named = "streams.fingers[" + std::to_string(k) + "].contact_point";
+        for (std::size_t at = note.find("streams.contact_point"); at != std::string::npos; at = note.find("streams.contact_point", at + named.size()))
+          note.replace(at, 21, named);
+      }
+      const std::string text = internal::Format("contact check (OnlineEstimator, on the samples up to %.3f s into the data, t = %s s): ",
+                                                last_update_t - first_t, Precise(last_update_t).c_str()) + note;
+      if (last || fingers > 1) {
+        warnings.push_back(text + (last ? "; OnlineEstimator used it as given (too few contacts to judge it before the end)"
+                                        : "; OnlineEstimator uses it as given (one OnlineStreams flag gates every finger's "
+                                          "contacts)") +
+                           ": estimate the recording with `pushgraph estimate`, which leaves it out");
+        continue;
+      }
+      traj.measured.contact_point.clear();
+      streams.contact_point = false;
+      contacts_left_out = true;
+      RestartSmoother();
+      warnings.push_back(text + "; from this update on, every step so far solved again without it");
       return;
     }
-    traj.measured.contact_point.clear();
-    for (push::ExtraFinger& f : traj.extra_fingers) f.measured.contact_point.clear();
-    streams.contact_point = false;
-    contacts_left_out = true;
-    RestartSmoother();
-    warnings.push_back(text + note + "; from this update on, every step so far solved again without it");
   }
 
   void CheckTouchingFingersAreNear() {
@@ -1221,7 +1255,7 @@ double OnlineEstimator::Update(double until) {
   // The contact and shape checks first: either may start the smoother again (without the
   // contact stream, with the shape in its units).
   const auto start = std::chrono::steady_clock::now();
-  m.CheckContacts(until);
+  m.CheckContacts(until, false);
   m.CheckShape(until, false);
   const double checked = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   m.smoother->builder.AppendSteps(until);
@@ -1245,6 +1279,7 @@ EstimationResult OnlineEstimator::Finish() {
   if (m.newest_t > m.last_update_t) Update(m.newest_t);  // the end: wait for nobody
   m.finished = true;
   if (m.smoother->next_step == 0) throw GraphError("OnlineEstimator::Finish: no measurements were added");
+  m.CheckContacts(m.last_update_t, true);
   m.CheckShape(m.last_update_t, true);
   EstimationResult r = m.smoother->Finish();
   if (m.alignment.checked) r.shape_alignment = m.alignment;

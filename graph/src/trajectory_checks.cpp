@@ -1404,19 +1404,23 @@ void CheckStreamTimeUnits(const push::Trajectory& traj) {
   ForEachFingerStream(traj, check);
   // The object's stream in another unit than the finger's (an object tracker in milliseconds
   // beside the rest in seconds ran over 1080 s, 23 mm off, with a hint about the finger stream).
+  // Refused only when the unit is evident: divided by 1000 (or 1e6) most of its rows fall within
+  // the finger's time. A long object recording around a finger tracked for a short tap is data.
   const auto& finger = traj.measured.finger_pose;
-  if (finger.size() < 2) return;
-  const double f0 = finger.front().t, f1 = finger.back().t;
-  if (!(f1 > f0)) return;
-  const auto inside = std::count_if(object.begin(), object.end(), [&](const push::PoseSample& a) { return a.t >= f0 && a.t <= f1; });
-  // At most one row (or a tenth) inside: a short push has few camera frames, and a time stamp
-  // of 0 stays 0 in any unit.
-  if (span >= 100.0 * (f1 - f0) && object.size() >= 3 &&
-      static_cast<std::size_t>(inside) <= std::max<std::size_t>(1, object.size() / 10))
+  if (finger.size() < 2 || object.size() < 3) return;
+  const double f0 = finger.front().t, f1 = finger.back().t, finger_span = f1 - f0;
+  if (!(finger_span > 0.0) || span < 100.0 * finger_span) return;
+  const double slack = 0.1 * finger_span + 0.05;
+  for (const auto& [scale, unit] : {std::pair<double, const char*>{1e3, "milliseconds"}, {1e6, "microseconds"}}) {
+    const auto within = std::count_if(object.begin(), object.end(), [&](const push::PoseSample& a) {
+      return a.t / scale >= f0 - slack && a.t / scale <= f1 + slack;
+    });
+    if (static_cast<double>(within) < 0.8 * static_cast<double>(object.size())) continue;
     throw GraphError(Format("trajectory: streams.object_pose runs from %.6g to %.6g s, %.0f times as long as "
-                            "streams.finger_pose (%.6g to %.6g s), and only %zu of its %zu rows fall within the finger's "
-                            "time: are its time stamps in another unit (milliseconds?) than the finger's?",
-                            t0, t1, span / (f1 - f0), f0, f1, static_cast<std::size_t>(inside), object.size()));
+                            "streams.finger_pose (%.6g to %.6g s), and divided by %g its times fall within the finger's: "
+                            "are its time stamps in %s? Trajectory times are in seconds",
+                            t0, t1, span / finger_span, f0, f1, scale, unit));
+  }
 }
 
 std::optional<std::string> StreamCoverageNote(const push::Trajectory& traj) {

@@ -29,7 +29,7 @@ struct type_caster<double> {
       return true;
     }
     if (!convert) return false;
-    if (!PyLong_Check(src.ptr()) && std::string(str(type::handle_of(src).attr("__name__"))) == "bool_") return false;  // numpy.bool_
+    if (!PyLong_Check(src.ptr()) && IsNumpyBool(src)) return false;
     const double d = PyFloat_AsDouble(src.ptr());
     if (d == -1.0 && PyErr_Occurred()) {
       PyErr_Clear();
@@ -39,6 +39,26 @@ struct type_caster<double> {
     return true;
   }
   static handle cast(double src, return_value_policy /*policy*/, handle /*parent*/) { return PyFloat_FromDouble(src); }
+
+ private:
+  // numpy.bool_ (named numpy.bool in NumPy 2: an isinstance test, not its name) and 0-d boolean
+  // arrays.
+  static bool IsNumpyBool(handle src) {
+    static PyObject* const bool_type = [] {
+      PyObject* numpy = PyImport_ImportModule("numpy");
+      PyObject* type = numpy != nullptr ? PyObject_GetAttrString(numpy, "bool_") : nullptr;  // kept for the process
+      Py_XDECREF(numpy);
+      if (type == nullptr) PyErr_Clear();
+      return type;
+    }();
+    if (bool_type != nullptr) {
+      const int is_bool = PyObject_IsInstance(src.ptr(), bool_type);
+      if (is_bool < 0) PyErr_Clear();
+      if (is_bool == 1) return true;
+    }
+    if (isinstance<array>(src)) return reinterpret_borrow<array>(src).dtype().kind() == 'b';
+    return false;
+  }
 };
 }  // namespace pybind11::detail
 

@@ -166,6 +166,9 @@ TEST(TrajectoryJson, BadInputNamesFileAndPath) {
   // Where: the parser's "number overflow parsing '1e999'" had no place.
   ExpectError("{\"format\": \"pushgraph-trajectory-1\",\n \"streams\": {\"force\": [[0, 1e9999, 2]]}}",
               "number overflow parsing '1e9999' at line 2, column 28 (beyond a double's range");
+  // Not the same text inside a string before it.
+  ExpectError("{\"format\": \"1e9999\",\n \"streams\": {\"force\": [[0, 1e9999, 2]]}}",
+              "number overflow parsing '1e9999' at line 2, column 28");
   ExpectError(Doc(R"({"force": [[0, 1, 2], [0, 1, 2]]})"), "same time stamp");
   // Less than a nanosecond apart: the same time stamp too (1e-12 s apart and 3 cm different was
   // read as a 30 km/s jump); a microsecond apart is two samples.

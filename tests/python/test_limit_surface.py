@@ -71,7 +71,8 @@ def test_booleans_are_not_numbers():
     # A float argument given True was read as 1.0 (a 1 m disk, mu = 1) without a word.
     box = pg.Shape.box(0.1, 0.1)
     for call in (lambda: pg.Shape.disk(True), lambda: pg.LimitSurface(box, 1.0, True),
-                 lambda: pg.LimitSurface(box, np.bool_(True), 0.3), lambda: pg.Shape.box(True, 1.0)):
+                 lambda: pg.LimitSurface(box, np.bool_(True), 0.3), lambda: pg.Shape.box(True, 1.0),
+                 lambda: pg.Shape.disk(np.array(True))):
         with pytest.raises(TypeError):
             call()
     # Ints and NumPy scalars still convert.
