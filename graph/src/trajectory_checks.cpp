@@ -1411,7 +1411,10 @@ void CheckStreamTimeUnits(const push::Trajectory& traj) {
   const double f0 = finger.front().t, f1 = finger.back().t, finger_span = f1 - f0;
   if (!(finger_span > 0.0) || span < 100.0 * finger_span) return;
   const double slack = 0.1 * finger_span + 0.05;
-  for (const auto& [scale, unit] : {std::pair<double, const char*>{1e3, "milliseconds"}, {1e6, "microseconds"}}) {
+  // (No structured binding: a lambda cannot capture one in C++17, which clang enforces.)
+  for (const std::pair<double, const char*>& reading : {std::pair<double, const char*>{1e3, "milliseconds"}, {1e6, "microseconds"}}) {
+    const double scale = reading.first;
+    const char* unit = reading.second;
     const auto within = std::count_if(object.begin(), object.end(), [&](const push::PoseSample& a) {
       return a.t / scale >= f0 - slack && a.t / scale <= f1 + slack;
     });
