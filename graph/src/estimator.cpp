@@ -500,60 +500,6 @@ std::string SizeMismatchText(const RegistrationResult& r) {
 
 }  // namespace
 
-// Where the object's tracker is silent for a long stretch (over 0.5 s and 10 of its periods), the
-// estimated object moving much faster than its pusher: a pushed object cannot outrun the finger
-// (its speed at the contact is the finger's along the normal, and it turns about a point away
-// from it), so the estimate there is a local minimum of the pushing model. A hostile user's
-// 1.6 s gap in a 2 cm/s push: the batch QS object slid 52 mm along its edge (0.5 m/s) to put the
-// contact at a corner, 20.6 mm RMS against the tracker's 2.6, sigmas of 0.2 mm, and no word; the
-// incremental mode stayed at 1.0 mm.
-static std::optional<std::string> UnobservedRunawayNote(const push::Trajectory& traj, const std::vector<StateEstimate>& states,
-                                                        Model model, Mode mode) {
-  constexpr double kSpeedRatio = 5.0, kSpeedFloor = 0.02;  // m/s
-  const auto& object = traj.measured.object_pose;
-  if (object.size() < 3 || states.size() < 3) return std::nullopt;
-  std::vector<double> periods;
-  for (std::size_t i = 0; i + 1 < object.size(); ++i) periods.push_back(object[i + 1].t - object[i].t);
-  std::nth_element(periods.begin(), periods.begin() + periods.size() / 2, periods.end());
-  const double gap = std::max(0.5, 10.0 * periods[periods.size() / 2]);
-  std::string said;
-  for (std::size_t i = 0; i + 1 < object.size(); ++i) {
-    const double a = object[i].t, b = object[i + 1].t;
-    if (!(b - a > gap)) continue;
-    // Speeds over at least kSpan s (a step's 4 ms would measure the estimate's own jitter).
-    constexpr double kSpan = 0.04;
-    auto j = std::lower_bound(states.begin(), states.end(), a, [](const StateEstimate& s, double t) { return s.t < t; });
-    auto k = j;
-    double object_speed = 0.0, finger_speed = 0.0, at = a;
-    for (; j != states.end(); ++j) {
-      if (k <= j) k = j + 1;
-      while (k != states.end() && k->t < j->t + kSpan) ++k;
-      if (k == states.end() || k->t > b) break;
-      const double dt = k->t - j->t;
-      const double v = (k->object_pose.translation() - j->object_pose.translation()).norm() / dt;
-      if (v > object_speed) object_speed = v, at = j->t;
-      finger_speed = std::max(finger_speed, (k->finger_pose.translation() - j->finger_pose.translation()).norm() / dt);
-    }
-    if (!(object_speed > kSpeedRatio * finger_speed + kSpeedFloor)) continue;
-    said += internal::Format(
-        "%sbetween t = %.9g and %.9g s, where streams.object_pose has no sample, the estimated object moves at up to %.3g "
-        "m/s (at t = %.9g s) while the finger moves at most %.3g m/s",
-        said.empty() ? "" : "; ", a, b, object_speed, at, finger_speed);
-  }
-  if (said.empty()) return std::nullopt;
-  std::string why;
-  if (model == Model::kCp || model == Model::kSdf) {
-    why = "; CP and SDF have no pushing model to hold the object's motion to the finger's there (--model qs has one)";
-  } else if (mode == Mode::kBatch) {
-    why = "; it is a local minimum of the pushing model (D holds the object's direction of motion, not its speed): "
-          "--mode incremental, whose fixed-lag smoother follows the push through the gap, may not fall into it";
-  } else {
-    why = "; the fixed-lag smoother lost the object there (--mode batch solves the whole push at once)";
-  }
-  return "object unobserved: " + said + ": a pushed object cannot outrun its pusher, so the estimate there is wrong and its "
-         "sigmas understate the error" + why + "; samples of the tracker in that stretch would settle it";
-}
-
 // The noise model's scales set far (100 times or more) from their defaults: they then outweigh
 // the measurements or let the state drift, and an estimate worse than the raw data follows while
 // the diagnostics blame the sensors (quasi_static_sigma 1e-4: object 30 mm against 7.3 raw;
@@ -716,7 +662,7 @@ EstimationResult Estimate(const push::Trajectory& given, Model model, Mode mode,
           r.states.size(), r.states.front().t, r.states.back().t));
     }
   }
-  if (const std::optional<std::string> runaway = UnobservedRunawayNote(input, r.states, model, mode)) r.warnings.push_back(*runaway);
+  if (const std::optional<std::string> runaway = internal::UnobservedRunawayNote(input, r.states, model, mode)) r.warnings.push_back(*runaway);
   if (trajectory.ground_truth && trajectory.ground_truth->object_pose.empty()) {
     // The object's metrics were left out with no word (a hostile user's file).
     r.warnings.push_back("metrics: the input's ground_truth has no object_pose, so the object's metrics (object_position_rms, "

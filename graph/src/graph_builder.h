@@ -477,6 +477,11 @@ Diagnostics Diagnose(const push::Trajectory& trajectory, Model model, const Esti
                      const EstimationResult& result, const FrameState* frame,
                      std::shared_ptr<const geometry::ShapePairQuerier> querier = nullptr);
 
+/// Whether a finger pose sample lies within 0.05 s of `t` (the finger moves under 3 mm in it at
+/// 5 cm/s): a contact point at `t` can then be judged against the finger
+/// (DropContactStreamsOffTheFinger; OnlineEstimator counts such contacts before it judges).
+bool FingerPoseNear(const std::vector<push::PoseSample>& finger_poses, double t);
+
 /// Refuses a trajectory the estimator cannot use (trajectory_checks.cpp; GraphError naming the
 /// stream, sample and value): missing shapes or streams, NaN, unsupported magnitudes, unsorted
 /// samples, clock jumps within or between streams.
@@ -511,6 +516,12 @@ void CheckStreamTimeUnits(const push::Trajectory& trajectory);
 /// A finger's pose or force stream that has no rows where the object moves more than 10 mm at
 /// the start or end of the push (a sensor that stopped, or started late). Null when there is none.
 std::optional<std::string> StreamCoverageNote(const push::Trajectory& trajectory);
+
+/// Where the object's tracker is silent for over 0.5 s (and 10 of its periods), an estimated
+/// object moving over 5 times as fast as the finger (plus 2 cm/s): a pushed object cannot outrun
+/// its pusher. The warning, worded by model and mode; nullopt when there is none.
+std::optional<std::string> UnobservedRunawayNote(const push::Trajectory& trajectory, const std::vector<StateEstimate>& states,
+                                                 Model model, Mode mode);
 /// A warning when the measured force does negative work on the object over the samples where it
 /// is above a quarter of its 95th percentile (f . v summed, v the finger's velocity over +-0.1 s):
 /// a quasi-static push takes positive work from the finger, so such a stream has its sign flipped

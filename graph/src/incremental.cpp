@@ -727,14 +727,14 @@ struct OnlineEstimator::Impl {
 
   // The batch's check that the contact points lie on their finger (Estimate's
   // DropContactStreamsOffTheFinger), per finger, once kContactCheckSamples of its contacts have a
-  // finger pose within kNearInTime (contacts older than `until` - kNearInTime: every pose near
-  // them has come). With one finger a stream off it (another frame, an offset) is left out from
+  // finger pose near them (internal::FingerPoseNear; counted once older than `until` - kNearInTime,
+  // when every pose near them has come). With one finger a stream off it (another frame, an offset) is left out from
   // then on and the steps so far solved again without it, before the shape check reads the
   // contacts; with several (one OnlineStreams flag gates them all) it is said. Online it was used
   // as given: a tactile stream 5 cm off moved the object estimate with it, and the shape check
   // blamed the shape.
   static constexpr std::size_t kContactCheckSamples = 10;
-  static constexpr double kNearInTime = 0.05;  // s, as the batch check
+  static constexpr double kNearInTime = 0.05;  // s, FingerPoseNear's window
   enum class ContactVerdict { kUndecided, kOnFinger, kOff };
   std::vector<ContactVerdict> contact_verdict;  // per finger
   std::vector<std::size_t> contacts_scanned, contacts_judgeable;  // per finger
@@ -767,11 +767,7 @@ struct OnlineEstimator::Impl {
       // Count once each contact whose nearby poses have all come.
       std::size_t& scanned = contacts_scanned[k];
       while (scanned < contacts.size() && (last || contacts[scanned].t <= until - kNearInTime)) {
-        const double t = contacts[scanned].t;
-        const auto after = std::lower_bound(poses.begin(), poses.end(), t, [](const push::PoseSample& p, double x) { return p.t < x; });
-        const bool near = (after != poses.end() && after->t - t <= kNearInTime) ||
-                          (after != poses.begin() && t - std::prev(after)->t <= kNearInTime);
-        contacts_judgeable[k] += near;
+        contacts_judgeable[k] += internal::FingerPoseNear(poses, contacts[scanned].t);
         ++scanned;
       }
       if (contacts_judgeable[k] < (last ? std::size_t{5} : kContactCheckSamples)) continue;

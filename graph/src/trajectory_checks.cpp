@@ -1110,9 +1110,13 @@ push::Trajectory WithObjectInMetres(const push::Trajectory& traj) {
   return judged;
 }
 
+bool FingerPoseNear(const std::vector<push::PoseSample>& finger_poses, double t) {
+  constexpr double kNearInTime = 0.05;  // s
+  return !finger_poses.empty() && std::abs(NearestInTime(finger_poses, t).t - t) <= kNearInTime;
+}
+
 std::optional<push::Trajectory> DropContactStreamsOffTheFinger(const push::Trajectory& traj,
                                                                const push::MeasurementSigmas& sigmas, std::string* note) {
-  constexpr double kNearInTime = 0.05;  // s: the finger moves under 3 mm in it at 5 cm/s
   constexpr double kLeastOffset = 5e-3;  // m
   constexpr std::size_t kLeastSamples = 5;
   // Three times the two noises combined (root sum of squares): pure noise has a median of 0.67 times it.
@@ -1124,7 +1128,7 @@ std::optional<push::Trajectory> DropContactStreamsOffTheFinger(const push::Traje
     if (poses.empty() || contacts.size() < kLeastSamples || finger.empty()) return false;
     std::vector<double> distances;
     for (const push::PointSample& c : contacts) {
-      if (std::abs(NearestInTime(poses, c.t).t - c.t) > kNearInTime) continue;
+      if (!FingerPoseNear(poses, c.t)) continue;
       // The finger's pose at the contact's time, interpolated (a 10 Hz tracker at 0.3 m/s moves
       // the finger 15 mm between its samples).
       const geometry::Pose2 pose = push::PoseAtClamped(poses.begin(), poses.end(), c.t);
@@ -1424,6 +1428,57 @@ void CheckStreamTimeUnits(const push::Trajectory& traj) {
                             "are its time stamps in %s? Trajectory times are in seconds",
                             t0, t1, span / finger_span, f0, f1, scale, unit));
   }
+}
+
+// Where the object's tracker is silent for a long stretch (over 0.5 s and 10 of its periods), the
+// estimated object moving much faster than its pusher: a pushed object cannot outrun the finger
+// (its speed at the contact is the finger's along the normal, and it turns about a point away
+// from it), so the estimate there is a local minimum of the pushing model. A hostile user's
+// 1.6 s gap in a 2 cm/s push: the batch QS object slid 52 mm along its edge (0.5 m/s) to put the
+// contact at a corner, 20.6 mm RMS against the tracker's 2.6, sigmas of 0.2 mm, and no word; the
+// incremental mode stayed at 1.0 mm.
+std::optional<std::string> UnobservedRunawayNote(const push::Trajectory& traj, const std::vector<StateEstimate>& states,
+                                                        Model model, Mode mode) {
+  constexpr double kSpeedRatio = 5.0, kSpeedFloor = 0.02;  // m/s
+  const auto& object = traj.measured.object_pose;
+  if (object.size() < 3 || states.size() < 3) return std::nullopt;
+  const double gap = std::max(0.5, 10.0 * MedianPeriod(object));
+  std::string said;
+  for (std::size_t i = 0; i + 1 < object.size(); ++i) {
+    const double a = object[i].t, b = object[i + 1].t;
+    if (!(b - a > gap)) continue;
+    // Speeds over at least kSpan s (a step's 4 ms would measure the estimate's own jitter).
+    constexpr double kSpan = 0.04;
+    auto j = std::lower_bound(states.begin(), states.end(), a, [](const StateEstimate& s, double t) { return s.t < t; });
+    auto k = j;
+    double object_speed = 0.0, finger_speed = 0.0, at = a;
+    for (; j != states.end(); ++j) {
+      if (k <= j) k = j + 1;
+      while (k != states.end() && k->t < j->t + kSpan) ++k;
+      if (k == states.end() || k->t > b) break;
+      const double dt = k->t - j->t;
+      const double v = (k->object_pose.translation() - j->object_pose.translation()).norm() / dt;
+      if (v > object_speed) object_speed = v, at = j->t;
+      finger_speed = std::max(finger_speed, (k->finger_pose.translation() - j->finger_pose.translation()).norm() / dt);
+    }
+    if (!(object_speed > kSpeedRatio * finger_speed + kSpeedFloor)) continue;
+    said += Format(
+        "%sbetween t = %.9g and %.9g s, where streams.object_pose has no sample, the estimated object moves at up to %.3g "
+        "m/s (at t = %.9g s) while the finger moves at most %.3g m/s",
+        said.empty() ? "" : "; ", a, b, object_speed, at, finger_speed);
+  }
+  if (said.empty()) return std::nullopt;
+  std::string why;
+  if (model == Model::kCp || model == Model::kSdf) {
+    why = "; CP and SDF have no pushing model to hold the object's motion to the finger's there (--model qs has one)";
+  } else if (mode == Mode::kBatch) {
+    why = "; it is a local minimum of the pushing model (D holds the object's direction of motion, not its speed): "
+          "--mode incremental, whose fixed-lag smoother follows the push through the gap, may not fall into it";
+  } else {
+    why = "; the fixed-lag smoother lost the object there (--mode batch solves the whole push at once)";
+  }
+  return "object unobserved: " + said + ": a pushed object cannot outrun its pusher, so the estimate there is wrong and its "
+         "sigmas understate the error" + why + "; samples of the tracker in that stretch would settle it";
 }
 
 std::optional<std::string> StreamCoverageNote(const push::Trajectory& traj) {
