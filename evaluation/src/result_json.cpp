@@ -113,6 +113,7 @@ Json ResultJson(const graph::EstimationResult& r, bool with_states) {
     if (r.mu_at_bound) parameters["mu_at_bound"] = true;
   }
   if (r.finger_scale != 1.0) parameters["finger_scale"] = r.finger_scale;
+  if (r.object_delay != 0.0) parameters["object_delay"] = r.object_delay;
   if (!r.finger_shift.isZero(0.0)) parameters["finger_transform"] = {r.finger_shift.x(), r.finger_shift.y(), 0.0};
   if (r.shape_alignment) {
     const graph::ShapeAlignment& a = *r.shape_alignment;

@@ -190,6 +190,10 @@ EstimatorConfig ParseEstimatorConfig(const std::string& json_text, const std::st
       cfg.covariance_method = ParseChoice<EstimatorConfig::CovarianceMethod>(
           *it, source, key, {{"selected_inversion", EstimatorConfig::CovarianceMethod::kSelectedInversion},
                              {"ceres", EstimatorConfig::CovarianceMethod::kCeres}});
+    } else if (key == "object_delay") {
+      if (!it->is_number()) Fail(source, key, "expected a number (seconds)");
+      cfg.object_delay = it->get<double>();
+      if (!std::isfinite(cfg.object_delay) || std::abs(cfg.object_delay) > 10.0) Fail(source, key, "must be within +-10 s");
     } else if (key == "align_shape") {
       cfg.align_shape = ParseChoice<EstimatorConfig::AlignShape>(
           *it, source, key, {{"auto", EstimatorConfig::AlignShape::kAuto},
@@ -284,6 +288,9 @@ void ValidateConfig(const EstimatorConfig& cfg) {
   for (const auto& [key, member] : LossFields()) CheckPositive((cfg.*member).scale, "losses." + key + ".scale");
   for (const auto& [key, member] : IntFields()) {
     if (cfg.*member < 1) throw GraphError("config key '" + key + "' must be >= 1");
+  }
+  if (!(std::isfinite(cfg.object_delay) && std::abs(cfg.object_delay) <= 10.0)) {
+    throw GraphError("config key 'object_delay' must be a delay in seconds within +-10");
   }
   if (cfg.incremental_update_every_steps < 0) {
     throw GraphError("config key 'incremental_update_every_steps' must be >= 1 (0: unset)");

@@ -75,6 +75,10 @@ TEST(Estimator, ConfigParsingNamesBadKeys) {
   EXPECT_NE(message("{").find("cfg.json"), std::string::npos);
   EXPECT_NE(message(R"({"contact_finger": "nearest"})").find("contact_finger"), std::string::npos);
   EXPECT_NE(message(R"({"limit_surface_load": true})").find("limit_surface_load"), std::string::npos);
+  EXPECT_EQ(ParseEstimatorConfig(R"({"object_delay": -0.15})").object_delay, -0.15);
+  EXPECT_NE(message(R"({"object_delay": "0.1"})").find("cfg.json: config key 'object_delay': expected a number"),
+            std::string::npos);
+  EXPECT_NE(message(R"({"object_delay": 11})").find("object_delay"), std::string::npos);
   const EstimatorConfig d = ParseEstimatorConfig(R"({"contact_finger": "boundary", "limit_surface_load": "on"})");
   EXPECT_EQ(d.contact_finger, EstimatorConfig::ContactFinger::kBoundary);
   const EstimatorConfig e = ParseEstimatorConfig(R"({"estimate_mu": true, "mu_prior_sigma": 0.5, "covariance_method": "ceres"})");

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 namespace pushgraph::cli {
 namespace {
@@ -31,6 +32,7 @@ struct EstimateOptions {
   std::uint64_t seed = 1;
   std::string svg;
   std::string align_shape;  // empty: the configuration's (default auto)
+  std::optional<double> object_delay;  // unset: the configuration's (default 0)
   bool trim = true;         // an MIT recording: its contact phase only
 };
 
@@ -82,6 +84,7 @@ void RunEstimate(const EstimateOptions& o) {
   if (traj.measurement_sigmas) config = graph::ApplyMeasurementSigmas(config, *traj.measurement_sigmas);
   if (!o.config.empty()) config = graph::LoadEstimatorConfig(o.config, config);
   if (!o.align_shape.empty()) config.align_shape = ParseAlignShape(o.align_shape);
+  if (o.object_delay) config.object_delay = *o.object_delay;
   if (!o.solver.empty()) {
     config.solver = o.solver == "ceres" ? graph::EstimatorConfig::Solver::kCeres : graph::EstimatorConfig::Solver::kChain;
   }
@@ -181,6 +184,10 @@ void RegisterEstimate(CLI::App& app) {
   sub->add_flag("--trim,!--no-trim", opts->trim,
                 "An MIT recording: keep only its contact phase (the default); --no-trim keeps every sample");
   AddAlignShapeOption(sub, &opts->align_shape);
+  sub->add_option("--object-delay", opts->object_delay,
+                  "The object tracker's latency (s): its time stamps minus the finger's clock, subtracted from the "
+                  "object_pose stream before estimating (default: the config's object_delay, 0)")
+      ->check(FiniteNumber(-10.0, true, "within +-10 s", 10.0));
   sub->callback([opts]() { RunEstimate(*opts); });
 }
 
