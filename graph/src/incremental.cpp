@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <deque>
 #include <chrono>
+#include <cstdlib>
 #include <iostream>
 #include <limits>
 #include <map>
@@ -72,11 +73,16 @@ double MedianObjectPeriod(const std::vector<push::PoseSample>& obj,
   return periods[periods.size() / 2];
 }
 
-// A time in an error message, to 17 digits (samples can be nanoseconds apart).
+// A time in a message, in the fewest digits that read back as the same double (samples can be
+// nanoseconds apart; 17 digits printed the update time 0.36 as 0.35999999999999999).
 std::string Precise(double t) {
   std::ostringstream o;
-  o.precision(17);
-  o << t;
+  for (int digits = 6; digits <= 17; ++digits) {
+    o.str("");
+    o.precision(digits);
+    o << t;
+    if (digits == 17 || std::strtod(o.str().c_str(), nullptr) == t) break;
+  }
   return o.str();
 }
 

@@ -23,6 +23,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <unordered_map>
 
@@ -381,6 +382,56 @@ std::vector<std::vector<int>> SnapSeams(const std::vector<std::vector<int>>& fac
   return out;
 }
 
+// A closed surface covers every point of its footprint an even number of times (a line along the
+// up axis leaves it as often as it enters: above and below), whatever its T-junctions, winding or
+// number of parts. At sample points (a point inside each of up to 200 projected faces, on no
+// face's edge) the projected faces are counted exactly; an odd count means faces are missing
+// there, and the footprint lacks whatever they alone covered (a block whose bottom and some top
+// faces were lost read as a smaller block, without a word). nullopt when every sample is even. A
+// flat outline (one sheet) is meant to cover once and is not asked (the caller skips it).
+std::optional<std::string> OddCoverage(const std::vector<Polygon2>& faces) {
+  namespace bg = boost::geometry;
+  namespace bgi = boost::geometry::index;
+  using BPoint = bg::model::point<double, 2, bg::cs::cartesian>;
+  using BBox = bg::model::box<BPoint>;
+  std::vector<std::pair<BBox, std::size_t>> boxes;
+  for (std::size_t f = 0; f < faces.size(); ++f) {
+    const CGAL::Bbox_2 b = faces[f].bbox();
+    boxes.emplace_back(BBox(BPoint(b.xmin(), b.ymin()), BPoint(b.xmax(), b.ymax())), f);
+  }
+  const bgi::rtree<std::pair<BBox, std::size_t>, bgi::rstar<16>> tree(boxes.begin(), boxes.end());
+  const std::size_t stride = std::max<std::size_t>(1, faces.size() / 200);
+  int samples = 0, odd = 0, first_count = 0;
+  Point first;
+  std::vector<std::pair<BBox, std::size_t>> near;
+  for (std::size_t f = 0; f < faces.size(); f += stride) {
+    const Polygon2& face = faces[f];
+    const Point c = CGAL::centroid(face[0], face[1], face[2]);
+    if (face.bounded_side(c) != CGAL::ON_BOUNDED_SIDE) continue;
+    const double x = CGAL::to_double(c.x()), y = CGAL::to_double(c.y());
+    near.clear();
+    tree.query(bgi::intersects(BPoint(x, y)), std::back_inserter(near));
+    int count = 0;
+    bool on_edge = false;
+    for (const auto& [box, g] : near) {
+      const CGAL::Bounded_side side = faces[g].bounded_side(c);
+      on_edge = on_edge || side == CGAL::ON_BOUNDARY;
+      count += side == CGAL::ON_BOUNDED_SIDE;
+    }
+    if (on_edge) continue;
+    ++samples;
+    if (count % 2 == 1 && odd++ == 0) first = c, first_count = count;
+  }
+  if (odd == 0) return std::nullopt;
+  std::ostringstream text;
+  text.precision(6);
+  text << "the mesh is not closed: the point (" << CGAL::to_double(first.x()) << ", " << CGAL::to_double(first.y())
+       << ") of its footprint is covered by " << first_count << " face" << (first_count == 1 ? "" : "s") << ", and " << odd
+       << " of " << samples << " sample points an odd number of times (a closed surface covers each point an even number "
+       << "of times, from above and below): faces are missing, and the footprint lacks whatever they alone covered";
+  return text.str();
+}
+
 // tinyobjloader reads any text and skips what it does not know: a glTF file read as "the mesh
 // has no faces", with no word of the format. (STL, PLY and OFF are read: mesh_soup.h.)
 void RefuseOtherMeshFormats(const std::string& path) {
@@ -527,6 +578,7 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
     return true;
   };
   std::vector<Polygon2> projected;
+  bool fanned = false;  // a face crossing itself was united as its fan of triangles
   for (std::size_t f = 0; f < faces.size(); ++f) {
     bool used = false;
     auto add = [&](Polygon2 polygon) {
@@ -546,6 +598,7 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
       } else {
         for (std::size_t k = 1; k + 1 < p.size(); ++k)
           if (CGAL::orientation(p[0], p[k], p[k + 1]) != CGAL::COLLINEAR) {
+            fanned = true;
             const Point tri[3] = {p[0], p[k], p[k + 1]};
             add(Polygon2(tri, tri + 3));
           }
@@ -640,6 +693,9 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
                     ", so seen along the up axis every face has zero area; --up " + axis_names[flat_axis] + " reads it");
     }
     throw IoError(path + ": every face has zero area seen along the up axis (wrong --up?)");
+  }
+  if (flat_axis < 0 && !fanned) {
+    if (const std::optional<std::string> open = OddCoverage(projected)) rep.warnings.push_back(*open);
   }
   CGAL::Polygon_set_2<K> set;
   set.join(projected.begin(), projected.end());

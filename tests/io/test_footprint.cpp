@@ -230,6 +230,44 @@ TEST_F(Footprint, UnionOfOverlappingAndOpenNonManifoldMeshes) {
   EXPECT_DOUBLE_EQ(io::MeshFootprint(frame, mm).core_area(), 8.0e-6);
 }
 
+// A closed surface covers each point of its footprint an even number of times; a mesh with faces
+// lost (a block's bottom, some of its top) is said to be open, whatever its vertex order or
+// T-junctions. The shipped MIT meshes are closed, and a flat outline (one sheet) is meant so.
+TEST_F(Footprint, AMeshWithFacesMissingIsSaidToBeOpen) {
+  auto open_warning = [](const io::FootprintReport& r) {
+    for (const std::string& w : r.warnings)
+      if (w.find("the mesh is not closed") != std::string::npos) return w;
+    return std::string();
+  };
+  const std::string vertices = "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\nv 0 0 1\nv 2 0 1\nv 2 1 1\nv 0 1 1\n";
+  const std::string sides = "f 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
+  // The top split in two at x = 1 (a T-junction on the bottom's long edges seen from above).
+  const std::string top = "v 1 0 1\nv 1 1 1\nf 5 9 10 8\nf 9 6 7 10\n";
+  io::FootprintReport closed, open, no_bottom;
+  io::MeshFootprint(Write("closed.obj", vertices + top + sides + "f 1 4 3 2\n"), {}, &closed);
+  EXPECT_EQ(open_warning(closed), "");
+  const geometry::Shape half = io::MeshFootprint(Write("open.obj", vertices + "v 1 0 1\nv 1 1 1\nf 5 9 10 8\n" + sides), {}, &open);
+  const std::string said = open_warning(open);
+  EXPECT_NE(said.find("covered by 1 face"), std::string::npos) << said;
+  EXPECT_DOUBLE_EQ(half.core_area(), 1.0);  // what the lost face alone covered is lacking
+  io::MeshFootprint(Write("no_bottom.obj", vertices + top + sides), {}, &no_bottom);
+  EXPECT_NE(open_warning(no_bottom).find("2 of 2 sample points"), std::string::npos) << open_warning(no_bottom);
+  io::FootprintReport flat;
+  io::MeshFootprint(Write("flat.obj", "v 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\nf 1 2 3 4\n"), {}, &flat);
+  EXPECT_EQ(open_warning(flat), "");
+  if (!SharedAvailable()) GTEST_SKIP() << "no MIT meshes";
+  for (const char* name : {"rect1", "rect2", "rect3", "ellip1", "ellip2", "tri1", "tri2", "tri3"}) {
+    io::FootprintReport r;
+    io::MeshFootprint(kObj + name + ".obj", {}, &r);
+    EXPECT_EQ(open_warning(r), "") << name;
+  }
+  io::FootprintOptions along_y;
+  along_y.up = io::UpAxis::kY;
+  io::FootprintReport tip;
+  io::MeshFootprint(kObj + "tip.obj", along_y, &tip);
+  EXPECT_EQ(open_warning(tip), "");
+}
+
 // Seams a rounding error wide. A ring of quads, each with its own vertices, closed at angle 2 pi
 // (sin 2 pi = -1.2e-17 where the first quad has 0), and a U of five boxes with T-junctions turned
 // by 37 degrees and written to 9 digits: the exact union kept each seam as a slit, the ring's hole

@@ -1,8 +1,9 @@
 #pragma once
 // The planar footprint of a mesh: its faces projected along an up axis and united exactly
 // (CGAL Boolean set operations, Epeck), holes and several parts kept, duplicate and collinear
-// vertices removed. Open and non-manifold meshes are fine (only the projected faces matter);
-// faces with zero projected area (the sides of a prism) are skipped.
+// vertices removed. Non-manifold meshes are fine (only the projected faces matter); an open one
+// is read but warned of (FootprintReport::warnings: where faces are missing, the footprint lacks
+// what they alone covered); faces with zero projected area (the sides of a prism) are skipped.
 //
 //   io::FootprintOptions options;
 //   options.up = io::UpAxis::kY;                       // e.g. a cylinder lying along y
@@ -40,8 +41,9 @@ struct FootprintReport {
   /// union keeps such a seam as a slit of that width.
   int vertices_snapped = 0;
   /// What the footprint may not be what was meant: several objects united (tri3.obj holds two
-  /// blocks), or a prism along another axis than `up` (its side view, e.g. tip.obj without
-  /// --up y: every vertex on the two end planes of another axis).
+  /// blocks), a prism along another axis than `up` (its side view, e.g. tip.obj without
+  /// --up y: every vertex on the two end planes of another axis), or a mesh that is not closed
+  /// (a point of the footprint covered by an odd number of faces; flat outlines are not asked).
   std::vector<std::string> warnings;
   /// The axes along which the mesh is a prism (every vertex on two end planes, at least three on
   /// each): an extruded outline, whose cross-section is its footprint along that axis.
