@@ -402,17 +402,11 @@ std::optional<push::Trajectory> CentredFinger(const push::Trajectory& traj, cons
   return centred;
 }
 
-// The object_pose stream with `delay` (s) subtracted from its time stamps (ground truth as is).
-push::Trajectory WithObjectDelay(const push::Trajectory& traj, double delay) {
-  push::Trajectory out = traj;
-  for (push::PoseSample& s : out.measured.object_pose) s.t -= delay;
-  return out;
-}
-
 // `unit_doubt`: what the input checks found of its units ("time stamps that read as
 // milliseconds", ...; null: nothing), under which no shape is aligned.
+// `applied_delay`: the object_delay Estimate applied (config's is then 0).
 EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model model, Mode mode,
-                                   const EstimatorConfig& config, const char* unit_doubt);
+                                   const EstimatorConfig& config, const char* unit_doubt, double applied_delay = 0.0);
 
 // The longest stretch of the trajectory without an object pose (up to the finger stream's end),
 // when it is a long gap (internal::LongObjectGap): CP and SDF have no pushing model, so nothing
@@ -580,14 +574,22 @@ static bool GroundTruthIsTheMeasurements(const push::Trajectory& t) {
   return same;
 }
 
-EstimationResult Estimate(const push::Trajectory& given, Model model, Mode mode, const EstimatorConfig& config) {
+EstimationResult Estimate(const push::Trajectory& given_as_recorded, Model model, Mode mode, const EstimatorConfig& config) {
   const auto call_start = std::chrono::steady_clock::now();
   ValidateConfig(config);
   // A finger file in other units, as the object's is under auto and on (the registration finds
   // the object's units): a user's CAD export of both in millimetres was refused for the finger alone.
   // Validated first but for the finger's size, which FingerUnits judges (its smoothing is no
   // place for a NaN or a clock jump).
-  internal::ValidateTrajectory(given, /*finger_size=*/false);
+  internal::ValidateTrajectory(given_as_recorded, /*finger_size=*/false);
+  // A tracker's latency (object_delay) first: every check below judges the streams in step. Applied
+  // once, here (the config passed on has none; IncrementalEstimator used directly applies its own).
+  const std::optional<push::Trajectory> delayed =
+      config.object_delay != 0.0 ? std::optional<push::Trajectory>(internal::WithObjectDelay(given_as_recorded, config.object_delay))
+                                 : std::nullopt;
+  const push::Trajectory& given = delayed ? *delayed : given_as_recorded;
+  EstimatorConfig in_step = config;
+  in_step.object_delay = 0.0;
   std::string finger_disks;
   const std::optional<push::Trajectory> disk_fingers = internal::TessellatedFingersAsDisks(given, config, &finger_disks);
   const push::Trajectory& as_disks = disk_fingers ? *disk_fingers : given;
@@ -637,9 +639,7 @@ EstimationResult Estimate(const push::Trajectory& given, Model model, Mode mode,
                            : force_bias      ? (force_bias->clock_offset ? "a force stream out of step with the contact stream"
                                                                              : "a force sensor that reads a force out of contact")
                                              : nullptr;
-  EstimationResult r = config.object_delay != 0.0
-                           ? EstimateValidated(WithObjectDelay(input, config.object_delay), model, mode, config, unit_doubt)
-                           : EstimateValidated(input, model, mode, config, unit_doubt);
+  EstimationResult r = EstimateValidated(input, model, mode, in_step, unit_doubt, config.object_delay);
   r.object_delay = config.object_delay;
   // A covariance failure was only in RESULT.json's solver.covariance (NEES NaN, nothing said).
   if (config.covariance && r.solver.covariance_status.find("failed") != std::string::npos)
@@ -745,7 +745,7 @@ namespace {
 bool Converged(const SolverStats& s) { return !s.stalled && !s.at_iteration_limit; }
 
 EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model model, Mode mode,
-                                   const EstimatorConfig& config, const char* unit_doubt) {
+                                   const EstimatorConfig& config, const char* unit_doubt, double applied_delay) {
   using Align = EstimatorConfig::AlignShape;
   // The shape against the recording: the check, then registration where asked or needed.
   ShapeAlignment alignment;
@@ -1234,9 +1234,12 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
       // shape does, and one push cannot tell them apart (docs/estimation.md): a simulated push 0.1
       // to 0.3 s late had the true notched block "aligned" by turns of 84 to 108 degrees, and a
       // real rect1 recording 0.15 s late by (2.0, 4.2) mm, settled (2.29 mm against 1.91 raw).
-      if (config.object_delay == 0.0)
-        also += "; if the shape file is right, an object tracker running late against the finger (a camera's latency) "
-                "misplaces the contacts alike: --object-delay SECONDS (object_delay) shifts its time stamps";
+      also += applied_delay != 0.0
+                  ? internal::Format("; the object's time stamps were moved %.6g s earlier (object_delay): if the shape "
+                                     "file is right, a wrong delay misplaces the contacts alike", applied_delay)
+                  : std::string("; if the shape file is right, an object tracker running late against the finger (a "
+                                "camera's latency) misplaces the contacts alike: --object-delay SECONDS (object_delay) "
+                                "shifts its time stamps");
       warnings.push_back(what + "; " + AlignedText(*registration, alignment) + also);
     } else if (misfit && unit_gate) {
       warnings.push_back(what + "; not aligned on " + unit_doubt + " (warned above): fix that, then estimate "

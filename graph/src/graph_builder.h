@@ -563,6 +563,11 @@ std::optional<std::string> ShapeSizeNote(const push::Trajectory& trajectory);
 /// centroid (a CAD export): what the finger's own checks (FingerUnits, the finger's origin) judge
 /// the finger against, before the registration finds the object's units.
 push::Trajectory WithObjectInMetres(const push::Trajectory& trajectory);
+/// EstimatorConfig::object_delay: `delay` (s) subtracted from every measured object_pose stamp,
+/// and from the ground truth's object poses too where they carry exactly the measured stream's
+/// stamps (the tracker's own record, as mit-import and --add-noise keep: late like it); a
+/// simulator's truth on its own clock stays.
+push::Trajectory WithObjectDelay(const push::Trajectory& trajectory, double delay);
 /// Finger shape files in other units (align_shape auto and on): a finger whose origin lies
 /// deeper inside it than the whole push reaches (ValidateTrajectory refuses it), or whose file
 /// reaches over 1 m from its origin, is read in the unit (millimetres, centimetres, inches) that

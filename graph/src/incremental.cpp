@@ -525,6 +525,7 @@ struct FixedLagSmoother {
     }
     total_update_time += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     EstimationResult r;
+    r.object_delay = cfg.object_delay;  // 0 from Estimate, which applied it and says so itself
     r.model = builder.model();
     r.mode = Mode::kIncremental;
     r.states.assign(states.begin(), states.begin() + next_step);
@@ -632,18 +633,22 @@ struct IncrementalEstimator::Impl {
   std::vector<double> triggers;
   std::size_t next_trigger = 0;
 
-  static std::optional<push::Trajectory> Prepare(const push::Trajectory& traj, const EstimatorConfig& cfg,
+  static std::optional<push::Trajectory> Prepare(const push::Trajectory& given, const EstimatorConfig& cfg,
                                                  std::string* disks_note, std::string* contacts_note) {
+    // A tracker's latency (object_delay): the object's stamps moved back first, as Estimate does.
+    std::optional<push::Trajectory> delayed;
+    if (cfg.object_delay != 0.0) delayed = internal::WithObjectDelay(given, cfg.object_delay);
+    const push::Trajectory& traj = delayed ? *delayed : given;
     std::optional<push::Trajectory> disks = internal::TessellatedFingersAsDisks(traj, cfg, disks_note);
     std::optional<push::Trajectory> without_contacts =
         internal::DropContactStreamsOffTheFinger(disks ? *disks : traj, cfg.measurement, contacts_note);
-    return without_contacts ? std::move(without_contacts) : std::move(disks);
+    return without_contacts ? std::move(without_contacts) : disks ? std::move(disks) : std::move(delayed);
   }
 
   Impl(const push::Trajectory& traj, Model model, const EstimatorConfig& cfg)
       : prepared(Prepare(traj, cfg, &finger_disks, &contact_note)),
         smoother(prepared ? *prepared : traj, model, cfg, nullptr) {
-    const auto& obj = traj.measured.object_pose;
+    const auto& obj = (prepared ? *prepared : traj).measured.object_pose;
     const auto& steps = smoother.builder.steps();
     double period = MedianObjectPeriod(obj);
     if (!(period > 0.0)) {
@@ -1101,8 +1106,11 @@ struct OnlineEstimator::Impl {
                             ? max_latency
                             : std::max(max_latency, 1.5 * smoother->cfg.incremental_update_every * object_period);
     double settled = newest_t;
-    for (double t : last_seen) {
-      if (std::isfinite(t) && newest_t - t <= live) settled = std::min(settled, t);
+    for (std::size_t k = 0; k < last_seen.size(); ++k) {
+      const double t = last_seen[k];
+      // A late tracker's poses (object_delay, stream 0) are behind the rest by the delay itself.
+      const double allowed = live + (k == 0 ? std::max(0.0, smoother->cfg.object_delay) : 0.0);
+      if (std::isfinite(t) && newest_t - t <= allowed) settled = std::min(settled, t);
     }
     return settled;
   }
@@ -1146,7 +1154,10 @@ OnlineEstimator::OnlineEstimator(const push::Trajectory& setup, Model model, con
     : impl_(std::make_unique<Impl>(setup, model, config, streams)) {}
 OnlineEstimator::~OnlineEstimator() = default;
 
-bool OnlineEstimator::AddObjectPose(double t, const geometry::Pose2& pose) {
+bool OnlineEstimator::AddObjectPose(double stamp, const geometry::Pose2& pose) {
+  // A tracker's latency (object_delay): the pose belongs to its stamp minus the delay (errors and
+  // the stream's liveness, Impl::SettledTime, speak of that time).
+  const double t = stamp - impl_->smoother->cfg.object_delay;
   if (!impl_->Accept(0, "object_pose", t, pose.vector().allFinite())) return false;
   impl_->traj.measured.object_pose.push_back({t, pose});
   impl_->object_period = MedianObjectPeriod(impl_->traj.measured.object_pose, Impl::kRecentPeriods);

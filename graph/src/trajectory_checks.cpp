@@ -1110,6 +1110,21 @@ push::Trajectory WithObjectInMetres(const push::Trajectory& traj) {
   return judged;
 }
 
+push::Trajectory WithObjectDelay(const push::Trajectory& traj, double delay) {
+  push::Trajectory out = traj;
+  std::vector<push::PoseSample>& measured = out.measured.object_pose;
+  if (out.ground_truth) {
+    std::vector<push::PoseSample>& truth = out.ground_truth->object_pose;
+    const bool same_stamps = truth.size() == measured.size() &&
+                             std::equal(truth.begin(), truth.end(), measured.begin(),
+                                        [](const push::PoseSample& a, const push::PoseSample& b) { return a.t == b.t; });
+    if (same_stamps && !truth.empty())
+      for (push::PoseSample& s : truth) s.t -= delay;
+  }
+  for (push::PoseSample& s : measured) s.t -= delay;
+  return out;
+}
+
 bool FingerPoseNear(const std::vector<push::PoseSample>& finger_poses, double t) {
   constexpr double kNearInTime = 0.05;  // s
   return !finger_poses.empty() && std::abs(NearestInTime(finger_poses, t).t - t) <= kNearInTime;

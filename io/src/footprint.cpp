@@ -387,8 +387,10 @@ std::vector<std::vector<int>> SnapSeams(const std::vector<std::vector<int>>& fac
 // number of parts. At sample points (a point inside each of up to 200 projected faces, on no
 // face's edge) the projected faces are counted exactly; an odd count means faces are missing
 // there, and the footprint lacks whatever they alone covered (a block whose bottom and some top
-// faces were lost read as a smaller block, without a word). nullopt when every sample is even. A
-// flat outline (one sheet) is meant to cover once and is not asked (the caller skips it).
+// faces were lost read as a smaller block, without a word), or a face inside the solid (two boxes
+// sharing one face written once). nullopt when every sample is even. A flat outline (one sheet)
+// is meant to cover once and is not asked, nor a mesh with a face crossing itself (united as a
+// fan of overlapping triangles): the caller skips both.
 std::optional<std::string> OddCoverage(const std::vector<Polygon2>& faces) {
   namespace bg = boost::geometry;
   namespace bgi = boost::geometry::index;
@@ -400,7 +402,7 @@ std::optional<std::string> OddCoverage(const std::vector<Polygon2>& faces) {
     boxes.emplace_back(BBox(BPoint(b.xmin(), b.ymin()), BPoint(b.xmax(), b.ymax())), f);
   }
   const bgi::rtree<std::pair<BBox, std::size_t>, bgi::rstar<16>> tree(boxes.begin(), boxes.end());
-  const std::size_t stride = std::max<std::size_t>(1, faces.size() / 200);
+  const std::size_t stride = std::max<std::size_t>(1, (faces.size() + 199) / 200);
   int samples = 0, odd = 0, first_count = 0;
   Point first;
   std::vector<std::pair<BBox, std::size_t>> near;
@@ -425,10 +427,11 @@ std::optional<std::string> OddCoverage(const std::vector<Polygon2>& faces) {
   if (odd == 0) return std::nullopt;
   std::ostringstream text;
   text.precision(6);
-  text << "the mesh is not closed: the point (" << CGAL::to_double(first.x()) << ", " << CGAL::to_double(first.y())
-       << ") of its footprint is covered by " << first_count << " face" << (first_count == 1 ? "" : "s") << ", and " << odd
-       << " of " << samples << " sample points an odd number of times (a closed surface covers each point an even number "
-       << "of times, from above and below): faces are missing, and the footprint lacks whatever they alone covered";
+  text << "the mesh is not closed, or holds inner or duplicate faces: the point (" << CGAL::to_double(first.x()) << ", "
+       << CGAL::to_double(first.y()) << ") of its footprint is covered by " << first_count << " face"
+       << (first_count == 1 ? "" : "s") << ", and " << odd << " of " << samples
+       << " sample points an odd number of times (a closed surface covers each point an even number of times, from above "
+       << "and below): where faces are missing, the footprint lacks what they alone covered";
   return text.str();
 }
 
@@ -607,6 +610,9 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
     rep.faces_used += used;
   }
   int flat_axis = -1;  // the axis across which every used vertex lies in one plane, if any
+  // Within 1e-6 of its size along the up axis: a sheet (an outline drawn flat, or tilted by a
+  // rounding: 1e-7 across 0.1 m), whose faces cover the footprint once by design.
+  bool thin_along_up = false;
   {
     std::vector<std::string> with_faces;
     std::vector<char> used(nv, 0);
@@ -643,6 +649,7 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
       if (hi[a] - lo[a] <= tolerance && hi[a] >= lo[a]) flat_axis = a;
     }
     if (flat_axis >= 0) rep.flat_axis = flat_axis == 0 ? UpAxis::kX : flat_axis == 1 ? UpAxis::kY : UpAxis::kZ;
+    thin_along_up = !(hi[up] - lo[up] > 1e3 * tolerance);  // tolerance is 1e-9 of the size
     for (int a = 0; a < 3 && flat_axis < 0; ++a) {
       bool on_ends = hi[a] > lo[a];
       int at_lo = 0, at_hi = 0;  // an end face needs three vertices (a lone triangle is no prism)
@@ -694,7 +701,7 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
     }
     throw IoError(path + ": every face has zero area seen along the up axis (wrong --up?)");
   }
-  if (flat_axis < 0 && !fanned) {
+  if (!thin_along_up && !fanned) {
     if (const std::optional<std::string> open = OddCoverage(projected)) rep.warnings.push_back(*open);
   }
   CGAL::Polygon_set_2<K> set;

@@ -142,10 +142,12 @@ struct EstimatorConfig {
   enum class AlignShape { kAuto, kOn, kOff };
   AlignShape align_shape = AlignShape::kAuto;
   /// The object tracker's latency (s): its time stamps minus the clock of the finger, contact
-  /// and force streams, subtracted from every object_pose stamp before estimating (ground truth
-  /// as is). A camera's 0.1 to 0.3 s is typical; it is not estimated: on a straight push a late
-  /// tracker and a shape file shifted along the push fit the contacts alike (docs/estimation.md,
-  /// Shape registration). Within +-10 s; JSON "object_delay" (s); --object-delay.
+  /// and force streams, subtracted from every object_pose stamp before anything else (Estimate,
+  /// IncrementalEstimator, OnlineEstimator::AddObjectPose), and from the ground truth's object
+  /// poses where they carry the measured stream's own stamps (a recording's, late like it). A
+  /// camera's 0.1 to 0.3 s is typical; it is not estimated: on a straight push a late tracker and
+  /// a shape file shifted along the push fit the contacts alike (docs/estimation.md, Shape
+  /// registration). Within +-10 s; JSON "object_delay" (s); --object-delay.
   double object_delay = 0.0;
   /// Also estimate a continuous scale factor (disk fingers) when aligning; the units (m, cm, mm,
   /// inch) and a mirrored file are always detected.

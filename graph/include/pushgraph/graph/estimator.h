@@ -172,9 +172,8 @@ struct EstimationResult {
   /// it and not as given, or clearly closer, minus the shape's centroid (said in the warnings).
   /// RESULT.json parameters.finger_transform [x, y, 0], written when not zero.
   geometry::Vec2 finger_shift = geometry::Vec2::Zero();
-  /// The delay (s) subtracted from the object_pose stream's time stamps: config.object_delay, or
-  /// with it unset the one graph::FitObjectDelay found (said in the warnings); 0: as recorded.
-  /// RESULT.json parameters.object_delay, written when not 0.
+  /// The delay (s) subtracted from the object_pose stream's time stamps (config.object_delay);
+  /// 0: as recorded. RESULT.json parameters.object_delay, written when not 0.
   double object_delay = 0.0;
   /// The shape check and alignment (RESULT.json parameters.shape_transform and "shape").
   std::optional<ShapeAlignment> shape_alignment;
