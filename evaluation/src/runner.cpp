@@ -130,6 +130,7 @@ std::string EvaluationOptions::SettingsJson() const {
   j["occlusion_mode"] = graph::ModeName(occlusion_mode);
   const char* align[] = {"auto", "on", "off"};
   j["align_shape"] = align[static_cast<int>(estimator.align_shape)];
+  if (estimator.object_delay != 0.0) j["object_delay"] = estimator.object_delay;
   j["simulate"] = {{"count", simulation.count},          {"name", simulation.name},
                    {"push_distance", simulation.push_distance}, {"speed", simulation.speed},
                    {"offset_fraction", simulation.offset_fraction}, {"mass", simulation.object.mass},
