@@ -404,9 +404,8 @@ std::optional<push::Trajectory> CentredFinger(const push::Trajectory& traj, cons
 
 // `unit_doubt`: what the input checks found of its units ("time stamps that read as
 // milliseconds", ...; null: nothing), under which no shape is aligned.
-// `applied_delay`: the object_delay Estimate applied (config's is then 0).
 EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model model, Mode mode,
-                                   const EstimatorConfig& config, const char* unit_doubt, double applied_delay = 0.0);
+                                   const EstimatorConfig& config, const char* unit_doubt);
 
 // The longest stretch of the trajectory without an object pose (up to the finger stream's end),
 // when it is a long gap (internal::LongObjectGap): CP and SDF have no pushing model, so nothing
@@ -583,13 +582,11 @@ EstimationResult Estimate(const push::Trajectory& given_as_recorded, Model model
   // place for a NaN or a clock jump).
   internal::ValidateTrajectory(given_as_recorded, /*finger_size=*/false);
   // A tracker's latency (object_delay) first: every check below judges the streams in step. Applied
-  // once, here (the config passed on has none; IncrementalEstimator used directly applies its own).
+  // once, here (the incremental mode's IncrementalEstimator, which applies its own, gets none).
   const std::optional<push::Trajectory> delayed =
       config.object_delay != 0.0 ? std::optional<push::Trajectory>(internal::WithObjectDelay(given_as_recorded, config.object_delay))
                                  : std::nullopt;
   const push::Trajectory& given = delayed ? *delayed : given_as_recorded;
-  EstimatorConfig in_step = config;
-  in_step.object_delay = 0.0;
   std::string finger_disks;
   const std::optional<push::Trajectory> disk_fingers = internal::TessellatedFingersAsDisks(given, config, &finger_disks);
   const push::Trajectory& as_disks = disk_fingers ? *disk_fingers : given;
@@ -639,7 +636,7 @@ EstimationResult Estimate(const push::Trajectory& given_as_recorded, Model model
                            : force_bias      ? (force_bias->clock_offset ? "a force stream out of step with the contact stream"
                                                                              : "a force sensor that reads a force out of contact")
                                              : nullptr;
-  EstimationResult r = EstimateValidated(input, model, mode, in_step, unit_doubt, config.object_delay);
+  EstimationResult r = EstimateValidated(input, model, mode, config, unit_doubt);
   r.object_delay = config.object_delay;
   // A covariance failure was only in RESULT.json's solver.covariance (NEES NaN, nothing said).
   if (config.covariance && r.solver.covariance_status.find("failed") != std::string::npos)
@@ -745,7 +742,7 @@ namespace {
 bool Converged(const SolverStats& s) { return !s.stalled && !s.at_iteration_limit; }
 
 EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model model, Mode mode,
-                                   const EstimatorConfig& config, const char* unit_doubt, double applied_delay) {
+                                   const EstimatorConfig& config, const char* unit_doubt) {
   using Align = EstimatorConfig::AlignShape;
   // The shape against the recording: the check, then registration where asked or needed.
   ShapeAlignment alignment;
@@ -1173,7 +1170,9 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
     }
   } else if (mode != Mode::kBatch) {
     // Fixed-lag smoothing keeps the registered frame fixed (no static variable in the window).
-    IncrementalEstimator inc(*working, model, config);
+    EstimatorConfig in_step = config;
+    in_step.object_delay = 0.0;  // Estimate applied it to the streams already
+    IncrementalEstimator inc(*working, model, in_step);
     while (!inc.Done()) inc.Update();
     result = inc.Finish();
   }
@@ -1234,9 +1233,9 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
       // shape does, and one push cannot tell them apart (docs/estimation.md): a simulated push 0.1
       // to 0.3 s late had the true notched block "aligned" by turns of 84 to 108 degrees, and a
       // real rect1 recording 0.15 s late by (2.0, 4.2) mm, settled (2.29 mm against 1.91 raw).
-      also += applied_delay != 0.0
+      also += config.object_delay != 0.0
                   ? internal::Format("; the object's time stamps were moved %.6g s earlier (object_delay): if the shape "
-                                     "file is right, a wrong delay misplaces the contacts alike", applied_delay)
+                                     "file is right, a wrong delay misplaces the contacts alike", config.object_delay)
                   : std::string("; if the shape file is right, an object tracker running late against the finger (a "
                                 "camera's latency) misplaces the contacts alike: --object-delay SECONDS (object_delay) "
                                 "shifts its time stamps");
