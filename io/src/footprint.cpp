@@ -703,6 +703,11 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
   }
   if (!thin_along_up && !fanned) {
     if (const std::optional<std::string> open = OddCoverage(projected)) rep.warnings.push_back(*open);
+  } else if (!thin_along_up) {
+    // A fan's triangles overlap where the outline crosses itself, so coverage parity says nothing.
+    rep.warnings.push_back("whether the mesh is closed was not checked: a face crossing itself (its fan of triangles "
+                           "overlaps itself) spoils the count of faces over each footprint point; a face missing "
+                           "elsewhere would go unseen");
   }
   CGAL::Polygon_set_2<K> set;
   set.join(projected.begin(), projected.end());
