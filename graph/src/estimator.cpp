@@ -704,7 +704,7 @@ EstimationResult Estimate(const push::Trajectory& given_as_recorded, Model model
   if (without_contacts) front.push_back(contact_note);
   add(force_direction);
   if (force_bias) front.push_back(force_bias->text);
-  add(internal::ForceScaleNote(input, config.measurement.force));
+  add(internal::ForceScaleNote(input, config.measurement.force, config.estimate_mu));
   add(internal::MeasurementSigmaNote(input, config.measurement));
   r.warnings.insert(r.warnings.begin(), front.begin(), front.end());
   if (auto unobserved = UnobservedObjectNote(trajectory, model)) r.warnings.push_back(*unobserved);

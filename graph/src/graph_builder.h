@@ -542,7 +542,10 @@ std::optional<ForceOutOfContactNote> ForceBiasNote(const push::Trajectory& traje
 /// A warning when the measured forces' 95th percentile is over 20 times the object's friction load
 /// mu m g (and 5 force sigmas), or their fifth largest under 1/20 of it while the object moves over
 /// 1 cm (a quasi-static push needs about that load): another force unit, or a wrong mass or mu.
-std::optional<std::string> ForceScaleNote(const push::Trajectory& trajectory, double force_sigma);
+/// Where the object moves: the forces' upper quartile under a quarter of the load (kgf), or their
+/// lower quartile over twice it (a sensor's gain, or a mass or mu too small; not asked when
+/// `mu_estimated`, the fit then sizing mu_surface to the forces).
+std::optional<std::string> ForceScaleNote(const push::Trajectory& trajectory, double force_sigma, bool mu_estimated);
 /// The object and finger pose streams without their tracker glitches (the finger's floor 2 cm): samples more than max(1 cm, 10 scatters)
 /// or max(0.3 rad, 10 scatters) from the median of a window centred on them (+-max(0.1 s, 3
 /// periods)), when they are at most a tenth of the stream (more is the stream itself, left to the

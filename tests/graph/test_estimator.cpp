@@ -554,6 +554,32 @@ TEST(Estimator, ForcesOrAMassInAnotherUnitAreNamed) {
   push::Trajectory third = longer;
   for (auto& f : third.measured.force) f.force /= 3.0;
   EXPECT_FALSE(HasWarning(Estimate(third, Model::kCp, Mode::kBatch), "is the force in kgf"));
+  // Too large by a smaller factor than 20: quasi-static sliding needs at most the load, so forces
+  // 3 times it while the object moves are named (they were estimated as they stood); 1.5 times not.
+  EXPECT_FALSE(HasWarning(Estimate(longer, Model::kCp, Mode::kBatch), "though quasi-static sliding needs at most"));
+  for (const double gain : {3.0, 10.0}) {
+    push::Trajectory high = longer;
+    for (auto& f : high.measured.force) f.force *= gain;
+    const EstimationResult r = Estimate(high, Model::kQs, Mode::kBatch);
+    EXPECT_TRUE(HasWarning(r, "though quasi-static sliding needs at most the load: is the force sensor's scale off")) << gain;
+  }
+  push::Trajectory half_again = longer;
+  for (auto& f : half_again.measured.force) f.force *= 1.5;
+  EXPECT_FALSE(HasWarning(Estimate(half_again, Model::kCp, Mode::kBatch), "though quasi-static sliding needs at most"));
+  push::Trajectory light = longer;  // the mass, not the sensor: the same words
+  light.object.mass /= 3.0;
+  EXPECT_TRUE(HasWarning(Estimate(light, Model::kCp, Mode::kBatch), "or the mass or mu_surface too small"));
+  // Fitting mu_surface sizes it to the forces: not asked then (the fit is reported).
+  EstimatorConfig fit_mu;
+  fit_mu.estimate_mu = true;
+  fit_mu.mu_prior_sigma = 1.0;
+  push::Trajectory low_mu = longer;
+  low_mu.object.mu_surface /= 3.0;
+  EXPECT_TRUE(HasWarning(Estimate(low_mu, Model::kQs, Mode::kBatch), "or the mass or mu_surface too small"));
+  const EstimationResult fitted = Estimate(low_mu, Model::kQs, Mode::kBatch, fit_mu);
+  EXPECT_FALSE(HasWarning(fitted, "though quasi-static sliding needs at most"));
+  ASSERT_TRUE(fitted.mu.has_value());
+  EXPECT_NEAR(*fitted.mu, longer.object.mu_surface, 0.1 * longer.object.mu_surface);
 }
 
 // Tracker glitches (a sample 10 cm off among 25 Hz object poses) are left out with a warning
