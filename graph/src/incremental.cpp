@@ -642,6 +642,11 @@ struct IncrementalEstimator::Impl {
     std::optional<push::Trajectory> disks = internal::TessellatedFingersAsDisks(traj, cfg, disks_note);
     std::optional<push::Trajectory> without_contacts =
         internal::DropContactStreamsOffTheFinger(disks ? *disks : traj, cfg.measurement, contacts_note);
+    std::string faults_note;
+    std::optional<push::Trajectory> without_faults = internal::DropContactRowFaults(
+        without_contacts ? *without_contacts : disks ? *disks : traj, cfg.measurement, &faults_note);
+    if (without_faults) *contacts_note += (contacts_note->empty() ? "" : "; ") + faults_note;
+    if (without_faults) return without_faults;
     return without_contacts ? std::move(without_contacts) : disks ? std::move(disks) : std::move(delayed);
   }
 
@@ -727,7 +732,64 @@ struct OnlineEstimator::Impl {
   double recent_p95 = 0.0;  // of recent_force, refreshed every 32 samples (a selection of 512: ~2 us)
   std::size_t since_p95 = 0;
   int dropped_faults = 0;
-  std::string first_fault;
+  // Per kind of sample left out as a fault ("force sample", "object_pose sample", "contact_point
+  // row"): how many, why, and the first (Finish() names each kind).
+  struct Faults {
+    int count = 0;
+    std::string why, first;
+  };
+  std::map<std::string, Faults> faults;
+  void Fault(const std::string& kind, const std::string& why, const std::string& first) {
+    ++dropped_faults;
+    Faults& f = faults[kind];
+    if (f.count++ == 0) f.why = why, f.first = first;
+  }
+  // Object tracker glitches (the batch rule's end-of-stream form, DropObjectPoseGlitches): a pose
+  // farther from the median of the five accepted before it than max(1 cm, 10 sigmas) (0.3 rad) plus twice their
+  // motion plus their speed times the time since, when those five lie within 0.5 s of it. One
+  // pose 5 m off pulled the online estimate 10 cm past where the object ever went, with no word.
+  // Three left out in a row that agree with one another are a step of the tracker (a
+  // re-initialization), not glitches: the third and those after it are taken.
+  std::vector<push::PoseSample> pending_glitches;
+  static constexpr double kGlitchFloor = 0.01, kGlitchAngle = 0.3, kGlitchWindow = 0.5;  // m, rad, s
+  static constexpr std::size_t kStepSamples = 3;
+  bool ObjectPoseGlitch(double t, const geometry::Pose2& pose, double* off) {
+    const auto& s = traj.measured.object_pose;
+    if (s.size() < 5 || t - s[s.size() - 5].t > kGlitchWindow) return false;
+    std::vector<double> xs, ys, as;
+    for (std::size_t k = s.size() - 5; k < s.size(); ++k) {
+      xs.push_back(s[k].pose.x), ys.push_back(s[k].pose.y);
+      as.push_back(std::remainder(s[k].pose.theta - pose.theta, 2.0 * M_PI));
+    }
+    const push::PoseSample &near = s.back(), &far = s[s.size() - 5];
+    const double motion = (near.pose.translation() - far.pose.translation()).norm();
+    const double turn = std::abs(std::remainder(near.pose.theta - far.pose.theta, 2.0 * M_PI));
+    const double span = std::max(near.t - far.t, 1e-9), ahead = t - near.t;
+    // Ten of the tracker's sigmas at least (the batch's ten scatters): with the paper's 5 mm
+    // noise a 1 cm floor is two sigmas.
+    const push::MeasurementSigmas& sigma = smoother->cfg.measurement;
+    const double floor = std::max(kGlitchFloor, 10.0 * sigma.object_trans), floor_angle = std::max(kGlitchAngle, 10.0 * sigma.object_rot);
+    *off = std::hypot(pose.x - internal::Median(xs), pose.y - internal::Median(ys));
+    const bool glitch = *off > floor + 2.0 * motion + motion / span * ahead ||
+                        std::abs(internal::Median(as)) > floor_angle + 2.0 * turn + turn / span * ahead;
+    if (!glitch) {
+      pending_glitches.clear();
+      return false;
+    }
+    // A step: agrees with the glitches just before it (within the floor plus their own motion).
+    if (!pending_glitches.empty()) {
+      const push::PoseSample& last = pending_glitches.back();
+      const bool agrees = (pose.translation() - last.pose.translation()).norm() <= floor + motion / span * (t - last.t) &&
+                          std::abs(std::remainder(pose.theta - last.pose.theta, 2.0 * M_PI)) <= floor_angle;
+      if (!agrees) pending_glitches.clear();
+    }
+    pending_glitches.push_back({t, pose});
+    if (pending_glitches.size() >= kStepSamples) {
+      pending_glitches.clear();
+      return false;
+    }
+    return true;
+  }
   bool finished = false;
   // The batch's check that a touching finger is near the object (trajectory_checks.cpp), per
   // finger at its first touch: its first contact point, or the first force sample the estimator's
@@ -1038,7 +1100,10 @@ struct OnlineEstimator::Impl {
                      "setup[\"fingers\"][k - 1] in Python)");
   }
 
-  bool Accept(int stream, const char* name, double t, bool finite) {
+  // `magnitude` within `bound` (positions within geometry::kMaxCoordinate, forces within 1e9 N,
+  // the batch reader's bounds): one position of 1e20 m was taken, and every update after it
+  // failed in the geometry with no word of which sample.
+  bool Accept(int stream, const char* name, double t, bool finite, double magnitude = 0.0, double bound = INFINITY) {
     const std::size_t index = seen[stream];
     auto where = [&] {
       return "OnlineEstimator: streams." + (stream >= 4 ? "fingers[" + std::to_string((stream - 1) / 3) + "]." : std::string()) + name + "[" +
@@ -1050,6 +1115,10 @@ struct OnlineEstimator::Impl {
                        "arguments in Python): it decides contact gating and the load factor");
     }
     if (!std::isfinite(t) || !finite) throw GraphError(where() + " is not finite");
+    if (magnitude > bound) {
+      throw GraphError(where() + " is out of the supported range (" + Precise(magnitude) + (bound > 1e8 ? " N" : " m") +
+                       "; positions within 1e6 m, forces within 1e9 N): a corrupt sample? It is not taken");
+    }
     // The trajectory's bound (|t| <= 1e11 s: epoch seconds): one wild first time stamp (-1e300)
     // was accepted and every later sample then refused as a clock jump.
     if (std::abs(t) > push::kMaxTimeStamp) {
@@ -1158,7 +1227,16 @@ bool OnlineEstimator::AddObjectPose(double stamp, const geometry::Pose2& pose) {
   // A tracker's latency (object_delay): the pose belongs to its stamp minus the delay (errors and
   // the stream's liveness, Impl::SettledTime, speak of that time).
   const double t = stamp - impl_->smoother->cfg.object_delay;
-  if (!impl_->Accept(0, "object_pose", t, pose.vector().allFinite())) return false;
+  const std::size_t index = impl_->seen[0];
+  if (!impl_->Accept(0, "object_pose", t, pose.vector().allFinite(), pose.translation().cwiseAbs().maxCoeff(),
+                     geometry::kMaxCoordinate))
+    return false;
+  double off = 0.0;
+  if (impl_->ObjectPoseGlitch(t, pose, &off)) {
+    impl_->Fault("object_pose sample", "tracker glitches: more than max(1 cm, 10 sigmas) or max(0.3 rad, 10 sigmas), plus the recent motion, from the median of the five poses before",
+                 internal::Format("object_pose[%zu] at t = %s s, %.3g mm off", index, Precise(t).c_str(), 1e3 * off));
+    return false;
+  }
   impl_->traj.measured.object_pose.push_back({t, pose});
   impl_->object_period = MedianObjectPeriod(impl_->traj.measured.object_pose, Impl::kRecentPeriods);
   return true;
@@ -1170,15 +1248,36 @@ bool OnlineEstimator::AddForce(double t, const geometry::Vec2& force) { return A
 bool OnlineEstimator::AddFingerPose(double t, int finger, const geometry::Pose2& pose) {
   Impl& m = *impl_;
   const int stream = m.FingerStream(finger, 0, "AddFingerPose");
-  if (!m.Accept(stream, "finger_pose", t, pose.vector().allFinite())) return false;
+  if (!m.Accept(stream, "finger_pose", t, pose.vector().allFinite(), pose.translation().cwiseAbs().maxCoeff(),
+                geometry::kMaxCoordinate))
+    return false;
   (finger == 0 ? m.traj.measured.finger_pose : m.traj.extra_fingers[finger - 1].measured.finger_pose).push_back({t, pose});
   return true;
 }
 bool OnlineEstimator::AddContactPoint(double t, int finger, const geometry::Vec2& point) {
   Impl& m = *impl_;
   const int stream = m.FingerStream(finger, 1, "AddContactPoint");
-  if (!m.Accept(stream, "contact_point", t, point.allFinite())) return false;
+  const std::size_t index = m.seen[stream];
+  if (!m.Accept(stream, "contact_point", t, point.allFinite(), point.cwiseAbs().maxCoeff(), geometry::kMaxCoordinate))
+    return false;
   if (m.contacts_left_out) return false;  // the contact check left the stream out
+  // A corrupt row (the batch's DropContactRowFaults), against the finger's newest pose when it
+  // is near in time: one row 5 m off took a batch estimate to 160 mm.
+  const auto& poses = finger == 0 ? m.traj.measured.finger_pose : m.traj.extra_fingers[finger - 1].measured.finger_pose;
+  const geometry::Shape& shape = finger == 0 ? m.traj.finger.shape : m.traj.extra_fingers[finger - 1].finger.shape;
+  if (internal::FingerPoseNear(poses, t) && !shape.empty()) {
+    const geometry::Pose2 at = push::PoseAtClamped(poses.begin(), poses.end(), t);
+    const double d = std::abs(geometry::QueryPoint(shape, geometry::InverseAct(at, point)).signed_distance);
+    const double bound = internal::ContactFaultBound(m.smoother->cfg.measurement);
+    if (d > bound) {
+      m.Fault("contact_point row",
+              internal::Format("more than %.3g mm from the finger's boundary at its pose near the row's time", 1e3 * bound),
+              internal::Format("%scontact_point[%zu] at t = %s s, %.3g mm off",
+                               finger == 0 ? "" : ("fingers[" + std::to_string(finger) + "].").c_str(), index,
+                               Precise(t).c_str(), 1e3 * d));
+      return false;
+    }
+  }
   (finger == 0 ? m.traj.measured.contact_point : m.traj.extra_fingers[finger - 1].measured.contact_point).push_back({t, point});
   return true;
 }
@@ -1186,7 +1285,7 @@ bool OnlineEstimator::AddForce(double t, int finger, const geometry::Vec2& force
   Impl& m = *impl_;
   const int stream = m.FingerStream(finger, 2, "AddForce");
   const std::size_t index = m.seen[stream];
-  if (!m.Accept(stream, "force", t, force.allFinite())) return false;
+  if (!m.Accept(stream, "force", t, force.allFinite(), force.cwiseAbs().maxCoeff(), 1e9)) return false;
   const double magnitude = force.norm();
   const bool known_object = m.traj.object.mass > 0.0 && m.traj.object.mu_surface > 0.0;
   if (m.recent_force.size() >= 8) {
@@ -1197,12 +1296,10 @@ bool OnlineEstimator::AddForce(double t, int finger, const geometry::Vec2& force
   const bool judged = known_object || m.recent_force.size() >= 8;
   const double bound = internal::ForceFaultBound(m.recent_p95, m.traj.object);
   if (judged && magnitude > bound) {
-    if (m.dropped_faults++ == 0) {
-      char text[200];
-      std::snprintf(text, sizeof text, "%sforce[%zu] at t = %.9g s, |f| = %.3g N (bound %.3g N)",
-                    finger == 0 ? "" : ("fingers[" + std::to_string(finger) + "].").c_str(), index, t, magnitude, bound);
-      m.first_fault = text;
-    }
+    m.Fault("force sample", "50 times the recent forces or the object's friction limit",
+            internal::Format("%sforce[%zu] at t = %.9g s, |f| = %.3g N (bound %.3g N)",
+                             finger == 0 ? "" : ("fingers[" + std::to_string(finger) + "].").c_str(), index, t, magnitude,
+                             bound));
     return false;
   }
   m.recent_force.push_back(magnitude);
@@ -1310,11 +1407,9 @@ EstimationResult OnlineEstimator::Finish() {
         "per %d step%s",
         r.solver.updates, r.states.size(), every, m.max_latency, m.object_period, every, every == 1 ? "" : "s"));
   }
-  if (m.dropped_faults > 0) {
-    r.warnings.insert(r.warnings.begin(), std::to_string(m.dropped_faults) + " force sample" +
-                                              (m.dropped_faults == 1 ? "" : "s") +
-                                              " left out as sensor faults (50 times the recent forces or the object's "
-                                              "friction limit); the first: " + m.first_fault);
+  for (const auto& [kind, f] : m.faults) {
+    r.warnings.insert(r.warnings.begin(), std::to_string(f.count) + " " + kind + (f.count == 1 ? "" : "s") +
+                                              " left out as sensor faults (" + f.why + "); the first: " + f.first);
   }
   return r;
 }

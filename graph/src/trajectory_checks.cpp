@@ -1194,6 +1194,60 @@ std::optional<push::Trajectory> DropContactStreamsOffTheFinger(const push::Traje
   return out;
 }
 
+double ContactFaultBound(const push::MeasurementSigmas& sigmas) {
+  return std::max(kContactFaultFloor, 10.0 * std::hypot(sigmas.contact, sigmas.finger_trans));
+}
+
+std::optional<push::Trajectory> DropContactRowFaults(const push::Trajectory& traj, const push::MeasurementSigmas& sigmas,
+                                                     std::string* note) {
+  const double bound = ContactFaultBound(sigmas);
+  std::string said;
+  // Rows judged against their own finger's pose near in time (FingerPoseNear), interpolated.
+  auto faults = [&](const std::vector<push::PoseSample>& poses, const geometry::Shape& finger,
+                    const std::vector<push::PointSample>& contacts, const std::string& prefix) {
+    std::vector<bool> fault(contacts.size(), false);
+    if (poses.empty() || finger.empty()) return fault;
+    std::size_t count = 0, first = 0;
+    double first_distance = 0.0;
+    for (std::size_t i = 0; i < contacts.size(); ++i) {
+      const push::PointSample& c = contacts[i];
+      if (!FingerPoseNear(poses, c.t)) continue;
+      const geometry::Pose2 pose = push::PoseAtClamped(poses.begin(), poses.end(), c.t);
+      const double d = std::abs(geometry::QueryPoint(finger, geometry::InverseAct(pose, c.point)).signed_distance);
+      if (!(d > bound)) continue;
+      fault[i] = true;
+      if (count++ == 0) first = i, first_distance = d;
+    }
+    // More than a tenth is the stream itself (DropContactStreamsOffTheFinger's case), not faults.
+    if (count == 0 || 10 * count > contacts.size()) return std::vector<bool>(contacts.size(), false);
+    said += (said.empty() ? "" : "; ") +
+            Format("%zu %scontact_point row%s left out as sensor faults (more than %.3g mm from the finger's boundary at "
+                   "the finger pose of their time, ten times the contact sensor's and the finger tracker's noise "
+                   "combined); the first: %scontact_point[%zu] at t = %.9g s, %.3g mm off",
+                   count, prefix.c_str(), count == 1 ? "" : "s", 1e3 * bound, prefix.c_str(), first, contacts[first].t,
+                   1e3 * first_distance);
+    return fault;
+  };
+  auto keep = [](std::vector<push::PointSample>* rows, const std::vector<bool>& fault) {
+    std::vector<push::PointSample> kept;
+    for (std::size_t i = 0; i < rows->size(); ++i)
+      if (!fault[i]) kept.push_back((*rows)[i]);
+    *rows = std::move(kept);
+  };
+  const std::vector<bool> first = faults(traj.measured.finger_pose, traj.finger.shape, traj.measured.contact_point, "");
+  std::vector<std::vector<bool>> extra;
+  for (std::size_t k = 0; k < traj.extra_fingers.size(); ++k) {
+    const push::ExtraFinger& f = traj.extra_fingers[k];
+    extra.push_back(faults(f.measured.finger_pose, f.finger.shape, f.measured.contact_point, "fingers[" + std::to_string(k + 1) + "]."));
+  }
+  if (said.empty()) return std::nullopt;
+  push::Trajectory out = traj;
+  keep(&out.measured.contact_point, first);
+  for (std::size_t k = 0; k < out.extra_fingers.size(); ++k) keep(&out.extra_fingers[k].measured.contact_point, extra[k]);
+  *note = said;
+  return out;
+}
+
 std::optional<push::Trajectory> TessellatedFingersAsDisks(const push::Trajectory& traj, const EstimatorConfig& config,
                                                           std::string* note) {
   if (!config.tessellated_finger_as_disk) return std::nullopt;

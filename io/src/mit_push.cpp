@@ -483,9 +483,25 @@ MitRecording ReadMitPush(const std::string& path, const MitReadOptions& o) {
 
   FindContactPhase(&rec, o);
   if (o.trim_to_contact && rec.contact_found) {
+    const std::size_t objects = rec.streams.object_pose.size(), fingers = rec.streams.finger_pose.size();
     Trim(&rec.streams.object_pose, rec.contact_start, rec.contact_end);
     Trim(&rec.streams.finger_pose, rec.contact_start, rec.contact_end);
     Trim(&rec.streams.force, rec.contact_start, rec.contact_end);
+    // A contact phase that holds no pose: the force sensor's clock offset from the trackers' (one
+    // shifted by a second was written with 0 object and 0 finger samples, exit 0, and `estimate`
+    // then said "nothing anchors the object").
+    const bool no_object = rec.streams.object_pose.empty() && objects > 0, no_finger = rec.streams.finger_pose.empty() && fingers > 0;
+    if (no_object || no_finger) {
+      std::ostringstream text;
+      text.precision(12);
+      text << path << ": the contact phase (" << (rec.force_frozen ? "from the object's motion" : "from the force magnitude")
+           << ", " << rec.contact_start << " to " << rec.contact_end
+           << " s) holds no " << (no_object && no_finger ? "object or finger pose" : no_object ? "object pose" : "finger pose")
+           << " sample, though the recording has " << (no_object ? objects : fingers) << " (from "
+           << (no_object ? raw.object : raw.tip).front()[0] << " to " << (no_object ? raw.object : raw.tip).back()[0]
+           << " s): are the force sensor's and the trackers' clocks offset? mit-import --no-trim keeps every sample";
+      throw IoError(text.str());
+    }
   }
   return rec;
 }

@@ -56,7 +56,22 @@ def _config_json(config):
     if config is None:
         return ""
     if isinstance(config, dict):
-        return _json.dumps(config)
+        # NumPy scalars and arrays (np.int64(20), np.float32(0.5)) as the Python numbers they hold;
+        # anything else that is no JSON value is named with its key.
+        def plain(value):
+            if hasattr(value, "tolist"):
+                return value.tolist()
+            raise TypeError("a value of type %s is not a JSON value (numbers, strings, booleans, None, lists and dicts of them)"
+                            % type(value).__name__)
+        parts = []
+        for key, value in config.items():
+            if not isinstance(key, str):
+                raise TypeError("config: the key %r is not a string (config keys are names, docs/estimation.md)" % (key,))
+            try:
+                parts.append("%s: %s" % (_json.dumps(key), _json.dumps(value, default=plain)))
+            except (TypeError, ValueError) as e:
+                raise TypeError("config[%r]: %s" % (key, e)) from None
+        return "{" + ", ".join(parts) + "}"
     if isinstance(config, (str, bytes, _os.PathLike)):
         with open(config, "r", encoding="utf-8") as f:
             return f.read()

@@ -325,6 +325,15 @@ Raises IoError naming the file and the field.)doc");
       [](const std::filesystem::path& file, const geometry::Shape& object, double mass, double mu_surface,
          const geometry::Shape& finger, double mu_contact, bool trim_to_contact) {
         const std::string path = file.string();
+        // The tool's bounds (mit-import --mass, --mu-surface, --mu-contact): they also set the
+        // contact phase's force threshold, and a mass of -1 or a NaN mu was taken without a word.
+        auto check = [](double v, bool ok, const char* name, const char* range) {
+          if (!ok) throw py::value_error(std::string("read_mit_push: ") + name + " = " + py::repr(py::float_(v)).cast<std::string>() +
+                                         " is outside " + range);
+        };
+        check(mass, mass > 0.0 && mass <= 1e6, "mass", "(0, 1e6] kg");
+        check(mu_surface, mu_surface > 0.0 && mu_surface <= 10.0, "mu_surface", "(0, 10]");
+        check(mu_contact, mu_contact >= 0.0 && mu_contact <= 10.0, "mu_contact", "[0, 10]");
         io::MitReadOptions options;
         options.trim_to_contact = trim_to_contact;
         options.contact_force = io::MitContactForce(mass, mu_surface);  // as `pushgraph estimate` reads it

@@ -444,22 +444,24 @@ TEST(Online, AContactStreamOffTheFingerIsLeftOut) {
 
 // A corrupted force sample (1e5 N) arriving online is a sensor fault as in batch: AddForce
 // returns false, it is counted, and Finish() warns about it; the estimate is the one without it.
+// QS online with an update whenever due; `faults` gets DroppedFaultySamples().
+EstimationResult RunCountingFaults(const push::Trajectory& traj, int* faults) {
+  OnlineEstimator online(SetupOf(traj), Model::kQs, {}, StreamsOf(traj));
+  Feed(traj, online, [&] {
+    if (online.UpdateDue()) online.Update();
+  });
+  *faults = online.DroppedFaultySamples();
+  return online.Finish();
+}
+
 TEST(Online, ForceSpikesAreLeftOutAsSensorFaults) {
   const push::Trajectory t = GeneratePush(OffsetPush(22, 1.0));
   push::Trajectory spiked = t;
   const std::size_t k = spiked.measured.force.size() / 2;
   spiked.measured.force[k].force = Vec2(1e5, 0.0);
-  auto run = [](const push::Trajectory& traj, int* faults) {
-    OnlineEstimator online(SetupOf(traj), Model::kQs, {}, StreamsOf(traj));
-    Feed(traj, online, [&] {
-      if (online.UpdateDue()) online.Update();
-    });
-    *faults = online.DroppedFaultySamples();
-    return online.Finish();
-  };
   int clean_faults = -1, faults = -1;
-  const EstimationResult clean = run(t, &clean_faults);
-  const EstimationResult r = run(spiked, &faults);
+  const EstimationResult clean = RunCountingFaults(t, &clean_faults);
+  const EstimationResult r = RunCountingFaults(spiked, &faults);
   EXPECT_EQ(clean_faults, 0);
   EXPECT_EQ(faults, 1);
   ASSERT_FALSE(r.warnings.empty());
@@ -467,6 +469,64 @@ TEST(Online, ForceSpikesAreLeftOutAsSensorFaults) {
   EXPECT_NE(r.warnings[0].find("force[" + std::to_string(k) + "]"), std::string::npos) << r.warnings[0];
   EXPECT_NEAR(r.metrics.at("object_position_rms"), clean.metrics.at("object_position_rms"),
               0.05 * clean.metrics.at("object_position_rms"));
+}
+
+// A tracker glitch (one object pose 5 m off) and a corrupt contact row (5 m off the finger)
+// are left out online as in batch, each kind named; a position beyond the supported range is
+// refused by name and the estimator goes on (it was taken, and every later update failed).
+// A step of the tracker that stays is no glitch: its poses are taken from the third on.
+TEST(Online, TrackerGlitchesAndCorruptContactRowsAreLeftOut) {
+  const push::Trajectory t = GeneratePush(OffsetPush(22, 1.0));
+  int clean_faults = -1, faults = -1;
+  const EstimationResult clean = RunCountingFaults(t, &clean_faults);
+  EXPECT_EQ(clean_faults, 0);
+  EXPECT_TRUE(clean.warnings.empty() || !HasWarning(clean, "left out as sensor faults")) << clean.warnings[0];
+  push::Trajectory bad = t;
+  const std::size_t k = bad.measured.object_pose.size() / 2;
+  bad.measured.object_pose[k].pose.x += 5.0;
+  const std::size_t c = bad.measured.contact_point.size() / 2;
+  bad.measured.contact_point[c].point.x() += 5.0;
+  const EstimationResult r = RunCountingFaults(bad, &faults);
+  EXPECT_EQ(faults, 2);
+  EXPECT_TRUE(HasWarning(r, "1 object_pose sample left out as sensor faults (tracker glitches"));
+  EXPECT_TRUE(HasWarning(r, "object_pose[" + std::to_string(k) + "]"));
+  EXPECT_TRUE(HasWarning(r, "1 contact_point row left out as sensor faults"));
+  EXPECT_TRUE(HasWarning(r, "contact_point[" + std::to_string(c) + "]"));
+  EXPECT_LT(r.metrics.at("object_position_rms"), 1.2 * clean.metrics.at("object_position_rms"));
+  // Out of range: refused by name, the run goes on.
+  {
+    OnlineEstimator online(SetupOf(t), Model::kQs, {}, StreamsOf(t));
+    const std::vector<Arrival> arrivals = ArrivalOrder(t);
+    bool refused = false;
+    for (std::size_t a = 0; a < arrivals.size(); ++a) {
+      if (arrivals[a].stream == 0 && arrivals[a].index == k) {
+        try {
+          online.AddObjectPose(arrivals[a].t, geometry::Pose2{1e20, 0.0, 0.0});
+        } catch (const GraphError& e) {
+          refused = true;
+          EXPECT_NE(std::string(e.what()).find("object_pose[" + std::to_string(k) + "]"), std::string::npos) << e.what();
+          EXPECT_NE(std::string(e.what()).find("out of the supported range"), std::string::npos) << e.what();
+        }
+        continue;
+      }
+      Deliver(arrivals[a], t, online);
+      if (a + 1 == arrivals.size() || arrivals[a + 1].t > arrivals[a].t + 1e-9) {
+        if (online.UpdateDue()) online.Update();
+      }
+    }
+    EXPECT_TRUE(refused);
+    const EstimationResult ranged = online.Finish();
+    EXPECT_LT(ranged.metrics.at("object_position_rms"), 1.2 * clean.metrics.at("object_position_rms"));
+  }
+  // A step of 10 cm from the middle on that stays: taken after two samples, and the estimate
+  // goes with it.
+  push::Trajectory stepped = t;
+  for (std::size_t i = k; i < stepped.measured.object_pose.size(); ++i) stepped.measured.object_pose[i].pose.y += 0.1;
+  int step_faults = -1;
+  const EstimationResult s = RunCountingFaults(stepped, &step_faults);
+  EXPECT_EQ(step_faults, 2);
+  const double y_end = stepped.measured.object_pose.back().pose.y;
+  EXPECT_LT(std::abs(s.states.back().object_pose.y - y_end), std::abs(s.states.back().object_pose.y - (y_end - 0.1)));
 }
 
 // A force sample and a finger pose before the first camera frames (an MIT recording's order:

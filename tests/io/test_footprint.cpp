@@ -481,6 +481,19 @@ TEST_F(Footprint, ClearErrors) {
   expect_error(Write("badidx.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n"), {}, "cannot read OFF mesh");
   expect_error(Write("nan.off", "OFF\n3 1 0\n0 0 0\nnan 0 0\n0 1 0\n3 0 1 2\n"), {}, "");
   expect_error((dir_ / "missing.stl").string(), {}, "no such file");
+  // Counts a file cannot hold are refused before the reader sizes anything by them (a 90-byte OFF
+  // whose face claimed 2e9 vertices took 15.6 GB); an index past the vertices is named.
+  expect_error(Write("huge.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n2000000000 0 1 2\n"), {},
+               "face 1's vertex count at line 6 claims 2000000000, more than the file's");
+  expect_error(Write("long.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n5 0 1 2\n"), {},
+               "face 1 at line 6 lists 5 vertices but its line holds 3 numbers after the count");
+  expect_error(Write("many.off", "OFF\n2000000000 1 0\n0 0 0\n"), {}, "the vertex count at line 2 claims 2000000000");
+  expect_error(Write("index.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n"), {},
+               "face 1 at line 6 refers to vertex '3', but the file has 3 vertices, indexed from 0 to 2");
+  const std::string ply_head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                               "element face 1\nproperty list int int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n";
+  expect_error(Write("huge.ply", ply_head + "2000000000 0 1 2\n"), {}, "claims 2000000000, more than the file's");
+  expect_error(Write("index.ply", ply_head + "3 0 1 9\n"), {}, "refers to vertex '9', but the file has 3 vertices");
   io::FootprintOptions named;
   named.object = "part";
   expect_error(Write("square.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n"), named,

@@ -188,6 +188,27 @@ TEST_F(MitPush, ALightObjectsContactPhaseUsesItsFrictionLoad) {
   }));
 }
 
+// The force sensor's clock a second ahead of the trackers': its contact phase holds no pose.
+// It was written with 0 object and 0 finger samples (exit 0); now an error naming the offset.
+TEST_F(MitPush, AContactPhaseWithoutPosesIsAClockOffsetError) {
+  auto sets = CleanPush();
+  for (Row& f : sets[2].second) f[0] += 1.0;
+  const std::string path = (dir_ / "late_force.h5").string();
+  WriteH5(path, sets);
+  io::MitReadOptions trim;
+  trim.trim_to_contact = true;
+  try {
+    io::ReadMitPush(path, trim);
+    ADD_FAILURE() << "accepted";
+  } catch (const io::IoError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("holds no object or finger pose sample, though the recording has 200"), std::string::npos) << what;
+    EXPECT_NE(what.find("clocks offset"), std::string::npos) << what;
+  }
+  trim.trim_to_contact = false;
+  EXPECT_EQ(io::ReadMitPush(path, trim).streams.object_pose.size(), 200u);
+}
+
 TEST_F(MitPush, FrozenSyntheticSensorAndJsonVariant) {
   auto sets = CleanPush();
   for (std::size_t i = 0; i < sets[2].second.size(); ++i) {  // stuck, with spikes, like rect1

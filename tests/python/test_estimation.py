@@ -119,6 +119,12 @@ def test_incremental_every_step_and_the_chain_solver(push):
     assert np.all(inc["solver"]["update_times_s"] > 0)
     assert np.all(np.isnan(inc["object_pose_cov"]))
     assert inc["metrics"]["object_position_rms"] < 1.1 * batch["metrics"]["object_position_rms"]
+    # NumPy numbers in a config dict are the numbers they hold; other values are named by key.
+    again = pg.estimate(push, model="qs", mode="incremental",
+                        config={"solver": "chain", "incremental_update_every_steps": np.int64(5), "covariance": np.bool_(False)})
+    assert again["metrics"]["object_position_rms"] == inc["metrics"]["object_position_rms"]
+    with pytest.raises(TypeError, match="config\\['max_iterations'\\]: a value of type object is not a JSON value"):
+        pg.estimate(push, config={"max_iterations": object()})
 
 
 def test_online_estimator_fed_from_python(push):
@@ -199,6 +205,11 @@ def test_mit_recording():
     assert t["measured"]["object_pose"]["t"].size > 100
     with pytest.raises(pg.IoError, match="nothing.h5"):
         pg.read_mit_push(str(f.parent / "nothing.h5"), pg.Shape.box(0.09, 0.09), 0.8, 0.35, pg.Shape.disk(0.00235))
+    # The tool's bounds on mass and frictions (they also set the contact phase's threshold).
+    for mass, mu, name in ((-1.0, 0.35, "mass"), (1e9, 0.35, "mass"), (0.8, float("nan"), "mu_surface"),
+                           (0.8, -5.0, "mu_surface")):
+        with pytest.raises(ValueError, match="read_mit_push: %s = " % name):
+            pg.read_mit_push(str(f), pg.Shape.box(0.09, 0.09), mass, mu, pg.Shape.disk(0.00235))
 
 
 def test_evaluation_tables_as_dicts(notched_block):

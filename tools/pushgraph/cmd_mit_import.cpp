@@ -47,6 +47,9 @@ void RegisterMitImport(CLI::App& app) {
     object.mass = a->mass;
     object.mu_surface = a->mu_surface;
     push::FingerDescription finger{LoadShapeArgument(a->finger, "--finger"), a->mu_contact};
+    // As simulate and footprint do: a mesh in millimetres made a 90 m block here without a word.
+    WarnShapeUnits(object.shape, "--object", a->object);
+    WarnShapeUnits(finger.shape, "--finger", a->finger);
     push::Trajectory trajectory = io::MitToTrajectory(rec, object, finger);
     ChooseObjectReading(a->object, readings, graph::EstimatorConfig{}, &trajectory, nullptr);
     io::SaveTrajectoryJson(trajectory, a->output);
