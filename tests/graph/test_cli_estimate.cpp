@@ -1054,6 +1054,22 @@ TEST_F(EstimateCli, AFingerSizeTheGraphPrefersIsUsedAndNamed) {
     std::printf("[registration] ellip1 with a 9 mm probe: radius used %.2f mm, object RMS %.2f mm\n", radius * 1e3, rms * 1e3);
     EXPECT_NEAR(radius, kProbe, 1.2e-3) << rec;  // 5.49 and 4.53 mm
   }
+  // The converse on the 20 mm/s recording: the right probe and the mesh shifted by 1 cm. The
+  // graph prefers a finger 5.4 mm larger there too (by 11 in cost), and the contacts fit the
+  // placement as well: the warning names the placement beside the size (the frame error went
+  // unnamed, blamed on the probe).
+  const std::string out = dir() + "/shifted.json";
+  const pushgraph::testing::ToolRun r = EstimateMit(Mit() + "abs/ellip1/motion_surface=abs_shape=ellip1_a=0_v=20_i=0.000_s=0.675_t=0.698.h5",
+                                                    "ellip1.obj", "--transform 0.01,0,0", kProbe, kEllip1Mass, out);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j = Load(out);
+  EXPECT_LT(j["metrics"]["object_position_rms"].get<double>(), 1.3e-3);
+  if (j["parameters"].contains("finger_radius")) {
+    EXPECT_NE(r.err.find("if the probe's radius is right, the shape file's frame may be off by that much"), std::string::npos)
+        << r.err;
+  } else {
+    EXPECT_TRUE(j["parameters"].contains("shape_transform")) << r.err;
+  }
 }
 
 
