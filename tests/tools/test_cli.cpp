@@ -279,6 +279,28 @@ TEST_F(CliTest, OutputsThatAreInputsAreRefusedAndInputsKept) {
   std::stringstream tkept;
   tkept << tin.rdbuf();
   EXPECT_EQ(tkept.str(), traj_text);
+  // An empty output (or any empty value) is refused before any work: `-o ""` ran the whole
+  // estimate and then failed to write.
+  for (const std::string& args : {"estimate " + traj + " -o ''", "estimate " + traj + " -o r.json --config ''"}) {
+    const ToolRun r = Exec(args);
+    EXPECT_EQ(r.status, 2) << args;
+    EXPECT_NE(r.err.find("an empty value"), std::string::npos) << args << ": " << r.err;
+  }
+  // Inputs from a pipe are read once (the HDF5 sniff and then the JSON reader each read
+  // /dev/stdin, the second finding it empty: "unexpected end of input"), and the same for a
+  // mesh, whose OBJ coordinates are read twice.
+  {
+    const std::string piped = (dir_ / "piped.json").string();
+    const std::string cmd = "cat " + traj + " | " + std::string(PUSHGRAPH_TOOL) + " estimate /dev/stdin --model cp -o " + piped +
+                            " 2>/dev/null";
+    EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    EXPECT_TRUE(fs::exists(piped));
+    const std::string mesh = Write("box.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n");
+    const std::string fp = (dir_ / "fp.json").string();
+    const std::string cmd2 = "cat " + mesh + " | " + std::string(PUSHGRAPH_TOOL) + " footprint /dev/stdin -q -o " + fp + " 2>/dev/null";
+    EXPECT_EQ(std::system(cmd2.c_str()), 0) << cmd2;
+    EXPECT_TRUE(fs::exists(fp));
+  }
   // A real write replaces the file whole and leaves nothing else in the folder.
   const std::string out = (dir_ / "out.json").string();
   ASSERT_EQ(Exec("footprint " + shape + " -o " + out + " -q").status, 0);

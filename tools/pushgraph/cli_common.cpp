@@ -15,9 +15,12 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <optional>
 #include <sstream>
+#include <vector>
 
+#include <stdlib.h>
 #include <unistd.h>
 
 namespace pushgraph::cli {
@@ -290,6 +293,59 @@ std::string FormatSize(double size) {
 }
 
 }  // namespace
+
+namespace {
+
+// The copies of piped inputs (ReadOnceInput), removed at exit.
+struct PipedInputs {
+  std::filesystem::path dir;
+  std::vector<std::pair<std::string, std::string>> copies;  // temporary path, given path
+  ~PipedInputs() {
+    std::error_code ec;
+    if (!dir.empty()) std::filesystem::remove_all(dir, ec);
+  }
+};
+PipedInputs& Piped() {
+  static PipedInputs piped;
+  return piped;
+}
+
+}  // namespace
+
+CLI::Validator ReadOnceInput() {
+  return CLI::Validator(
+      [](std::string& path) -> std::string {
+        namespace fs = std::filesystem;
+        std::error_code ec;
+        const fs::file_status st = fs::status(path, ec);
+        if (ec || fs::is_regular_file(st) || fs::is_directory(st) || !fs::exists(st)) return "";  // the readers say what is wrong
+        if (!fs::is_fifo(st) && !fs::is_character_file(st) && !fs::is_socket(st)) return "";
+        std::ifstream in(path, std::ios::binary);
+        if (!in) return "";
+        PipedInputs& piped = Piped();
+        if (piped.dir.empty()) {
+          std::string templ = (fs::temp_directory_path(ec) / "pushgraph-input-XXXXXX").string();
+          if (ec || ::mkdtemp(templ.data()) == nullptr) return "cannot copy the piped input " + path + " to a temporary file";
+          piped.dir = templ;
+        }
+        const fs::path copy = piped.dir / (std::to_string(piped.copies.size()) + "-" + fs::path(path).filename().string());
+        std::ofstream out(copy, std::ios::binary);
+        out << in.rdbuf();
+        out.close();
+        if (!out) return "cannot copy the piped input " + path + " to " + copy.string();
+        piped.copies.emplace_back(copy.string(), path);
+        path = copy.string();
+        return "";
+      },
+      "", "ReadOnceInput");
+}
+
+std::string WithGivenInputPaths(std::string text) {
+  for (const auto& [copy, given] : Piped().copies) {
+    for (std::size_t at = text.find(copy); at != std::string::npos; at = text.find(copy, at + given.size())) text.replace(at, copy.size(), given);
+  }
+  return text;
+}
 
 void WarnShapeUnits(const geometry::Shape& shape, const std::string& what, const std::string& path) {
   if (const auto units = io::ShapeUnitsWarning(shape, 1.0, "pushgraph footprint " + path + " --scale "))

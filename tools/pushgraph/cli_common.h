@@ -49,6 +49,13 @@ CLI::Validator FiniteNumber(double min, bool inclusive, const std::string& rule,
 /// The message names the flag: "--mass: must be a finite number in (0, 1e6] (kg), got 1e308".
 CLI::Validator MassValue();
 CLI::Validator FrictionValue(bool zero_allowed);
+/// A CLI11 transform for an input file that may be a pipe (`<(cat x)`, /dev/stdin): its bytes are
+/// copied once into a private temporary file of the same name, whose path the option then holds
+/// (readers that look at a file twice, an HDF5 sniff then JSON, or an OBJ's coordinates read
+/// again, found the pipe empty: "unexpected end of input"). Regular files pass unchanged.
+CLI::Validator ReadOnceInput();
+/// `text` with every such temporary path replaced by the path the user gave (for messages).
+std::string WithGivenInputPaths(std::string text);
 /// The --align-shape option of estimate and evaluate: auto, on or off (empty: not given, the
 /// configuration's value stands).
 void AddAlignShapeOption(CLI::App* sub, std::string* value);

@@ -16,7 +16,8 @@ void RegisterDistance(CLI::App& app) {
   auto* cmd = app.add_subcommand("distance", "Exact signed distance, closest point and normal for points in a CSV file");
   auto shape_path = std::make_shared<std::string>();
   auto points_path = std::make_shared<std::string>();
-  cmd->add_option("SHAPE", *shape_path, "Shape JSON file")->required();
+  cmd->add_option("SHAPE", *shape_path, "Shape JSON file")->required()
+      ->transform(ReadOnceInput());
   cmd->add_option("POINTS", *points_path, "CSV file with header x,y (points in the shape's frame)")->required();
   cmd->footer(
       "Prints CSV: x,y,signed_distance,closest_x,closest_y,normal_x,normal_y (one row per input point).\n"

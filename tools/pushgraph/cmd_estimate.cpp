@@ -163,16 +163,20 @@ void RegisterEstimate(CLI::App& app) {
   CLI::App* sub = app.add_subcommand("estimate", "Estimate object/finger poses, contacts and forces of a push (factor graph)");
   sub->add_option("input", opts->input,
                   "Input: trajectory (pushgraph-trajectory-1 JSON) or MIT recording (.h5, or the dataset's JSON)")
-      ->required();
+      ->required()
+      ->transform(ReadOnceInput());
   sub->add_option("--model", opts->model, "Graph: cp, sdf, qs or yu (Yu-Rodriguez baseline)")->capture_default_str();
   sub->add_option("--mode", opts->mode, "batch or incremental (fixed-lag smoothing)")->capture_default_str();
   sub->add_option("-o,--output", opts->output, "Output RESULT.json")->required();
   sub->add_option("--solver", opts->solver,
                   "chain (the default: banded Levenberg-Marquardt, chain_solver.h) or ceres (the reference); overrides the config's")
       ->check(CLI::IsMember({"chain", "ceres"}));
-  sub->add_option("--config", opts->config, "Estimator configuration JSON (sigmas, losses, window; docs/estimation.md)");
-  sub->add_option("--object", opts->object, "Object shape JSON or OBJ mesh (required for MIT recordings; overrides a trajectory's)");
-  sub->add_option("--finger", opts->finger, "Finger (probe) shape JSON or OBJ mesh (required for MIT recordings)");
+  sub->add_option("--config", opts->config, "Estimator configuration JSON (sigmas, losses, window; docs/estimation.md)")
+      ->transform(ReadOnceInput());
+  sub->add_option("--object", opts->object, "Object shape JSON or OBJ mesh (required for MIT recordings; overrides a trajectory's)")
+      ->transform(ReadOnceInput());
+  sub->add_option("--finger", opts->finger, "Finger (probe) shape JSON or OBJ mesh (required for MIT recordings)")
+      ->transform(ReadOnceInput());
   sub->add_option("--mass", opts->mass, "Object mass in kg (required for MIT recordings)")->check(MassValue());
   sub->add_option("--mu", opts->mu, "Object-table friction coefficient (required for MIT recordings)")
       ->check(FrictionValue(true));

@@ -24,7 +24,8 @@ void RegisterFootprint(CLI::App& app) {
     bool quiet = false, mirror = false;
   };
   auto args = std::make_shared<Args>();
-  cmd->add_option("MESH", args->mesh, "Mesh file (Wavefront OBJ, STL, PLY or OFF), or a shape JSON to transform")->required();
+  cmd->add_option("MESH", args->mesh, "Mesh file (Wavefront OBJ, STL, PLY or OFF), or a shape JSON to transform")->required()
+      ->transform(ReadOnceInput());
   CLI::Option* up = cmd->add_option("--up", args->up, "Axis to project along: x, y or z")->capture_default_str();
   CLI::Option* object = cmd->add_option("--object", args->object, "Only this object/group of the file (default: all together)");
   cmd->add_option("--scale", args->scale, "Multiply coordinates, e.g. 0.001 for millimetres")

@@ -77,7 +77,8 @@ void RegisterLimitSurface(CLI::App& app) {
   auto options = std::make_shared<LimitSurfaceOptions>();
   auto* cmd = app.add_subcommand("limit-surface", "Limit surface of a sliding shape under uniform pressure");
   cmd->add_option("SHAPE", options->shape_path, "Support region: shape JSON file (polygons with holes, or a disk) or OBJ mesh (its footprint along z)")
-      ->required();
+      ->required()
+      ->transform(ReadOnceInput());
   cmd->add_option("--mass", options->mass, "Object mass in kg (> 0)")->required()->check(MassValue());
   cmd->add_option("--mu", options->mu, "Object-surface friction coefficient (> 0)")->required()->check(FrictionValue(false));
   cmd->add_option("--gravity", options->gravity, "Gravity in m/s^2 (default 9.80665)");

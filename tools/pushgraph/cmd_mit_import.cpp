@@ -20,10 +20,13 @@ void RegisterMitImport(CLI::App& app) {
     bool trim = true;
   };
   auto a = std::make_shared<Args>();
-  cmd->add_option("RECORDING", a->recording, "Recording (.h5 or .json)")->required();
+  cmd->add_option("RECORDING", a->recording, "Recording (.h5 or .json)")->required()
+      ->transform(ReadOnceInput());
   cmd->add_option("--object", a->object, "Object shape JSON (e.g. from pushgraph footprint) or mesh (OBJ, STL, PLY, OFF)")
-      ->required();
-  cmd->add_option("--finger", a->finger, "Finger shape JSON or mesh (OBJ, STL, PLY, OFF)")->required();
+      ->required()
+      ->transform(ReadOnceInput());
+  cmd->add_option("--finger", a->finger, "Finger shape JSON or mesh (OBJ, STL, PLY, OFF)")->required()
+      ->transform(ReadOnceInput());
   cmd->add_option("--mass", a->mass, "Object mass (kg)")->required()->check(MassValue());
   cmd->add_option("--mu-surface", a->mu_surface, "Object-table friction coefficient")->required()->check(FrictionValue(false));
   cmd->add_option("--mu-contact", a->mu_contact, "Finger-object friction coefficient")

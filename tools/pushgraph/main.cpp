@@ -59,6 +59,16 @@ int main(int argc, char** argv) {
     }
   }
   args = JoinNegativeValues(args, value_options);
+  // No option or argument of this tool means anything empty: `-o ""` ran a whole estimate and then
+  // failed to write "" (an empty path reads as "not given" to the output checks).
+  for (CLI::App* sub : app.get_subcommands({})) {
+    for (CLI::Option* opt : sub->get_options()) {
+      if (opt->get_type_size() == 0) continue;
+      opt->check(CLI::Validator(
+          [](std::string& value) { return value.empty() ? std::string("an empty value (a file name or a number is expected)") : std::string(); },
+          "", "NonEmpty"));
+    }
+  }
   std::vector<std::string> reversed(args.rbegin(), args.rend());
   try {
     app.parse(reversed);
@@ -69,10 +79,10 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::cerr << "pushgraph: " << e.what() << " (see pushgraph --help)\n";
+    std::cerr << "pushgraph: " << WithGivenInputPaths(e.what()) << " (see pushgraph --help)\n";
     return 2;
   } catch (const std::exception& e) {
-    std::cerr << "pushgraph: error: " << e.what() << "\n";
+    std::cerr << "pushgraph: error: " << WithGivenInputPaths(e.what()) << "\n";
     return 1;
   }
   return 0;
