@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <map>
@@ -231,6 +232,8 @@ EstimatorConfig ParseEstimatorConfig(const std::string& json_text, const std::st
 }
 
 EstimatorConfig LoadEstimatorConfig(const std::string& path, const EstimatorConfig& base) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw GraphError(path + ": is a directory, not a config file");
   std::ifstream in(path);
   if (!in) throw GraphError("cannot open config file '" + path + "'");
   std::stringstream ss;

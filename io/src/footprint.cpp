@@ -484,6 +484,9 @@ geometry::Shape MeshFootprint(const std::string& path, const FootprintOptions& o
       std::string message = reader.Error();
       while (!message.empty() && (message.back() == '\n' || message.back() == '\r')) message.pop_back();
       std::replace(message.begin(), message.end(), '\n', ' ');
+      // tinyobjloader says "e.g. zero value for face index" of any face it cannot read ("f a b c").
+      if (message.find("Failed parse `f' line") != std::string::npos)
+        message += " (each of a face's entries must be a vertex number: from 1, or negative counting back from the last vertex)";
       throw IoError(path + ": cannot read mesh: " + (message.empty() ? std::string("unknown error") : message));
     }
     const tinyobj::attrib_t& attrib = reader.GetAttrib();

@@ -95,6 +95,11 @@ TEST_F(LimitSurfaceCli, BadInputIsAOneLineError) {
   EXPECT_NE(Exec(square_ + " --mu 0.3").status, 0);  // --mass is required
   // --samples is read by --ellipsoid alone (it was ignored without it).
   ExpectOneLineError(square_ + " --mass 1 --mu 0.3 --samples 10", "--ellipsoid");
+  // A sliver has exact values but no ellipsoid: said so (it was "the load must be finite and
+  // non-zero" alone); without --ellipsoid it is reported.
+  const std::string sliver = Write("sliver.json", R"({"polygons": [{"outer": [[0,0],[1,0],[2,1e-17]]}]})");
+  ExpectOneLineError(sliver + " --mass 0.5 --mu 0.3 --ellipsoid --samples 200", "a region this thin");
+  EXPECT_EQ(Exec(sliver + " --mass 0.5 --mu 0.3").status, 0);
 }
 
 // An OBJ mesh is read as its footprint (it was a raw JSON parse error), and a shape in other

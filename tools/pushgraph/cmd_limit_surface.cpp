@@ -63,10 +63,23 @@ void Run(const LimitSurfaceOptions& options) {
   }
   if (options.ellipsoid) {
     if (options.samples < 6) throw CliError("--samples must be >= 6 (the fitted ellipsoid has 6 unknowns)");
-    out["ellipsoid"] = {
-        {"paper", ToJson(ls::CompareWithExact(support, ls::PaperEllipsoid(summary), options.samples))},
-        {"fitted", ToJson(ls::CompareWithExact(support, ls::FitEllipsoid(support, options.samples, 2),
-                                               options.samples))}};
+    try {
+      out["ellipsoid"] = {
+          {"paper", ToJson(ls::CompareWithExact(support, ls::PaperEllipsoid(summary), options.samples))},
+          {"fitted", ToJson(ls::CompareWithExact(support, ls::FitEllipsoid(support, options.samples, 2),
+                                                 options.samples))}};
+    } catch (const ls::LimitSurfaceError& e) {
+      // A sliver (a triangle 1e-17 m high) has exact loads, but some twist's load is zero or its
+      // ellipsoid singular: "EllipsoidTwist: the load must be finite and non-zero" said neither.
+      const geometry::Box2 box = spec.region.bounds();
+      const double span = std::max(box.max.x() - box.min.x(), box.max.y() - box.min.y());
+      char text[320];
+      std::snprintf(text, sizeof text,
+                    " (the support region's area is %.3g m^2 over a span of %.3g m, %.3g of a square's: a region this "
+                    "thin has a near-degenerate limit surface, which no ellipsoid fits; without --ellipsoid its exact f_max, tau_max and c are reported)",
+                    summary.area, span, span > 0.0 ? summary.area / (span * span) : 0.0);
+      throw CliError("--ellipsoid: " + std::string(e.what()) + text);
+    }
   }
   std::cout << DumpJson(out) << "\n";
 }
