@@ -1227,7 +1227,7 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
       // the frame error went unnamed (the 9 mm probe given for the 4.7 mm one on the same
       // recording wins by 14: the data cannot tell the two apart there).
       std::string placement;
-      if (registration->size_explains) {
+      if (registration->size_explains && !identity_wins && !units_win) {  // the winner was a placement
         placement = "; the shape moved (" + contacts_best + internal::Format(") fits the contacts about as well (whole-graph "
                     "cost %.1f against %.1f with the finger resized): if the probe's radius is right, the shape file's frame "
                     "may be off by that much", placement_cost, size_cost);

@@ -591,9 +591,9 @@ std::optional<push::Trajectory> DropContactStreamsOffTheFinger(const push::Traje
 /// A contact row no sensor of this push could have measured (a corrupt row): farther from its
 /// finger's boundary (the finger pose near its time, interpolated) than ContactFaultBound, max(2 cm,
 /// 10 sqrt(sigma_contact^2 + sigma_finger^2)). One row moved by 5 m took a batch estimate to 160 mm
-/// against 2.8 mm raw, with no word. Rows without a finger pose within 0.05 s are not judged; more
-/// than a tenth of a stream is no fault (DropContactStreamsOffTheFinger's case). Returns the
-/// trajectory without them and sets `note`; nullopt when there is none.
+/// against 2.8 mm raw, with no word. Rows without a finger pose within 0.05 s are not judged; a
+/// stream off its finger as a whole is DropContactStreamsOffTheFinger's case (run it first).
+/// Returns the trajectory without them and sets `note`; nullopt when there is none.
 std::optional<push::Trajectory> DropContactRowFaults(const push::Trajectory& trajectory, const push::MeasurementSigmas& sigmas,
                                                      std::string* note);
 constexpr double kContactFaultFloor = 0.02;  // m

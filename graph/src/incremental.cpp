@@ -751,6 +751,16 @@ struct OnlineEstimator::Impl {
   // Three left out in a row that agree with one another are a step of the tracker (a
   // re-initialization), not glitches: the third and those after it are taken.
   std::vector<push::PoseSample> pending_glitches;
+  // A pose stream's speed over its newest 0.1 s or more (its newest pose against the last one at
+  // least 0.1 s older, or its oldest); 0 with fewer than two poses.
+  static double RecentSpeed(const std::vector<push::PoseSample>& poses) {
+    if (poses.size() < 2) return 0.0;
+    const push::PoseSample& newest = poses.back();
+    std::size_t k = poses.size() - 2;
+    while (k > 0 && newest.t - poses[k].t < 0.1) --k;
+    const double dt = newest.t - poses[k].t;
+    return dt > 0.0 ? (newest.pose.translation() - poses[k].pose.translation()).norm() / dt : 0.0;
+  }
   static constexpr double kGlitchFloor = 0.01, kGlitchAngle = 0.3, kGlitchWindow = 0.5;  // m, rad, s
   static constexpr std::size_t kStepSamples = 3;
   bool ObjectPoseGlitch(double t, const geometry::Pose2& pose, double* off) {
@@ -769,8 +779,13 @@ struct OnlineEstimator::Impl {
     // noise a 1 cm floor is two sigmas.
     const push::MeasurementSigmas& sigma = smoother->cfg.measurement;
     const double floor = std::max(kGlitchFloor, 10.0 * sigma.object_trans), floor_angle = std::max(kGlitchAngle, 10.0 * sigma.object_rot);
+    // A pushed object can start to move as fast as its finger (the five poses before at rest
+    // allowed nothing: a 0.4 m/s push had 0.3 s of poses refused at its onset): twice the
+    // fastest finger's recent speed over the time since the oldest of the five.
+    double finger_speed = RecentSpeed(traj.measured.finger_pose);
+    for (const push::ExtraFinger& f : traj.extra_fingers) finger_speed = std::max(finger_speed, RecentSpeed(f.measured.finger_pose));
     *off = std::hypot(pose.x - internal::Median(xs), pose.y - internal::Median(ys));
-    const bool glitch = *off > floor + 2.0 * motion + motion / span * ahead ||
+    const bool glitch = *off > floor + 2.0 * motion + motion / span * ahead + 2.0 * finger_speed * (t - far.t) ||
                         std::abs(internal::Median(as)) > floor_angle + 2.0 * turn + turn / span * ahead;
     if (!glitch) {
       pending_glitches.clear();
@@ -779,7 +794,8 @@ struct OnlineEstimator::Impl {
     // A step: agrees with the glitches just before it (within the floor plus their own motion).
     if (!pending_glitches.empty()) {
       const push::PoseSample& last = pending_glitches.back();
-      const bool agrees = (pose.translation() - last.pose.translation()).norm() <= floor + motion / span * (t - last.t) &&
+      const bool agrees = (pose.translation() - last.pose.translation()).norm() <=
+                              floor + 2.0 * std::max(motion / span, finger_speed) * (t - last.t) &&
                           std::abs(std::remainder(pose.theta - last.pose.theta, 2.0 * M_PI)) <= floor_angle;
       if (!agrees) pending_glitches.clear();
     }
@@ -1261,14 +1277,20 @@ bool OnlineEstimator::AddContactPoint(double t, int finger, const geometry::Vec2
   if (!m.Accept(stream, "contact_point", t, point.allFinite(), point.cwiseAbs().maxCoeff(), geometry::kMaxCoordinate))
     return false;
   if (m.contacts_left_out) return false;  // the contact check left the stream out
-  // A corrupt row (the batch's DropContactRowFaults), against the finger's newest pose when it
-  // is near in time: one row 5 m off took a batch estimate to 160 mm.
+  // A corrupt row (the batch's DropContactRowFaults), against the finger's pose near its time,
+  // once the contact check has found the stream on its finger (before, a stream 5 cm off had
+  // every row refused one by one, and the check that leaves the stream out never ran). Beyond the
+  // newest finger pose, the finger's recent speed widens the bound (a 20 Hz finger at 0.5 m/s
+  // moves 25 mm between poses: good rows were refused against the stale pose).
   const auto& poses = finger == 0 ? m.traj.measured.finger_pose : m.traj.extra_fingers[finger - 1].measured.finger_pose;
   const geometry::Shape& shape = finger == 0 ? m.traj.finger.shape : m.traj.extra_fingers[finger - 1].finger.shape;
-  if (internal::FingerPoseNear(poses, t) && !shape.empty()) {
+  const bool on_finger = m.contact_verdict.size() == static_cast<std::size_t>(m.fingers) &&
+                         m.contact_verdict[finger] == Impl::ContactVerdict::kOnFinger;
+  if (on_finger && internal::FingerPoseNear(poses, t) && !shape.empty()) {
     const geometry::Pose2 at = push::PoseAtClamped(poses.begin(), poses.end(), t);
     const double d = std::abs(geometry::QueryPoint(shape, geometry::InverseAct(at, point)).signed_distance);
-    const double bound = internal::ContactFaultBound(m.smoother->cfg.measurement);
+    const double beyond = std::max(0.0, t - poses.back().t);
+    const double bound = internal::ContactFaultBound(m.smoother->cfg.measurement) + 2.0 * Impl::RecentSpeed(poses) * beyond;
     if (d > bound) {
       m.Fault("contact_point row",
               internal::Format("more than %.3g mm from the finger's boundary at its pose near the row's time", 1e3 * bound),

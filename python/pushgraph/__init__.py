@@ -155,7 +155,10 @@ class OnlineEstimator:
     setup: a trajectory dict whose streams may be empty (object and finger descriptions);
     contact_point, force: which sensors will report (they decide contact gating and the
     limit-surface load factor). Each add_* returns False when the sample came too late (at or
-    before the last update) and was dropped; samples out of order or not finite raise GraphError.
+    before the last update) and was dropped, or was left out as a sensor fault (a tracker glitch
+    far from the poses before it, a contact row far off its finger, a force spike; counted by
+    dropped_faulty_samples, the first of each kind named in finish()'s warnings); samples out of
+    order, not finite or beyond 1e6 m / 1e9 N raise GraphError (the estimator goes on).
     Several fingers: setup["fingers"] holds fingers 1, 2, ... (their streams empty); their samples
     come with finger=k (each finger's sensors are the kinds declared), and latest_state() has
     finger1_pose, finger2_pose, ... and every contact with its finger.
@@ -196,6 +199,10 @@ class OnlineEstimator:
     @property
     def dropped_late_samples(self):
         return self._core.dropped_late_samples
+
+    @property
+    def dropped_faulty_samples(self):
+        return self._core.dropped_faulty_samples
 
     def warnings(self):
         """What is wrong with the setup so far, as sentences (finish() repeats them): the object's

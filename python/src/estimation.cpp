@@ -240,6 +240,7 @@ void RegisterEstimation(py::module_& m) {
            "until"_a = INFINITY)
       .def("latest_state", [](const Online& o) { return StateToDict(o.estimator->LatestState()); })
       .def_property_readonly("dropped_late_samples", [](const Online& o) { return o.estimator->DroppedLateSamples(); })
+      .def_property_readonly("dropped_faulty_samples", [](const Online& o) { return o.estimator->DroppedFaultySamples(); })
       .def("warnings", [](const Online& o) { return o.estimator->Warnings(); })
       .def("finish", [](Online& o) {
         EstimationResult r;

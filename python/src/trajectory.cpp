@@ -389,16 +389,30 @@ Raises IoError naming the file and the field.)doc");
               if (!(x >= 0.0) || !std::isfinite(x)) throw py::value_error("sigmas['" + key + "']: " + what + " must be finite and >= 0");
               return x;
             };
+            // A value of another form is named with what is expected (a bare "Unable to cast Python
+            // instance to C++ type" came of sigmas={"finger": (0.0005, 0.0)}).
+            auto number = [&](const char* expected) {
+              try {
+                return v.cast<double>();
+              } catch (const py::cast_error&) {
+                throw py::type_error("sigmas['" + key + "']: expected " + expected + ", got " + py::repr(v).cast<std::string>());
+              }
+            };
             if (key == "object") {
-              const auto pair = v.cast<std::pair<double, double>>();
+              std::pair<double, double> pair;
+              try {
+                pair = v.cast<std::pair<double, double>>();
+              } catch (const py::cast_error&) {
+                throw py::type_error("sigmas['object']: expected a pair (position m, angle rad), got " + py::repr(v).cast<std::string>());
+              }
               plan.noise.object_pose.position.sigma = positive(pair.first, "the position sigma");
               plan.noise.object_pose.angle.sigma = positive(pair.second, "the angle sigma");
             } else if (key == "finger") {
-              plan.noise.finger_pose.position.sigma = positive(v.cast<double>(), "the sigma");
+              plan.noise.finger_pose.position.sigma = positive(number("one number (the position sigma, m; the finger's angle is not noised)"), "the sigma");
             } else if (key == "contact") {
-              plan.noise.contact_point.position.sigma = positive(v.cast<double>(), "the sigma");
+              plan.noise.contact_point.position.sigma = positive(number("one number (m)"), "the sigma");
             } else if (key == "force") {
-              plan.noise.force.position.sigma = positive(v.cast<double>(), "the sigma");
+              plan.noise.force.position.sigma = positive(number("one number (N)"), "the sigma");
             } else {
               throw py::value_error("sigmas: unknown key '" + key + "' (object, finger, contact, force)");
             }

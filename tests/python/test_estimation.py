@@ -158,6 +158,49 @@ def test_online_estimator_fed_from_python(push):
     assert online.warnings() == []
 
 
+def feed_online(push, **streams):
+    """The push's samples in time order into an OnlineEstimator, updating when due; its result."""
+    setup = {"object": push["object"], "finger": push["finger"], "measured": {},
+             "measurement_sigmas": push["measurement_sigmas"], "ground_truth": push["ground_truth"]}
+    online = pg.OnlineEstimator(setup, model="qs", contact_point=True, force=True, **streams)
+    m = push["measured"]
+    samples = sorted(((t, stream, v) for stream, value in [("object_pose", "pose"), ("finger_pose", "pose"),
+                                                             ("contact_point", "point"), ("force", "force")]
+                      for t, v in zip(m[stream]["t"], m[stream][value])), key=lambda s: s[0])
+    add = {"object_pose": online.add_object_pose, "finger_pose": online.add_finger_pose,
+           "contact_point": online.add_contact_point, "force": online.add_force}
+    for k, (t, stream, v) in enumerate(samples):
+        add[stream](t, v)
+        if (k + 1 == len(samples) or samples[k + 1][0] > t) and online.update_due():
+            online.update()
+    result = online.finish()
+    result["dropped_faulty_samples"] = online.dropped_faulty_samples
+    return result
+
+
+def test_online_fault_guards_keep_good_samples(notched_block):
+    """The online guards against tracker glitches and corrupt contact rows take nothing good: a fast
+    push from rest with a precise tracker (0.3 s of poses were refused at its onset), a 20 Hz finger
+    at 0.5 m/s (contact rows judged against its stale pose); and a contact stream 5 cm off is left
+    out by the contact check, not row by row (each row was refused, and the check never ran)."""
+    finger = pg.Shape.disk(0.005)
+    fast = pg.simulate(notched_block, finger, speed=0.4, distance=0.3, standoff=0.18, object_rate=20.0, seed=3,
+                       sigmas={"object": (0.0005, 0.005)})
+    coarse = pg.simulate(notched_block, finger, speed=0.5, distance=0.3, finger_rate=20.0, seed=3)
+    for push in (fast, coarse):
+        result = feed_online(push)
+        assert not [w for w in result["warnings"] if "sensor faults" in w], result["warnings"]
+        assert result["dropped_faulty_samples"] == 0
+        assert np.all(np.isfinite(result["object_pose"]))
+    with pytest.raises(TypeError, match=r"sigmas\['finger'\]: expected one number"):
+        pg.simulate(notched_block, finger, sigmas={"finger": (0.0005, 0.0)})
+    off = pg.simulate(notched_block, finger, seed=3, sigmas={"contact": 0.001, "finger": 0.0005})
+    off["measured"]["contact_point"]["point"][:, 0] += 0.05
+    result = feed_online(off)
+    assert [w for w in result["warnings"] if "contact check (OnlineEstimator" in w], result["warnings"]
+    assert not [w for w in result["warnings"] if "contact_point row" in w], result["warnings"]
+
+
 def test_online_estimator_names_a_shape_in_millimetres(push):
     setup = {"object": dict(push["object"]), "finger": push["finger"], "measured": {}}
     setup["object"]["shape"] = push["object"]["shape"].transformed(scale=1000.0)

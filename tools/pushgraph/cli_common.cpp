@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cerrno>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -21,6 +22,7 @@
 #include <vector>
 
 #include <stdlib.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 namespace pushgraph::cli {
@@ -208,6 +210,8 @@ namespace {
 // such a file is read twice).
 geometry::Shape LoadMeshArgument(const std::string& path, const std::string& what, std::vector<std::string>* warnings,
                                  MeshReadings* other_readings) {
+  // Messages name the path given (a piped input is read from a temporary copy).
+  const std::string shown = WithGivenInputPaths(path);
   io::FootprintOptions options;
   io::FootprintReport report;
   geometry::Shape shape;
@@ -247,24 +251,24 @@ geometry::Shape LoadMeshArgument(const std::string& path, const std::string& wha
                "pushgraph: %s %s: the mesh's footprint along %s%s, in its own frame and units (%zu polygon(s), %d "
                "hole(s), %.4g x %.4g m); another up axis, scale or frame: pushgraph footprint %s --up/--scale/"
                "--transform -o SHAPE.json\n",
-               what.c_str(), path.c_str(), up,
+               what.c_str(), shown.c_str(), up,
                options.up == io::UpAxis::kZ ? ""
                : report.flat_axis           ? " (an outline drawn flat across it)"
                                             : " (a prism along it: its cross-section)",
                shape.polygons().size(), holes, box.max.x() - box.min.x(),
-               box.max.y() - box.min.y(), path.c_str());
+               box.max.y() - box.min.y(), shown.c_str());
   for (std::string w : report.warnings) {
     // footprint's own flags (--object names the shape file here, and there is no --up): the command.
     for (const std::string flag : {"--object NAME", "--up x", "--up y", "--up z"}) {
       if (const std::size_t at = w.find(flag); at != std::string::npos)
-        w.replace(at, flag.size(), "pushgraph footprint " + path + " " + flag + " -o SHAPE.json");
+        w.replace(at, flag.size(), "pushgraph footprint " + shown + " " + flag + " -o SHAPE.json");
     }
     if (other_readings && !other_readings->shapes.empty() && w.find("its side view") != std::string::npos) {
       other_readings->side_view = w;  // the caller's recording decides whether it is one
       continue;
     }
-    std::fprintf(stderr, "pushgraph: warning: %s %s: %s\n", what.c_str(), path.c_str(), w.c_str());
-    if (warnings) warnings->push_back(what + " " + path + ": " + w);
+    std::fprintf(stderr, "pushgraph: warning: %s %s: %s\n", what.c_str(), shown.c_str(), w.c_str());
+    if (warnings) warnings->push_back(what + " " + shown + ": " + w);
   }
   if (finger) {
     // A tessellated cylinder is the disk it approximates (geometry::TessellatedDisk; the
@@ -276,8 +280,8 @@ geometry::Shape LoadMeshArgument(const std::string& path, const std::string& wha
                    "of radius %.4g mm at (%.3f, %.3f) mm it approximates (a polygonal finger solves 6 to 13x "
                    "slower; to keep the polygon: pushgraph footprint %s%s -o SHAPE.json, and "
                    "\"tessellated_finger_as_disk\": false in --config)\n",
-                   what.c_str(), path.c_str(), fit->corners, 1e3 * fit->disk.radius(),
-                   1e3 * centre.x(), 1e3 * centre.y(), path.c_str(),
+                   what.c_str(), shown.c_str(), fit->corners, 1e3 * fit->disk.radius(),
+                   1e3 * centre.x(), 1e3 * centre.y(), shown.c_str(),
                    options.up == io::UpAxis::kZ ? "" : (std::string(" --up ") + up).c_str());
       return fit->disk;
     }
@@ -319,7 +323,27 @@ CLI::Validator ReadOnceInput() {
         std::error_code ec;
         const fs::file_status st = fs::status(path, ec);
         if (ec || fs::is_regular_file(st) || fs::is_directory(st) || !fs::exists(st)) return "";  // the readers say what is wrong
-        if (!fs::is_fifo(st) && !fs::is_character_file(st) && !fs::is_socket(st)) return "";
+        struct stat input_stat {};
+        const bool stated = ::stat(path.c_str(), &input_stat) == 0;
+        // A device is no input, but for this command's standard input at a terminal (/dev/zero
+        // was read, or copied, until memory or /tmp filled).
+        if (fs::is_character_file(st) || fs::is_block_file(st)) {
+          struct stat in_stat {};
+          const bool is_stdin = stated && ::fstat(STDIN_FILENO, &in_stat) == 0 && in_stat.st_dev == input_stat.st_dev &&
+                                in_stat.st_ino == input_stat.st_ino;
+          return is_stdin ? "" : path + " is a device, not an input file";
+        }
+        if (!fs::is_fifo(st) && !fs::is_socket(st)) return "";
+        // This command's own output or error stream is no input (--config /dev/stdout into a pipe
+        // waited forever for its own output).
+        if (stated) {
+          for (const int fd : {STDOUT_FILENO, STDERR_FILENO}) {
+            struct stat out_stat {};
+            if (::fstat(fd, &out_stat) == 0 && out_stat.st_dev == input_stat.st_dev && out_stat.st_ino == input_stat.st_ino)
+              return path + " is this command's own " + (fd == STDOUT_FILENO ? "standard output" : "standard error") +
+                     ", not an input";
+          }
+        }
         std::ifstream in(path, std::ios::binary);
         if (!in) return "";
         PipedInputs& piped = Piped();
@@ -330,7 +354,20 @@ CLI::Validator ReadOnceInput() {
         }
         const fs::path copy = piped.dir / (std::to_string(piped.copies.size()) + "-" + fs::path(path).filename().string());
         std::ofstream out(copy, std::ios::binary);
-        out << in.rdbuf();
+        // At most 4 GiB: no input of this tool is larger, and an endless producer must not fill /tmp.
+        constexpr std::uint64_t kMaxPipedBytes = std::uint64_t{4} << 30;
+        std::vector<char> buffer(1 << 16);
+        std::uint64_t total = 0;
+        while (in.read(buffer.data(), static_cast<std::streamsize>(buffer.size())) || in.gcount() > 0) {
+          out.write(buffer.data(), in.gcount());
+          total += static_cast<std::uint64_t>(in.gcount());
+          if (total > kMaxPipedBytes) {
+            out.close();
+            std::error_code remove_ec;
+            fs::remove(copy, remove_ec);
+            return "the piped input " + path + " goes on beyond 4 GiB: no input of pushgraph is that large";
+          }
+        }
         out.close();
         if (!out) return "cannot copy the piped input " + path + " to " + copy.string();
         piped.copies.emplace_back(copy.string(), path);
@@ -348,8 +385,10 @@ std::string WithGivenInputPaths(std::string text) {
 }
 
 void WarnShapeUnits(const geometry::Shape& shape, const std::string& what, const std::string& path) {
-  if (const auto units = io::ShapeUnitsWarning(shape, 1.0, "pushgraph footprint " + path + " --scale "))
-    std::fprintf(stderr, "pushgraph: warning: %s %s: %s\n", what.c_str(), path.c_str(), units->c_str());
+  // Messages name the path given (a piped input is read from a temporary copy).
+  const std::string shown = WithGivenInputPaths(path);
+  if (const auto units = io::ShapeUnitsWarning(shape, 1.0, "pushgraph footprint " + shown + " --scale "))
+    std::fprintf(stderr, "pushgraph: warning: %s %s: %s\n", what.c_str(), shown.c_str(), units->c_str());
 }
 
 geometry::Shape LoadShapeArgument(const std::string& path, const std::string& what, std::vector<std::string>* warnings,
@@ -371,10 +410,12 @@ geometry::Shape LoadShapeArgument(const std::string& path, const std::string& wh
 
 std::string ChooseObjectReading(const std::string& path, const MeshReadings& readings, const graph::EstimatorConfig& config,
                                 push::Trajectory* trajectory, std::vector<std::string>* warnings) {
+  // Messages name the path given (a piped input is read from a temporary copy).
+  const std::string shown = WithGivenInputPaths(path);
   if (readings.shapes.empty()) return "";
   auto say = [&](const std::string& text) {
-    std::fprintf(stderr, "pushgraph: warning: --object %s: %s\n", path.c_str(), text.c_str());
-    if (warnings) warnings->push_back("--object " + path + ": " + text);
+    std::fprintf(stderr, "pushgraph: warning: --object %s: %s\n", shown.c_str(), text.c_str());
+    if (warnings) warnings->push_back("--object " + shown + ": " + text);
   };
   if (config.align_shape == graph::EstimatorConfig::AlignShape::kOff) {
     if (!readings.side_view.empty()) say(readings.side_view);
@@ -394,7 +435,7 @@ std::string ChooseObjectReading(const std::string& path, const MeshReadings& rea
     say("the mesh is a prism along " + up + " (a y-up export, or an object lying on its side), and the recording's "
         "contacts fit its cross-section along " + up + ", not its footprint along z (its side view): estimated with the "
         "cross-section (" + FormatSize(box.max.x() - box.min.x()) + " x " + FormatSize(box.max.y() - box.min.y()) +
-        " in the file's units; " + reason + "); pushgraph footprint " + path + " --up " + up + " -o SHAPE.json saves it");
+        " in the file's units; " + reason + "); pushgraph footprint " + shown + " --up " + up + " -o SHAPE.json saves it");
     return up;
   }
   if (!readings.side_view.empty() && !(choice.checked[0] && choice.checks[0].fits))

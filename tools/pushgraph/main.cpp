@@ -65,7 +65,7 @@ int main(int argc, char** argv) {
     for (CLI::Option* opt : sub->get_options()) {
       if (opt->get_type_size() == 0) continue;
       opt->check(CLI::Validator(
-          [](std::string& value) { return value.empty() ? std::string("an empty value (a file name or a number is expected)") : std::string(); },
+          [](std::string& value) { return value.empty() ? std::string("an empty value") : std::string(); },
           "", "NonEmpty"));
     }
   }

@@ -118,13 +118,20 @@ class OnlineEstimator {
   /// Each returns false when the sample came too late (at or before the last update) and was dropped;
   /// AddContactPoint also once the contact check left the stream out (its points off the finger:
   /// another frame or an offset; Finish() says so).
+  /// Also false for a sample no sensor of this push could have measured, left out as a sensor
+  /// fault (DroppedFaultySamples() counts them; Finish()'s warnings name the first of each kind):
+  /// an object pose far from the five before it (a tracker glitch: more than max(1 cm, 10 sigmas)
+  /// or max(0.3 rad, 10 sigmas) beyond their motion and the finger's; three such poses in a row
+  /// that agree are a step of the tracker, taken from the third); a contact row farther from the
+  /// finger than ContactFaultBound (max(2 cm, 10 sigmas)), once the contact check found its stream
+  /// on the finger; a force as AddForce says. A position beyond 1e6 m or a force beyond 1e9 N is a
+  /// GraphError naming the sample (not taken; the estimator goes on).
   /// Without a finger index: finger 0 (Trajectory::finger).
   bool AddObjectPose(double t, const geometry::Pose2& pose);
   bool AddFingerPose(double t, const geometry::Pose2& pose);
   bool AddContactPoint(double t, const geometry::Vec2& point);
   /// Also false for a force no sensor of this push could have measured (above 50 times the larger
-  /// of the recent forces' 95th percentile and mu m g, and above 1 N): a sensor fault, left out;
-  /// DroppedFaultySamples() counts them and Finish()'s warnings name the first.
+  /// of the recent forces' 95th percentile and mu m g, and above 1 N): a sensor fault, left out.
   bool AddForce(double t, const geometry::Vec2& force);
   /// Finger `finger`'s samples: 0 is Trajectory::finger, k >= 1 the setup's extra_fingers[k - 1]
   /// (a push with several fingers; each has the kinds of sensors OnlineStreams declares). Every
