@@ -225,7 +225,9 @@ PosePairs Broadcast(const py::handle& a_in, const py::handle& b_in, const char* 
     throw py::value_error(std::string(a_name) + " and " + b_name + ": " + std::to_string(na) + " and " +
                           std::to_string(nb) + " rows (equal, or one of them 1)");
   }
-  p.n = std::max(na, nb);
+  // NumPy's rule: one row beside none is none (it was one row, read from the empty array's
+  // missing memory).
+  p.n = na == 0 || nb == 0 ? 0 : std::max(na, nb);
   return p;
 }
 

@@ -107,12 +107,30 @@ of the centre of pressure.
       .def(
           "twist_for_load",
           [](const PyLimitSurface& ls, const py::handle& loads) {
-            return MapRows(loads, "loads", [&](const double* l, double* out) {
+            // Rows whose Newton solve did not converge (a facet of a point support's surface,
+            // where the twist is not unique): said, as C++'s InverseResult::converged says it
+            // (185 of 2000 random loads on three legs came back silently, 1.9x off in dissipation).
+            std::size_t unconverged = 0, first = 0, row = 0;
+            double first_residual = 0.0;
+            py::array_t<double> twists = MapRows(loads, "loads", [&](const double* l, double* out) {
               const InverseResult r = TwistForLoad(ls.support, Load{Vec2(l[0], l[1]), l[2]});
               out[0] = r.twist.vx;
               out[1] = r.twist.vy;
               out[2] = r.twist.omega;
+              if (!r.converged && unconverged++ == 0) first = row, first_residual = r.angle_residual;
+              ++row;
             });
+            if (unconverged > 0) {
+              char text[400];
+              std::snprintf(text, sizeof text,
+                            "twist_for_load: %zu of %zu loads did not converge (the first: loads[%zu], its load %.3g rad "
+                            "from the surface's): where the limit surface is not smooth (a support of points or straight "
+                            "edges has flat faces and creases) the solve can stop short, and the returned twist need not "
+                            "be the load's (the one of maximum dissipation)",
+                            unconverged, row, first, first_residual);
+              WarnUser(text);
+            }
+            return twists;
           },
           "loads"_a,
           "The exact surface's twist direction for each load (N, 3) -> (N, 3): (vx, vy, omega), scaled so\n"

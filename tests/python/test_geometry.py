@@ -150,6 +150,10 @@ def test_shape_pairs_broadcast_and_their_jacobians(notched_block):
         np.testing.assert_allclose(r["J_sd_object_pose"][i], num, atol=1e-6)
     with pytest.raises(ValueError, match="3 and 2 rows"):
         pair.query(np.zeros((3, 3)), np.zeros((2, 3)))
+    # One pose beside none is none, as NumPy broadcasts (it was one row read from missing memory).
+    for a, b in (((5, 5, 0), np.zeros((0, 3))), (np.zeros((0, 3)), (0, 0, 0))):
+        r = pair.query(a, b)
+        assert r["signed_distance"].shape == (0,) and r["finger_point"].shape == (0, 2)
 
 
 def test_distance_field_within_its_measured_error(notched_block):

@@ -48,6 +48,11 @@ def test_ellipsoid_and_bad_input():
         pg.LimitSurface(pg.Shape.disk(0.05), -1.0, 0.5)
     points = pg.LimitSurface(pg.Shape.box(0.1, 0.1), 1.0, 0.5, points=[[0.05, 0, 1.0], [-0.05, 0, 1.0]])
     assert points.summary["c"] == pytest.approx(0.05, rel=1e-12)
+    # A load whose inverse solve stops short on a point support's non-smooth surface is said (C++'s
+    # InverseResult::converged; Python returned it silently).
+    legs = pg.LimitSurface(pg.Shape.box(1, 1), 1, 0.5, points=[[0, 0, 1], [1, 0, 1], [0, 1, 1]])
+    with pytest.warns(UserWarning, match=r"twist_for_load: 1 of 1 loads did not converge \(the first: loads\[0\]"):
+        legs.twist_for_load([[1.4675926467316445, 0.2993293920542826, 1.7320450791519741]])
 
 
 def test_twist_for_load_columns_and_any_magnitude():
