@@ -481,6 +481,11 @@ Diagnostics Diagnose(const push::Trajectory& trajectory, Model model, const Esti
 /// 5 cm/s): a contact point at `t` can then be judged against the finger
 /// (DropContactStreamsOffTheFinger; OnlineEstimator counts such contacts before it judges).
 bool FingerPoseNear(const std::vector<push::PoseSample>& finger_poses, double t);
+/// How far `point` (world frame) lies from the finger's boundary at its pose at `t`, interpolated
+/// between the poses around `t` (held at the newest beyond it). The one measure of the contact
+/// checks: a stream off its finger, a corrupt row, online and in batch.
+double DistanceFromFinger(const std::vector<push::PoseSample>& finger_poses, const geometry::Shape& finger, double t,
+                          const geometry::Vec2& point);
 
 /// Refuses a trajectory the estimator cannot use (trajectory_checks.cpp; GraphError naming the
 /// stream, sample and value): missing shapes or streams, NaN, unsupported magnitudes, unsorted

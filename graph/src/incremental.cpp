@@ -645,8 +645,10 @@ struct IncrementalEstimator::Impl {
     std::string faults_note;
     std::optional<push::Trajectory> without_faults = internal::DropContactRowFaults(
         without_contacts ? *without_contacts : disks ? *disks : traj, cfg.measurement, &faults_note);
-    if (without_faults) *contacts_note += (contacts_note->empty() ? "" : "; ") + faults_note;
-    if (without_faults) return without_faults;
+    if (without_faults) {
+      *contacts_note += (contacts_note->empty() ? "" : "; ") + faults_note;
+      return without_faults;
+    }
     return without_contacts ? std::move(without_contacts) : disks ? std::move(disks) : std::move(delayed);
   }
 
@@ -1119,7 +1121,8 @@ struct OnlineEstimator::Impl {
   // `magnitude` within `bound` (positions within geometry::kMaxCoordinate, forces within 1e9 N,
   // the batch reader's bounds): one position of 1e20 m was taken, and every update after it
   // failed in the geometry with no word of which sample.
-  bool Accept(int stream, const char* name, double t, bool finite, double magnitude = 0.0, double bound = INFINITY) {
+  bool Accept(int stream, const char* name, double t, bool finite, double magnitude = 0.0, double bound = INFINITY,
+              const char* unit = "") {
     const std::size_t index = seen[stream];
     auto where = [&] {
       return "OnlineEstimator: streams." + (stream >= 4 ? "fingers[" + std::to_string((stream - 1) / 3) + "]." : std::string()) + name + "[" +
@@ -1132,7 +1135,7 @@ struct OnlineEstimator::Impl {
     }
     if (!std::isfinite(t) || !finite) throw GraphError(where() + " is not finite");
     if (magnitude > bound) {
-      throw GraphError(where() + " is out of the supported range (" + Precise(magnitude) + (bound > 1e8 ? " N" : " m") +
+      throw GraphError(where() + " is out of the supported range (" + Precise(magnitude) + " " + unit +
                        "; positions within 1e6 m, forces within 1e9 N): a corrupt sample? It is not taken");
     }
     // The trajectory's bound (|t| <= 1e11 s: epoch seconds): one wild first time stamp (-1e300)
@@ -1245,7 +1248,7 @@ bool OnlineEstimator::AddObjectPose(double stamp, const geometry::Pose2& pose) {
   const double t = stamp - impl_->smoother->cfg.object_delay;
   const std::size_t index = impl_->seen[0];
   if (!impl_->Accept(0, "object_pose", t, pose.vector().allFinite(), pose.translation().cwiseAbs().maxCoeff(),
-                     geometry::kMaxCoordinate))
+                     geometry::kMaxCoordinate, "m"))
     return false;
   double off = 0.0;
   if (impl_->ObjectPoseGlitch(t, pose, &off)) {
@@ -1265,7 +1268,7 @@ bool OnlineEstimator::AddFingerPose(double t, int finger, const geometry::Pose2&
   Impl& m = *impl_;
   const int stream = m.FingerStream(finger, 0, "AddFingerPose");
   if (!m.Accept(stream, "finger_pose", t, pose.vector().allFinite(), pose.translation().cwiseAbs().maxCoeff(),
-                geometry::kMaxCoordinate))
+                geometry::kMaxCoordinate, "m"))
     return false;
   (finger == 0 ? m.traj.measured.finger_pose : m.traj.extra_fingers[finger - 1].measured.finger_pose).push_back({t, pose});
   return true;
@@ -1274,7 +1277,7 @@ bool OnlineEstimator::AddContactPoint(double t, int finger, const geometry::Vec2
   Impl& m = *impl_;
   const int stream = m.FingerStream(finger, 1, "AddContactPoint");
   const std::size_t index = m.seen[stream];
-  if (!m.Accept(stream, "contact_point", t, point.allFinite(), point.cwiseAbs().maxCoeff(), geometry::kMaxCoordinate))
+  if (!m.Accept(stream, "contact_point", t, point.allFinite(), point.cwiseAbs().maxCoeff(), geometry::kMaxCoordinate, "m"))
     return false;
   if (m.contacts_left_out) return false;  // the contact check left the stream out
   // A corrupt row (the batch's DropContactRowFaults), against the finger's pose near its time,
@@ -1287,8 +1290,7 @@ bool OnlineEstimator::AddContactPoint(double t, int finger, const geometry::Vec2
   const bool on_finger = m.contact_verdict.size() == static_cast<std::size_t>(m.fingers) &&
                          m.contact_verdict[finger] == Impl::ContactVerdict::kOnFinger;
   if (on_finger && internal::FingerPoseNear(poses, t) && !shape.empty()) {
-    const geometry::Pose2 at = push::PoseAtClamped(poses.begin(), poses.end(), t);
-    const double d = std::abs(geometry::QueryPoint(shape, geometry::InverseAct(at, point)).signed_distance);
+    const double d = internal::DistanceFromFinger(poses, shape, t, point);
     const double beyond = std::max(0.0, t - poses.back().t);
     const double bound = internal::ContactFaultBound(m.smoother->cfg.measurement) + 2.0 * Impl::RecentSpeed(poses) * beyond;
     if (d > bound) {
@@ -1307,7 +1309,7 @@ bool OnlineEstimator::AddForce(double t, int finger, const geometry::Vec2& force
   Impl& m = *impl_;
   const int stream = m.FingerStream(finger, 2, "AddForce");
   const std::size_t index = m.seen[stream];
-  if (!m.Accept(stream, "force", t, force.allFinite(), force.cwiseAbs().maxCoeff(), 1e9)) return false;
+  if (!m.Accept(stream, "force", t, force.allFinite(), force.cwiseAbs().maxCoeff(), 1e9, "N")) return false;
   const double magnitude = force.norm();
   const bool known_object = m.traj.object.mass > 0.0 && m.traj.object.mu_surface > 0.0;
   if (m.recent_force.size() >= 8) {

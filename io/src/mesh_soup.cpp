@@ -35,11 +35,15 @@ void CheckClaimedCounts(const std::string& path, const std::string& format) {
   const auto bytes = std::filesystem::file_size(path, ec);
   if (ec) return;
   auto fail = [&](const std::string& what) { throw IoError(path + ": cannot read " + format + " mesh: " + what); };
-  auto count_at = [&](const std::string& token, const std::string& what, std::size_t line) {
+  // A token's value as a whole number >= 0, or -1 when it is none.
+  auto whole = [](const std::string& token) {
     char* end = nullptr;
     const double v = std::strtod(token.c_str(), &end);
-    if (end == token.c_str() || *end != '\0' || !(v >= 0.0) || v != std::floor(v))
-      fail(what + " at line " + std::to_string(line) + " is '" + token + "', not a count");
+    return end == token.c_str() || *end != '\0' || !(v >= 0.0) || v != std::floor(v) ? -1.0 : v;
+  };
+  auto count_at = [&](const std::string& token, const std::string& what, std::size_t line) {
+    const double v = whole(token);
+    if (v < 0.0) fail(what + " at line " + std::to_string(line) + " is '" + token + "', not a count");
     if (v > static_cast<double>(bytes) / 2.0)
       fail(what + " at line " + std::to_string(line) + " claims " + token + ", more than the file's " + std::to_string(bytes) +
            " bytes could hold (truncated, or a corrupt count)");
@@ -58,8 +62,8 @@ void CheckClaimedCounts(const std::string& path, const std::string& format) {
     }
     return t;
   };
-  // A face line: its vertex count within the numbers after it.
-  // Its indices within the `vertices` (counted from 0, as OFF and PLY count).
+  // A face line: its vertex count within the numbers after it, its indices within `vertices`
+  // (counted from 0, as OFF and PLY count).
   auto check_face = [&](const std::vector<std::string>& t, std::size_t face, std::size_t line, std::size_t vertices) {
     if (t.empty()) return;
     const std::string which = "face " + std::to_string(face + 1) + " at line " + std::to_string(line);
@@ -67,10 +71,8 @@ void CheckClaimedCounts(const std::string& path, const std::string& format) {
     if (n + 1 > t.size())
       fail(which + " lists " + t[0] + " vertices but its line holds " + std::to_string(t.size() - 1) + " numbers after the count");
     for (std::size_t k = 1; k <= n; ++k) {
-      char* end = nullptr;
-      const double index = std::strtod(t[k].c_str(), &end);
-      if (end == t[k].c_str() || *end != '\0' || !(index >= 0.0) || index != std::floor(index) ||
-          index >= static_cast<double>(vertices))
+      const double index = whole(t[k]);
+      if (index < 0.0 || index >= static_cast<double>(vertices))
         fail(which + " refers to vertex '" + t[k] + "', but the file has " + std::to_string(vertices) +
              " vertices, indexed from 0 to " + std::to_string(vertices == 0 ? 0 : vertices - 1));
     }

@@ -348,6 +348,7 @@ CLI::Validator ReadOnceInput() {
         if (!in) return "";
         PipedInputs& piped = Piped();
         if (piped.dir.empty()) {
+          // mkdtemp replaces the six X's with a unique name and creates the folder (mode 0700).
           std::string templ = (fs::temp_directory_path(ec) / "pushgraph-input-XXXXXX").string();
           if (ec || ::mkdtemp(templ.data()) == nullptr) return "cannot copy the piped input " + path + " to a temporary file";
           piped.dir = templ;
