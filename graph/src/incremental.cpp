@@ -614,7 +614,7 @@ struct FixedLagSmoother {
   }
 
   StateEstimate LatestState(const char* who) const {
-    if (next_step == 0) throw GraphError(std::string(who) + "::LatestState before the first Update");
+    if (next_step == 0) throw GraphError(std::string(who) + "::LatestState: no step estimated yet (no Update has added a step)");
     StateEstimate s = builder.State(next_step - 1);
     if (!builder.ForceScaleObservable()) s.force.reset();  // as Finish() reports it
     return s;

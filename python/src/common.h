@@ -11,6 +11,7 @@
 #include <cmath>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 // Every float argument of the module (a radius, a mass, mu, a resolution) refuses booleans:
@@ -108,21 +109,25 @@ inline Array Vector(const py::handle& object, const char* what) {
   return a;
 }
 
-/// The first row of `a` (N, k) with a non-finite entry, or -1.
-inline py::ssize_t FirstNonFinite(const Array& a) {
+/// The first entry of `a` (N, k) that is not finite, as (row, column), or (-1, -1).
+inline std::pair<py::ssize_t, py::ssize_t> FirstNonFinite(const Array& a) {
   const double* d = a.data();
   const py::ssize_t n = a.shape(0), k = a.shape(1);
   for (py::ssize_t i = 0; i < n; ++i) {
     for (py::ssize_t j = 0; j < k; ++j) {
-      if (!std::isfinite(d[i * k + j])) return i;
+      if (!std::isfinite(d[i * k + j])) return {i, j};
     }
   }
-  return -1;
+  return {-1, -1};
 }
 
+/// ValueError naming the entry: "pose[0, 2] is nan" (a NaN theta read "pose[0] is not finite").
 inline void CheckFinite(const Array& a, const char* what) {
-  const py::ssize_t bad = FirstNonFinite(a);
-  if (bad >= 0) throw py::value_error(std::string(what) + "[" + std::to_string(bad) + "] is not finite");
+  const auto [row, column] = FirstNonFinite(a);
+  if (row < 0) return;
+  const double value = a.data()[row * a.shape(1) + column];
+  throw py::value_error(std::string(what) + "[" + std::to_string(row) + ", " + std::to_string(column) + "] is " +
+                        (std::isnan(value) ? "nan" : value > 0 ? "inf" : "-inf") + ": every entry must be finite");
 }
 
 /// A message from C++ as a Python str, invalid UTF-8 as U+FFFD: messages quote file names and

@@ -131,6 +131,8 @@ def test_online_estimator_fed_from_python(push):
     setup = {"object": push["object"], "finger": push["finger"],
              "measured": {}, "measurement_sigmas": push["measurement_sigmas"]}
     online = pg.OnlineEstimator(setup, model="qs", contact_point=True, force=True)
+    with pytest.raises(pg.GraphError, match="no step estimated yet"):
+        online.latest_state()
     m = push["measured"]
     samples = []
     for stream, value in [("object_pose", "pose"), ("finger_pose", "pose"), ("contact_point", "point"), ("force", "force")]:

@@ -41,7 +41,7 @@ def test_bad_shapes_name_what_and_where():
     bowtie = np.array([[0, 0], [1, 1], [1, 0], [0, 1]], dtype=float)
     with pytest.raises(pg.GeometryError, match="polygon 0, outer boundary, vertex 0: ring is not simple"):
         pg.Shape.from_arrays(bowtie)
-    with pytest.raises(ValueError, match=r"outer\[2\] is not finite"):
+    with pytest.raises(ValueError, match=r"outer\[2, 0\] is nan: every entry must be finite"):
         pg.Shape.from_arrays([[0, 0], [1, 0], [np.nan, 1]])
     with pytest.raises(ValueError, match=r"shape \(N, 2\), got \(3, 3\)"):
         pg.Shape.from_arrays(np.zeros((3, 3)))
@@ -67,7 +67,7 @@ def test_query_arrays_shapes_dtypes_and_bad_arrays(notched_block):
     assert notched_block.signed_distance([0.0, 0.0]).shape == (1,)
     assert notched_block.signed_distance(np.zeros((0, 2))).shape == (0,)
     assert notched_block.signed_distance(np.array([[1, 2]], dtype=np.int64))[0] > 0
-    with pytest.raises(ValueError, match=r"points\[3\] is not finite"):
+    with pytest.raises(ValueError, match=r"points\[3, 1\] is inf"):
         bad = pts.copy()
         bad[3, 1] = np.inf
         notched_block.signed_distance(bad)
@@ -148,6 +148,11 @@ def test_shape_pairs_broadcast_and_their_jacobians(notched_block):
         np.testing.assert_allclose(r["J_sd_finger_pose"][i], num, atol=1e-6)
         num = numeric_jacobian(lambda x: pair.query(x, finger[i])["signed_distance"], np.zeros(3))
         np.testing.assert_allclose(r["J_sd_object_pose"][i], num, atol=1e-6)
+    # A bad entry is named by row and column: a NaN heading was "pose[0] is not finite".
+    bad = finger.copy()
+    bad[1, 2] = np.nan
+    with pytest.raises(ValueError, match=r"\[1, 2\] is nan"):
+        pair.query([0.0, 0.0, 0.0], bad)
     with pytest.raises(ValueError, match="3 and 2 rows"):
         pair.query(np.zeros((3, 3)), np.zeros((2, 3)))
     # One pose beside none is none, as NumPy broadcasts (it was one row read from missing memory).

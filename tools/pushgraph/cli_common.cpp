@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cerrno>
+#include <csignal>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -21,6 +22,7 @@
 #include <sstream>
 #include <vector>
 
+#include <signal.h>
 #include <stdlib.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -314,6 +316,42 @@ PipedInputs& Piped() {
   return piped;
 }
 
+// The same paths for a signal handler, which may only call async-signal-safe functions (unlink,
+// rmdir, raise): an interrupted or terminated run (Ctrl-C in a long estimate) left its copies
+// in /tmp. A path is written before the count that publishes it. SIGKILL cannot be caught.
+constexpr int kMaxSignalPaths = 16;
+char signal_files[kMaxSignalPaths][4096];
+char signal_dir[4096];
+volatile std::sig_atomic_t signal_file_count = 0;
+
+extern "C" void RemovePipedCopiesAndDie(int sig) {
+  for (int i = 0; i < signal_file_count; ++i) ::unlink(signal_files[i]);
+  if (signal_dir[0] != '\0') ::rmdir(signal_dir);
+  std::signal(sig, SIG_DFL);
+  std::raise(sig);
+}
+
+// Copies `path` into `slot` when it fits (with its terminating zero).
+bool CopyForSignal(const std::string& path, char* slot) {
+  if (path.size() >= sizeof signal_dir) return false;
+  std::memcpy(slot, path.c_str(), path.size() + 1);
+  return true;
+}
+
+// Once, when the folder is made: the handler for the signals that end a run, where the user
+// has not set them aside (nohup ignores SIGHUP: it stays ignored).
+void CleanUpOnSignals(const std::string& dir) {
+  if (!CopyForSignal(dir, signal_dir)) return;
+  for (const int sig : {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE}) {
+    struct sigaction current {};
+    if (::sigaction(sig, nullptr, &current) != 0 || current.sa_handler != SIG_DFL) continue;
+    struct sigaction action {};
+    action.sa_handler = RemovePipedCopiesAndDie;
+    sigemptyset(&action.sa_mask);
+    ::sigaction(sig, &action, nullptr);
+  }
+}
+
 }  // namespace
 
 CLI::Validator ReadOnceInput() {
@@ -352,8 +390,12 @@ CLI::Validator ReadOnceInput() {
           std::string templ = (fs::temp_directory_path(ec) / "pushgraph-input-XXXXXX").string();
           if (ec || ::mkdtemp(templ.data()) == nullptr) return "cannot copy the piped input " + path + " to a temporary file";
           piped.dir = templ;
+          CleanUpOnSignals(templ);
         }
         const fs::path copy = piped.dir / (std::to_string(piped.copies.size()) + "-" + fs::path(path).filename().string());
+        if (signal_file_count < kMaxSignalPaths && CopyForSignal(copy.string(), signal_files[signal_file_count])) {
+          signal_file_count = signal_file_count + 1;
+        }
         std::ofstream out(copy, std::ios::binary);
         // At most 4 GiB: no input of this tool is larger, and an endless producer must not fill /tmp.
         constexpr std::uint64_t kMaxPipedBytes = std::uint64_t{4} << 30;
