@@ -135,6 +135,45 @@ TEST(DistanceField, GradientMatchesNumericDifferences) {
   EXPECT_TRUE(tally.MostlyChecked(0.9));
 }
 
+// The outermost half cell keeps the exact gradient: the interpolation reads exact samples beyond
+// the grid (it read copies of the last row: 0.5 for 1.0 on a box's last row, (0.33, 0.33) at the
+// grid's corners, (0, 0) at a corner with margin 0).
+TEST(DistanceField, TheGradientHoldsUpToTheGridsEdge) {
+  const Shape box = Shape::Box(0.12, 0.08);
+  for (const double margin : {0.01, 0.0}) {
+    const DistanceField f(box, Opt(0.002, margin));
+    const Box2 b = f.grid_bounds();
+    std::mt19937_64 rng(805);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    double worst = 0.0;
+    Vec2 worst_at = Vec2::Zero();
+    for (int k = 0; k < Scaled(400, 100); ++k) {
+      // A point in the outermost half cell of a random side, away from the box's corners and
+      // (inside the box) from its medial axis.
+      const int side = k % 4;
+      const double along = u(rng), depth = 0.5 * 0.002 * u(rng);
+      Vec2 p;
+      if (side == 0) p = Vec2(b.min.x() + 0.03 + 0.06 * along, b.max.y() - depth);
+      if (side == 1) p = Vec2(b.min.x() + 0.03 + 0.06 * along, b.min.y() + depth);
+      if (side == 2) p = Vec2(b.max.x() - depth, b.min.y() + 0.03 + (b.max.y() - b.min.y() - 0.06) * along);
+      if (side == 3) p = Vec2(b.min.x() + depth, b.min.y() + 0.03 + (b.max.y() - b.min.y() - 0.06) * along);
+      Vec2 g;
+      f.Evaluate(p, &g);
+      const double err = (g - QueryPoint(box, p).normal).norm();
+      if (err > worst) worst = err, worst_at = p;
+    }
+    EXPECT_LT(worst, 0.02) << "margin " << margin << " at " << worst_at.transpose();
+    if (margin > 0.0) {
+      // The grid's corners lie outside the box, where the exact gradient is smooth.
+      for (const Vec2& corner : {b.min, b.max, Vec2(b.min.x(), b.max.y()), Vec2(b.max.x(), b.min.y())}) {
+        Vec2 g;
+        f.Evaluate(corner, &g);
+        EXPECT_LT((g - QueryPoint(box, corner).normal).norm(), 0.02) << corner.transpose() << ": " << g.transpose();
+      }
+    }
+  }
+}
+
 TEST(DistanceField, ConservativeOutsideTheGrid) {
   const Shape s = TestShape();
   const DistanceField f(s, Opt(0.05, 0.02));

@@ -1022,6 +1022,32 @@ TEST_F(EstimateCli, AProbeTooSmallIsNamedBesideThePlacement) {
   EXPECT_NE(r.err.find("check the probe radius"), std::string::npos) << r.err;
 }
 
+// rect1's mesh 10 % too large: the contacts and the whole graph fit a placement (turned by 4.7 deg)
+// and the finger 4.5 mm smaller about as well. The placement was reported settled, with sigmas,
+// and the size as a probe of radius 0.2 mm; now it is unsettled and the size is named as the
+// outline's (a hostile user's probe, 2026-11-30).
+TEST_F(EstimateCli, AMeshOfTheWrongSizeIsNoSettledPlacement) {
+  if (Mit().empty()) GTEST_SKIP() << "no MIT data";
+  const std::string h5 = Mit() + "abs/rect1/motion_surface=abs_shape=rect1_a=0_v=75_i=2.000_s=0.700_t=-1.047.h5";
+  const std::string out = dir() + "/large.json";
+  const pushgraph::testing::ToolRun r = EstimateMit(h5, "rect1.obj", "--scale 1.1", kProbe, kRect1Mass, out);
+  ASSERT_EQ(r.status, 0) << r.err;
+  const nlohmann::json j = Load(out);
+  EXPECT_FALSE(j["shape"]["placement_settled"].get<bool>()) << r.err;
+  EXPECT_NE(j["shape"]["placement_unsettled_by"].get<std::string>().find("(another probe radius or object size) fits about as well"),
+            std::string::npos)
+      << j["shape"].dump();
+  // 4.5 mm on every side of a 45 mm half width (10 % on this recording).
+  const std::size_t size_at = r.err.find("(as an object size: its outline about ");
+  ASSERT_NE(size_at, std::string::npos) << r.err;
+  const double percent = std::stod(r.err.substr(size_at + 38));
+  EXPECT_NEAR(percent, 10.0, 2.0) << r.err.substr(size_at, 80);
+  EXPECT_EQ(r.err.compare(size_at + 38 + std::to_string(static_cast<int>(percent)).size(), 12, " % too large"), 0)
+      << r.err.substr(size_at, 80);
+  EXPECT_EQ(r.err.find("do not fix its position along"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("the contacts fix its position in no direction"), std::string::npos) << r.err;
+}
+
 // A 9 mm probe given for the 4.7 mm one: on two ellip1 recordings the whole graph prefers the
 // finger 3.5 and 4.5 mm smaller to any placement by 8 and 43 in cost. Estimated with the probe as
 // given, against a shape it does not touch, they were 1.49 and 2.43 mm off; with the preferred
