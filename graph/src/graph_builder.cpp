@@ -228,11 +228,16 @@ int GraphBuilder::AppendSteps(double until) {
   force_contact_last_.resize(num_fingers(), -INFINITY);
   if (!streams_.contact_point && !object_moving_seen_)
     object_moving_seen_ = ObjectSeenMoving(m.object_pose, cfg_.measurement.object_trans, &object_poses_seen_);
+  if (contact_reach_.empty()) {
+    const double sigma = std::hypot(cfg_.measurement.object_trans, cfg_.measurement.finger_trans);
+    for (int k = 0; k < num_fingers(); ++k) contact_reach_.emplace_back(traj_.object.shape, FingerShape(k), sigma);
+  }
   for (int k = 0; k < num_fingers() && !streams_.contact_point; ++k) {
     const auto& force = ForceRows(k);
     for (std::size_t& j = force_samples_seen_[k]; j < force.size(); ++j) {
       if (!ForceSaysTouching(force, force[j].t, cfg_.contact_max_gap, cfg_.contact_force_threshold, cfg_.measurement.force))
         continue;
+      if (contact_reach_[k].OutOfReach(m.object_pose, FingerPoseRows(k), force[j].t)) continue;
       force_contact_first_[k] = std::min(force_contact_first_[k], force[j].t);
       force_contact_last_[k] = force[j].t;
     }
@@ -251,6 +256,7 @@ int GraphBuilder::AppendSteps(double until) {
     if (std::isfinite(force_contact_first_[finger]) &&
         (t < force_contact_first_[finger] - 0.1 || t > force_contact_last_[finger] + 0.1))
       return false;
+    if (contact_reach_[finger].OutOfReach(m.object_pose, FingerPoseRows(finger), t)) return false;
     int k = -1;
     const double gap = NearestGap(force, t, &k);
     return k >= 0 && gap <= cfg_.contact_max_gap && force[k].force.norm() >= cfg_.contact_force_threshold;

@@ -123,6 +123,23 @@ struct SolveOutcome {
   std::unique_ptr<ChainSolver> chain;
 };
 
+/// Where a finger can touch the object at all: its origin within `reach` of the object's core
+/// centroid, reach = max(2 R_object, 0.1 m) + R_finger + 5 sigma (R: each shape's radius about its
+/// centroid, or origin; sigma the two pose streams' translation noises combined; twice the
+/// object's radius and the 0.1 m floor leave room for a shape file off by its own size or in
+/// other units, which the registration judges). A force stream reading noise alone at 0.05 N had
+/// a finger 0.2 m from a resting box gated into contact and the box dragged 120 mm.
+struct ContactReach {
+  geometry::Vec2 centroid{0.0, 0.0};  ///< object frame
+  double reach = INFINITY;
+  ContactReach() = default;
+  ContactReach(const geometry::Shape& object, const geometry::Shape& finger, double sigma_trans);
+  /// True when both streams have a pose within 0.1 s of `t` and, interpolated there, the finger
+  /// lies beyond reach (an object unseen for longer may have been pushed anywhere).
+  bool OutOfReach(const std::vector<push::PoseSample>& object_poses, const std::vector<push::PoseSample>& finger_poses,
+                  double t) const;
+};
+
 class GraphBuilder {
  public:
   /// Solves `problem` (built by this builder) with config.solver; `what` names the stage in
@@ -444,6 +461,7 @@ class GraphBuilder {
   std::vector<std::size_t> force_samples_seen_;
   /// Per finger: the first and last times its force stream showed a contact above its noise.
   std::vector<double> force_contact_first_, force_contact_last_;
+  std::vector<ContactReach> contact_reach_;  // per finger: where a force-gated contact can be
   bool object_moving_seen_ = false;
   std::size_t object_poses_seen_ = 0;
   std::unordered_map<ceres::ResidualBlockId, std::pair<FactorType, int>> origin_;  ///< for Describe

@@ -156,6 +156,9 @@ ContactPath PathOf(const push::Trajectory& traj, const std::vector<push::PoseSam
     const auto& contact = extra ? extra->contact_point : traj.measured.contact_point;
     const auto& force = extra ? extra->force : traj.measured.force;
     const FingerDisk disk = FingerAsDisk(finger == 0 ? traj.finger.shape : traj.extra_fingers[finger - 1].finger.shape);
+    const internal::ContactReach reach(traj.object.shape,
+                                       finger == 0 ? traj.finger.shape : traj.extra_fingers[finger - 1].finger.shape,
+                                       std::hypot(o.pose_sigma_trans, o.pose_sigma_trans));
     // A force stream that never shows a contact above its noise: the finger never touched (as the
     // graph takes it; its noise crossing the threshold had a passing finger's path fitted).
     std::size_t scanned = 0;
@@ -173,6 +176,8 @@ ContactPath PathOf(const push::Trajectory& traj, const std::vector<push::PoseSam
         break;  // another finger has the contact sensor: this one never touched
       } else if (!force.empty()) {
         if (nearest(force, f.t, &k) > o.contact_max_gap || force[k].force.norm() < o.contact_force_threshold) continue;
+        // Where the finger cannot touch the object, as the graph gates it (ContactReach).
+        if (reach.OutOfReach(objects, fingers[finger], f.t)) continue;
       }
       // The object pose at f.t, interpolated across gaps of at most max_object_gap.
       auto it = std::lower_bound(objects.begin(), objects.end(), f.t - 1e-9, [](const auto& a, double tt) { return a.t < tt; });

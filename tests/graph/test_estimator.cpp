@@ -19,6 +19,7 @@
 #include <memory>
 #include <cstdio>
 #include <map>
+#include <random>
 #include <tuple>
 
 namespace pushgraph::graph {
@@ -547,6 +548,50 @@ TEST(Estimator, ACorruptContactRowIsLeftOutByName) {
   IncrementalEstimator inc(bad, Model::kQs, {});
   while (!inc.Done()) inc.Update();
   EXPECT_TRUE(HasWarning(inc.Finish(), "1 contact_point row left out as sensor faults"));
+}
+
+// A resting box, a finger 0.15 to 0.25 m away that never touches it, and a force sensor reading
+// its declared noise (0.05 N) alone: the noise's chance crossings gated the finger into contact
+// and the box was dragged 120 mm (30 mm RMS against 1.5 mm raw; a hostile user's probe,
+// 2026-11-30). A finger beyond reach of the object is never gated in (ContactReach).
+TEST(Estimator, ForceNoiseDoesNotGateAFarFingerIntoContact) {
+  for (const bool sweeping : {false, true}) {
+    push::Trajectory tr;
+    tr.object = {geometry::Shape::Box(0.09, 0.09), 0.8374, 0.25};
+    tr.finger = {geometry::Shape::Disk(0.005), 0.3};
+    push::MeasurementSigmas sigmas;
+    sigmas.object_trans = 0.001, sigmas.object_rot = 0.01, sigmas.finger_trans = 0.001, sigmas.finger_rot = 0.001;
+    sigmas.force = 0.05;
+    tr.measurement_sigmas = sigmas;
+    std::mt19937 rng(1);
+    std::normal_distribution<double> n(0.0, 1.0);
+    push::Streams truth;
+    for (int k = 0; k < 1500; ++k) {
+      const double t = 0.004 * k;
+      if (k % 10 == 0) {
+        tr.measured.object_pose.push_back({t, {0.001 * n(rng), 0.001 * n(rng), 0.01 * n(rng)}});
+        truth.object_pose.push_back({t, {0.0, 0.0, 0.0}});
+      }
+      const geometry::Pose2 finger{sweeping ? 0.2 + 0.05 * std::sin(t) : 0.2, 0.0, 0.0};
+      truth.finger_pose.push_back({t, finger});
+      tr.measured.finger_pose.push_back({t, {finger.x + 0.001 * n(rng), 0.001 * n(rng), 0.001 * n(rng)}});
+      tr.measured.force.push_back({t, {sigmas.force * n(rng), sigmas.force * n(rng)}});
+    }
+    tr.ground_truth = truth;
+    const EstimatorConfig cfg = ApplyMeasurementSigmas({}, sigmas);
+    for (const Mode mode : {Mode::kBatch, Mode::kIncremental}) {
+      const EstimationResult r = Estimate(tr, Model::kQs, mode, cfg);
+      int touching = 0;
+      double farthest = 0.0;
+      for (const StateEstimate& s : r.states) {
+        touching += s.contact ? 1 : 0;
+        farthest = std::max(farthest, std::hypot(s.object_pose.x, s.object_pose.y));
+      }
+      EXPECT_EQ(touching, 0) << (sweeping ? "sweeping" : "static") << " mode " << static_cast<int>(mode);
+      EXPECT_LT(farthest, 5e-3) << (sweeping ? "sweeping" : "static") << " mode " << static_cast<int>(mode);
+      EXPECT_LT(r.metrics.at("object_position_rms"), r.metrics.at("measured_object_position_rms"));
+    }
+  }
 }
 
 TEST(Estimator, ForcesOrAMassInAnotherUnitAreNamed) {
