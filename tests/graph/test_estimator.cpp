@@ -590,6 +590,9 @@ TEST(Estimator, ForceNoiseDoesNotGateAFarFingerIntoContact) {
       EXPECT_EQ(touching, 0) << (sweeping ? "sweeping" : "static") << " mode " << static_cast<int>(mode);
       EXPECT_LT(farthest, 5e-3) << (sweeping ? "sweeping" : "static") << " mode " << static_cast<int>(mode);
       EXPECT_LT(r.metrics.at("object_position_rms"), r.metrics.at("measured_object_position_rms"));
+      std::printf("[far finger] %s, %s: object RMS %.2f mm (raw %.2f), farthest %.2f mm\n", sweeping ? "sweeping" : "static",
+                  mode == Mode::kBatch ? "batch" : "incremental", 1e3 * r.metrics.at("object_position_rms"),
+                  1e3 * r.metrics.at("measured_object_position_rms"), 1e3 * farthest);
     }
   }
 }
