@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <limits>
 #include <cmath>
+#include <cstdio>
 #include <vector>
 
 namespace pushgraph::geometry {
@@ -112,9 +113,24 @@ DistanceField::~DistanceField() = default;
 DistanceField::DistanceField(DistanceField&&) noexcept = default;
 DistanceField& DistanceField::operator=(DistanceField&&) noexcept = default;
 
+namespace {
+// A moved-from field holds nothing: an error, not a null dereference.
+void RequireHeld(const void* impl) {
+  if (impl == nullptr) throw GeometryError("DistanceField: operation on a moved-from field");
+}
+}  // namespace
+
 double DistanceField::Evaluate(const Vec2& point, Vec2* gradient) const {
-  if (!std::isfinite(point.x()) || !std::isfinite(point.y())) throw GeometryError("distance field query point is not finite");
+  RequireHeld(impl_.get());
   const Impl& m = *impl_;
+  if (!std::isfinite(point.x()) || !std::isfinite(point.y())) throw GeometryError("distance field query point is not finite");
+  // The exact query's bound: beyond it the continuation's squared distances overflow (inf at 1e154).
+  if (std::abs(point.x()) > kMaxQueryCoordinate || std::abs(point.y()) > kMaxQueryCoordinate) {
+    char text[160];
+    std::snprintf(text, sizeof text, "distance field query point (%g, %g) is beyond %g, the query coordinates' bound", point.x(),
+                  point.y(), kMaxQueryCoordinate);
+    throw GeometryError(text);
+  }
   const Vec2 clamped = point.cwiseMax(m.bounds.min).cwiseMin(m.bounds.max);
   if (clamped == point) return m.Interpolate(point, gradient);
   // Outside the grid: value at the nearest grid point plus the distance to it (1-Lipschitz, so
@@ -126,10 +142,10 @@ double DistanceField::Evaluate(const Vec2& point, Vec2* gradient) const {
   return inner + extra;
 }
 
-double DistanceField::max_error() const { return impl_->max_error; }
-Vec2 DistanceField::max_error_location() const { return impl_->max_error_at; }
-int DistanceField::rows() const { return impl_->rows; }
-int DistanceField::cols() const { return impl_->cols; }
-Box2 DistanceField::grid_bounds() const { return impl_->bounds; }
+double DistanceField::max_error() const { return (RequireHeld(impl_.get()), impl_->max_error); }
+Vec2 DistanceField::max_error_location() const { return (RequireHeld(impl_.get()), impl_->max_error_at); }
+int DistanceField::rows() const { return (RequireHeld(impl_.get()), impl_->rows); }
+int DistanceField::cols() const { return (RequireHeld(impl_.get()), impl_->cols); }
+Box2 DistanceField::grid_bounds() const { return (RequireHeld(impl_.get()), impl_->bounds); }
 
 }  // namespace pushgraph::geometry

@@ -366,6 +366,11 @@ Shape Shape::Box(double width, double height, double radius) {
 
 Shape Shape::RegularPolygon(int n, double circumradius, double radius) {
   if (n < 3) throw GeometryError("a regular polygon needs n >= 3, got " + std::to_string(n));
+  // A bound before any allocation: n = 1e9 ran out of memory (killed, or std::bad_alloc).
+  constexpr int kMaxCorners = 1000000;
+  if (n > kMaxCorners)
+    throw GeometryError("a regular polygon of " + std::to_string(n) + " corners is more than " + std::to_string(kMaxCorners) +
+                        " (a circle is Shape::Disk)");
   if (!(circumradius > 0.0) || !std::isfinite(circumradius)) throw GeometryError("circumradius must be finite and > 0");
   Ring ring;
   for (int i = 0; i < n; ++i) {

@@ -518,7 +518,13 @@ ShapePairQuerier::~ShapePairQuerier() = default;
 ShapePairQuerier::ShapePairQuerier(ShapePairQuerier&&) noexcept = default;
 ShapePairQuerier& ShapePairQuerier::operator=(ShapePairQuerier&&) noexcept = default;
 
+// A moved-from querier holds nothing: an error, not a null dereference.
+static void RequireHeld(const void* impl) {
+  if (impl == nullptr) throw GeometryError("ShapePairQuerier: operation on a moved-from querier");
+}
+
 ShapePairResult ShapePairQuerier::Query(const Pose2& object_pose, const Pose2& finger_pose, ShapePairJacobians* J) const {
+  RequireHeld(impl_.get());
   CheckPose(object_pose, "object");
   CheckPose(finger_pose, "finger");
   const Impl& m = *impl_;
@@ -543,9 +549,10 @@ ShapePairResult ShapePairQuerier::Query(const Pose2& object_pose, const Pose2& f
   return r;
 }
 
-const Shape& ShapePairQuerier::object() const { return impl_->object; }
-const Shape& ShapePairQuerier::finger() const { return impl_->finger; }
+const Shape& ShapePairQuerier::object() const { return (RequireHeld(impl_.get()), impl_->object); }
+const Shape& ShapePairQuerier::finger() const { return (RequireHeld(impl_.get()), impl_->finger); }
 int ShapePairQuerier::obstacles_built() const {
+  RequireHeld(impl_.get());
   std::lock_guard<std::mutex> lock(impl_->mutex);
   return impl_->built;
 }

@@ -61,9 +61,27 @@ void CheckTwist(const Twist& twist) {
     throw LimitSurfaceError("twist is zero: a sliding load needs a non-zero twist");
 }
 
+// A Support is made by MakeSupport; a default-constructed one (no region, no load) gave c = NaN
+// and loads of zero without a word.
+void CheckSupport(const Support& support) {
+  bool prepared = std::isfinite(support.normal_force) && support.normal_force > 0.0 && std::isfinite(support.mu) &&
+                  support.mu > 0.0;
+  switch (support.model) {
+    case SupportModel::kPiecewiseConstant: prepared = prepared && !support.rings.empty(); break;
+    case SupportModel::kSmooth: prepared = prepared && !support.rings.empty() && static_cast<bool>(support.density); break;
+    case SupportModel::kDisk: prepared = prepared && support.disk_radius > 0.0; break;
+    case SupportModel::kPoints: prepared = prepared && !support.points.empty(); break;
+  }
+  if (!prepared) {
+    throw LimitSurfaceError("support: not prepared (no region, normal force or friction: a default-constructed Support?); "
+                            "make it with MakeSupport");
+  }
+}
+
 }  // namespace
 
 Load SustainingLoad(const Support& support, const Twist& raw_twist, double* error_estimate) {
+  CheckSupport(support);
   CheckTwist(raw_twist);
   // Loads depend on the twist's direction only: scaling it to O(1) rules out overflow.
   const double scale = std::max({std::abs(raw_twist.vx), std::abs(raw_twist.vy), std::abs(raw_twist.omega)});

@@ -70,6 +70,16 @@ namespace py = pybind11;
 /// Any array-like of numbers, converted to C-contiguous float64 (a copy only when needed).
 using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
+/// A list or tuple holding a bool (at any depth): NumPy reads (True, 0, 0) as the numbers
+/// (1, 0, 0), where a bool array is refused (docs/python.md: booleans are no numbers).
+inline void RefuseBooleansInSequences(const py::handle& object, const char* what) {
+  if (!py::isinstance<py::list>(object) && !py::isinstance<py::tuple>(object)) return;
+  for (const py::handle item : object) {
+    if (PyBool_Check(item.ptr())) throw py::type_error(std::string(what) + ": expected real numbers, got a bool");
+    RefuseBooleansInSequences(item, what);
+  }
+}
+
 /// `a` as an (N, columns) array; a single row (columns,) is taken as N = 1 when `allow_row`.
 /// Throws ValueError naming `what` and the shape it got.
 /// `expected` replaces "an array of shape (N, columns)" in that message (one pose, one point).
@@ -77,6 +87,7 @@ inline Array Rows(const py::handle& object, int columns, const char* what, bool 
                   const char* expected = nullptr) {
   // Real numbers only: NumPy would cast complex numbers (dropping the imaginary part, a warning
   // at most), booleans and None (to NaN) without complaint.
+  RefuseBooleansInSequences(object, what);
   const py::array raw = py::array::ensure(object);
   if (!raw) throw py::type_error(std::string(what) + ": expected an array of numbers");
   const char kind = raw.dtype().kind();
@@ -100,6 +111,7 @@ inline Array Rows(const py::handle& object, int columns, const char* what, bool 
 
 /// A 1-D array of real numbers (times); TypeError / ValueError naming `what` otherwise.
 inline Array Vector(const py::handle& object, const char* what) {
+  RefuseBooleansInSequences(object, what);
   const py::array raw = py::array::ensure(object);
   if (!raw || (raw.dtype().kind() != 'f' && raw.dtype().kind() != 'i' && raw.dtype().kind() != 'u')) {
     throw py::type_error(std::string(what) + ": expected a 1-D array of real numbers");

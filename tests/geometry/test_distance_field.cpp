@@ -3,6 +3,7 @@
 // resolution), the C1 gradient, the conservative continuation outside the grid, and bad options.
 #include <pushgraph/geometry/distance_field.h>
 #include <pushgraph/geometry/point_query.h>
+#include <pushgraph/geometry/shape_pair.h>
 
 #include <gtest/gtest.h>
 
@@ -214,6 +215,24 @@ TEST(DistanceField, MoveAndBadOptions) {
   EXPECT_THROW(DistanceField(s, Opt(1e-9, 0.1)), GeometryError);  // absurdly many samples
   EXPECT_THROW(DistanceField(Shape(), Opt(0.1, 0.1)), GeometryError);
   EXPECT_THROW(h.Evaluate(Vec2(nan, 0)), GeometryError);
+  // Beyond the query coordinates' bound, as the exact query (it answered inf from 1e154 on).
+  EXPECT_THROW(h.Evaluate(Vec2(1e13, 0)), GeometryError);
+  EXPECT_THROW(h.Evaluate(Vec2(0, -1e200)), GeometryError);
+  EXPECT_TRUE(std::isfinite(h.Evaluate(Vec2(1e11, 0))));
+  // A moved-from field is an error, not a null dereference (it crashed).
+  EXPECT_THROW(g.Evaluate(Vec2(0.1, 0.2)), GeometryError);
+  EXPECT_THROW(g.max_error(), GeometryError);
+  EXPECT_THROW(g.rows(), GeometryError);
+}
+
+// A moved-from querier is an error, not a null dereference (it crashed).
+TEST(MovedFrom, AShapePairQuerierSaysSo) {
+  ShapePairQuerier a(Shape::Box(0.1, 0.1), Shape::Disk(0.01));
+  ShapePairQuerier b = std::move(a);
+  EXPECT_NEAR(b.Query(Pose2{}, Pose2{0.2, 0, 0}).signed_distance, 0.14, 1e-12);
+  EXPECT_THROW(a.Query(Pose2{}, Pose2{0.2, 0, 0}), GeometryError);  // NOLINT(bugprone-use-after-move)
+  EXPECT_THROW(a.obstacles_built(), GeometryError);
+  EXPECT_THROW(a.object(), GeometryError);
 }
 
 }  // namespace

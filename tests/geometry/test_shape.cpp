@@ -152,6 +152,9 @@ TEST(ShapeConstruction, ExplicitClosingVertexIsDropped) {
 TEST(ShapeConstruction, ConvexityAndDegenerateCores) {
   EXPECT_TRUE(Shape::Box(1, 2).is_convex());
   EXPECT_TRUE(Shape::RegularPolygon(7, 1).is_convex());
+  // Refused before any allocation (1e9 corners ran out of memory).
+  EXPECT_THROW(Shape::RegularPolygon(1000000000, 1), GeometryError);
+  EXPECT_THROW(Shape::RegularPolygon(2, 1), GeometryError);
   EXPECT_TRUE(Shape::Disk(0.1).is_convex());
   EXPECT_TRUE(Shape::Disk(0.1).is_degenerate_core());
   EXPECT_TRUE(Shape::Capsule(Vec2(0, 0), Vec2(1, 0), 0.1).is_degenerate_core());

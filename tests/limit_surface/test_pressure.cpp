@@ -266,6 +266,24 @@ TEST(LimitSurfacePressure, RejectsBadPressures) {
   EXPECT_THROW(MakeWith(box, Pressure::Points({{{0, 0}, 1.0}})), LimitSurfaceError);  // no extent
   EXPECT_THROW(MakeWith(box, Pressure::Points({{{0, 0}, -1.0}, {{1, 0}, 2.0}})), LimitSurfaceError);
   EXPECT_THROW(MakeWith(Shape::Disk(0.1), Pressure::Linear(1.0, {1.0, 0.0})), LimitSurfaceError);
+  // Non-negative at every vertex, negative inside (it was taken: c 0.0602 on this box).
+  try {
+    MakeWith(box, Pressure::Function([](const Vec2& p) { return p.squaredNorm() - 0.001; }));
+    ADD_FAILURE() << "a pressure negative inside the region was taken";
+  } catch (const LimitSurfaceError& e) {
+    EXPECT_NE(std::string(e.what()).find("negative inside the region"), std::string::npos) << e.what();
+  }
+  // The cell count in 64 bits: 65536 x 65537 read as "expected columns * rows = 65536".
+  GridPressure huge;
+  huge.columns = 65536;
+  huge.rows = 65537;
+  huge.values.assign(65536, 1.0);
+  try {
+    MakeWith(box, Pressure::Grid(huge));
+    ADD_FAILURE() << "a grid with too few values was taken";
+  } catch (const LimitSurfaceError& e) {
+    EXPECT_NE(std::string(e.what()).find("65536 * 65537 = 4295032832"), std::string::npos) << e.what();
+  }
 }
 
 TEST(LimitSurfaceErrors, RejectsBadSupportsAndTwists) {
@@ -296,6 +314,9 @@ TEST(LimitSurfaceErrors, RejectsBadSupportsAndTwists) {
   EXPECT_THROW(SustainingLoad(s, {0, 0, 0}), LimitSurfaceError);
   EXPECT_THROW(SustainingLoad(s, {NAN, 0, 1}), LimitSurfaceError);
   EXPECT_THROW(SustainingLoad(s, {0, INFINITY, 1}), LimitSurfaceError);
+  // A default-constructed Support is refused (Summarize gave c = NaN).
+  EXPECT_THROW(Summarize(Support{}), LimitSurfaceError);
+  EXPECT_THROW(SustainingLoad(Support{}, {1, 0, 0}), LimitSurfaceError);
 }
 
 }  // namespace

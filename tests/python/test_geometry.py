@@ -43,6 +43,11 @@ def test_bad_shapes_name_what_and_where():
         pg.Shape.from_arrays(bowtie)
     with pytest.raises(ValueError, match=r"outer\[2, 0\] is nan: every entry must be finite"):
         pg.Shape.from_arrays([[0, 0], [1, 0], [np.nan, 1]])
+    # A bool inside a list or tuple is no number, as a bool array is not (NumPy read it as 1).
+    with pytest.raises(TypeError, match="points: expected real numbers, got a bool"):
+        pg.Shape.box(0.1, 0.06).signed_distance([[True, 0.0]])
+    with pytest.raises(TypeError, match="got a bool"):
+        pg.Shape.box(0.1, 0.06).transformed((True, 0, 0))
     with pytest.raises(ValueError, match=r"shape \(N, 2\), got \(3, 3\)"):
         pg.Shape.from_arrays(np.zeros((3, 3)))
     with pytest.raises(ValueError, match="unknown key 'hole'"):

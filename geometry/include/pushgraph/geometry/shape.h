@@ -50,7 +50,7 @@ class Shape {
   static Shape Capsule(const Vec2& a, const Vec2& b, double radius);
   /// Axis-aligned rectangle centred at the origin, optionally rounded.
   static Shape Box(double width, double height, double radius = 0.0);
-  /// Convex regular n-gon centred at the origin with circumradius `circumradius`.
+  /// Convex regular n-gon centred at the origin with circumradius `circumradius` (3 <= n <= 1e6).
   static Shape RegularPolygon(int n, double circumradius, double radius = 0.0);
 
   bool empty() const;

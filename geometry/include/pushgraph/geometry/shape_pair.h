@@ -28,7 +28,7 @@
 //
 //   ShapePairQuerier contact(object, finger);           // keep it: it caches obstacles
 //   ShapePairResult r = contact.Query(object_pose, finger_pose);
-//   if (r.intersecting) { push finger along r.direction by r.depth to separate }
+//   if (r.intersecting) { move the finger along r.normal by r.depth to separate }
 #include <pushgraph/geometry/pose.h>
 #include <pushgraph/geometry/shape.h>
 

@@ -87,6 +87,8 @@ struct SolverStats {
   /// Wall time of the whole Estimate call: the input checks, the shape check and registration
   /// (and the placements it compares), the estimate and its self-diagnosis. Under align_shape
   /// "auto" the shape check can take longer than the estimate itself (time_s leaves it out).
+  /// 0 in IncrementalEstimator's and OnlineEstimator's results, which are no Estimate call (their
+  /// time_s and update_times_s say how long they took).
   double total_time_s = 0.0;
   double final_cost = 0.0; ///< batch: final cost; incremental: cost of the last window
   int updates = 0;         ///< incremental updates (1 for batch)

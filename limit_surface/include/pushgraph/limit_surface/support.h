@@ -29,8 +29,8 @@ using geometry::Vec2;
 
 /// Standard gravity, m/s^2.
 inline constexpr double kStandardGravity = 9.80665;
-/// The supported ranges (docs/limit_surface.md): mass in (0, kMaxMass] kg, friction coefficients
-/// in [0, kMaxFriction], gravity in (0, kMaxGravity] m/s^2. Beyond them no pushing experiment
+/// The supported ranges (docs/limit_surface.md): mass in (0, kMaxMass] kg, the surface's friction
+/// coefficient mu in (0, kMaxFriction] (without friction there is no limit surface), gravity in (0, kMaxGravity] m/s^2. Beyond them no pushing experiment
 /// exists and products like mu m g |r| overflow or lose their meaning: refused.
 inline constexpr double kMaxMass = 1e6;
 inline constexpr double kMaxFriction = 10.0;
@@ -83,7 +83,7 @@ struct SupportSpec {
   geometry::Shape region;
   Pressure pressure;
   double mass = 0.0;                    ///< kg, > 0
-  double mu = 0.0;                      ///< object-surface Coulomb coefficient, >= 0
+  double mu = 0.0;                      ///< object-surface Coulomb coefficient, in (0, kMaxFriction]
   double gravity = kStandardGravity;    ///< m/s^2, > 0
   double relative_tolerance = 1e-12;    ///< quadrature target (non-uniform pressures only)
 };
