@@ -1312,7 +1312,7 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
     std::snprintf(text, sizeof text,
                   "the object's shape fits this recording within the tolerance, but the contacts (log-likelihood +%.1f) "
                   "and the whole graph fit it clearly better elsewhere; ",
-                  registration->identity_cost - registration->aligned_cost);
+                  registration->evidence);
     warnings.push_back(text + AlignedText(*registration, alignment));
   }
   if (frame_wins && alignment.aligned) {
@@ -1359,7 +1359,7 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
     alignment.notes.push_back(internal::Format(
         "the contacts fit the shape better %s (log-likelihood +%.1f), but the whole graph rejects that placement "
         "(by more than %.0f in cost): the shape as given is used",
-        contacts_best.c_str(), registration->identity_cost - registration->aligned_cost, kFrameMargin));
+        contacts_best.c_str(), registration->evidence, kFrameMargin));
   } else if (registration && registration->fits_as_given && registration->better_elsewhere && !alignment.aligned) {
     // The gaps are within tolerance, but a different placement explains the contacts clearly
     // better: say so; aligning on this alone misfired on pushes that break the model.
@@ -1375,7 +1375,7 @@ EstimationResult EstimateValidated(const push::Trajectory& trajectory, Model mod
     warnings.push_back(internal::Format("the object's shape fits this recording within the tolerance, but the contacts fit it "
                                         "better %s (log-likelihood +%.1f)%s",
                                         registration->Describe().c_str(),
-                                        registration->identity_cost - registration->aligned_cost,
+                                        registration->evidence,
                                         suspect && !unit_gate ? ", though the whole graph does not (the estimate uses the shape as given)" : "") +
                        advice);
   }

@@ -117,6 +117,13 @@ bool ForceSaysTouching(const std::vector<push::ForceSample>& force, double t, do
   return Vec2(Median(x), Median(y)).norm() >= std::max(threshold, 5.0 * sigma / std::sqrt(n));
 }
 
+bool ForceContactHeld(const std::vector<push::ForceSample>& force, double t, double max_gap, double threshold,
+                      double sigma) {
+  constexpr double kHold = 0.05;  // s: three windows 0.1 s apart in all, each of +-20 ms
+  auto says = [&](double at) { return ForceSaysTouching(force, at, max_gap, threshold, sigma); };
+  return says(t) && ((says(t + kHold) && says(t + 2.0 * kHold)) || (says(t - kHold) && says(t - 2.0 * kHold)));
+}
+
 GraphBuilder::GraphBuilder(const push::Trajectory& trajectory, Model model, const EstimatorConfig& config,
                            std::shared_ptr<const geometry::ShapePairQuerier> querier)
     : traj_(trajectory), model_(model), cfg_(config) {
@@ -228,20 +235,21 @@ int GraphBuilder::AppendSteps(double until) {
   force_contact_last_.resize(num_fingers(), -INFINITY);
   if (!streams_.contact_point && !object_moving_seen_)
     object_moving_seen_ = ObjectSeenMoving(m.object_pose, cfg_.measurement.object_trans, &object_poses_seen_);
-  if (contact_reach_.empty()) {
-    const double sigma = std::hypot(cfg_.measurement.object_trans, cfg_.measurement.finger_trans);
-    for (int k = 0; k < num_fingers(); ++k) contact_reach_.emplace_back(traj_.object.shape, FingerShape(k), sigma);
-  }
+  force_contact_held_.resize(num_fingers(), 0);
   for (int k = 0; k < num_fingers() && !streams_.contact_point; ++k) {
     const auto& force = ForceRows(k);
     for (std::size_t& j = force_samples_seen_[k]; j < force.size(); ++j) {
       if (!ForceSaysTouching(force, force[j].t, cfg_.contact_max_gap, cfg_.contact_force_threshold, cfg_.measurement.force))
         continue;
-      if (contact_reach_[k].OutOfReach(m.object_pose, FingerPoseRows(k), force[j].t)) continue;
       force_contact_first_[k] = std::min(force_contact_first_[k], force[j].t);
       force_contact_last_[k] = force[j].t;
+      // A contact is seen only where the force holds it for 0.1 s somewhere (ForceContactHeld);
+      // the span it opens still starts at the first crossing (a contact's onset crosses on and off).
+      if (!force_contact_held_[k] &&
+          ForceContactHeld(force, force[j].t, cfg_.contact_max_gap, cfg_.contact_force_threshold, cfg_.measurement.force))
+        force_contact_held_[k] = 1;
     }
-    force_contact_seen_[k] = std::isfinite(force_contact_first_[k]) || object_moving_seen_;
+    force_contact_seen_[k] = force_contact_held_[k] || object_moving_seen_;
   }
   auto touching = [&](const std::vector<push::PointSample>& contact, const std::vector<push::ForceSample>& force,
                       double t, int finger) {
@@ -256,7 +264,6 @@ int GraphBuilder::AppendSteps(double until) {
     if (std::isfinite(force_contact_first_[finger]) &&
         (t < force_contact_first_[finger] - 0.1 || t > force_contact_last_[finger] + 0.1))
       return false;
-    if (contact_reach_[finger].OutOfReach(m.object_pose, FingerPoseRows(finger), t)) return false;
     int k = -1;
     const double gap = NearestGap(force, t, &k);
     return k >= 0 && gap <= cfg_.contact_max_gap && force[k].force.norm() >= cfg_.contact_force_threshold;

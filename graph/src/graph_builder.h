@@ -123,22 +123,6 @@ struct SolveOutcome {
   std::unique_ptr<ChainSolver> chain;
 };
 
-/// Where a finger can touch the object at all: its origin within `reach` of the object's core
-/// centroid, reach = max(2 R_object, 0.1 m) + R_finger + 5 sigma (R: each shape's radius about its
-/// centroid, or origin; sigma the two pose streams' translation noises combined; twice the
-/// object's radius and the 0.1 m floor leave room for a shape file off by its own size or in
-/// other units, which the registration judges). A force stream reading noise alone at 0.05 N had
-/// a finger 0.2 m from a resting box gated into contact and the box dragged 120 mm.
-struct ContactReach {
-  geometry::Vec2 centroid{0.0, 0.0};  ///< object frame
-  double reach = INFINITY;
-  ContactReach() = default;
-  ContactReach(const geometry::Shape& object, const geometry::Shape& finger, double sigma_trans);
-  /// True when both streams have a pose within 0.1 s of `t` and, interpolated there, the finger
-  /// lies beyond reach (an object unseen for longer may have been pushed anywhere).
-  bool OutOfReach(const std::vector<push::PoseSample>& object_poses, const std::vector<push::PoseSample>& finger_poses,
-                  double t) const;
-};
 
 class GraphBuilder {
  public:
@@ -461,7 +445,7 @@ class GraphBuilder {
   std::vector<std::size_t> force_samples_seen_;
   /// Per finger: the first and last times its force stream showed a contact above its noise.
   std::vector<double> force_contact_first_, force_contact_last_;
-  std::vector<ContactReach> contact_reach_;  // per finger: where a force-gated contact can be
+  std::vector<char> force_contact_held_;  // per finger: ForceContactHeld somewhere
   bool object_moving_seen_ = false;
   std::size_t object_poses_seen_ = 0;
   std::unordered_map<ceres::ResidualBlockId, std::pair<FactorType, int>> origin_;  ///< for Describe
@@ -644,6 +628,12 @@ double LongObjectGap(const push::Trajectory& trajectory);
 /// RMS (a light touch without a pushing model) and the QS force NEES 3.0 -> 7.7.
 bool ForceSaysTouching(const std::vector<push::ForceSample>& force, double t, double max_gap, double threshold,
                        double sigma);
+/// A contact the force stream holds: ForceSaysTouching at t and at the two times 0.05 and 0.1 s
+/// after it, or before it (the end of a contact). One window's median crosses the noise bound now
+/// and then: a force stream reading its declared 0.05 N noise alone, with the finger 0.2 m from a
+/// resting box, had such crossings open a contact span and the box dragged 120 mm.
+bool ForceContactHeld(const std::vector<push::ForceSample>& force, double t, double max_gap, double threshold,
+                      double sigma);
 /// Whether the object is seen to move: the median position of five consecutive poses more than
 /// max(2 cm, 4 sigma) from that of the first five. Scans from *scanned (updated) so a growing
 /// stream costs its new samples only. Something moved it, so a force stream under its noise

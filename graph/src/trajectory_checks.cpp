@@ -1144,24 +1144,6 @@ bool FingerPoseNear(const std::vector<push::PoseSample>& finger_poses, double t)
   return !finger_poses.empty() && std::abs(NearestInTime(finger_poses, t).t - t) <= kNearInTime;
 }
 
-ContactReach::ContactReach(const geometry::Shape& object, const geometry::Shape& finger, double sigma_trans)
-    : centroid(geometry::CoreCentroid(object)) {
-  constexpr double kReachFloor = 0.1;  // m
-  reach = std::max(2.0 * geometry::RadiusAbout(object, centroid), kReachFloor) +
-          geometry::RadiusAbout(finger, geometry::Vec2::Zero()) + 5.0 * sigma_trans;
-}
-
-bool ContactReach::OutOfReach(const std::vector<push::PoseSample>& object_poses,
-                              const std::vector<push::PoseSample>& finger_poses, double t) const {
-  constexpr double kNearInTime = 0.1;  // s
-  if (!std::isfinite(reach) || object_poses.empty() || finger_poses.empty()) return false;
-  if (std::abs(NearestInTime(object_poses, t).t - t) > kNearInTime || std::abs(NearestInTime(finger_poses, t).t - t) > kNearInTime)
-    return false;
-  const geometry::Vec2 object_centre = geometry::Act(push::PoseAtClamped(object_poses.begin(), object_poses.end(), t), centroid);
-  const geometry::Pose2 finger = push::PoseAtClamped(finger_poses.begin(), finger_poses.end(), t);
-  return (geometry::Vec2(finger.x, finger.y) - object_centre).norm() > reach;
-}
-
 double DistanceFromFinger(const std::vector<push::PoseSample>& finger_poses, const geometry::Shape& finger, double t,
                           const geometry::Vec2& point) {
   // The finger's pose at the contact's time, interpolated (a 10 Hz tracker at 0.3 m/s moves the

@@ -2,6 +2,8 @@
 // of pressure, and the integration model (see SupportModel in support.h).
 #include "detail.h"
 
+#include <pushgraph/geometry/point_query.h>
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -146,20 +148,24 @@ std::function<double(const Vec2&)> UserDensity(const Pressure& pressure, int* de
   };
 }
 
-void PrepareSmooth(Support& support, const std::vector<std::vector<Vec2>>& rings, const Pressure& pressure) {
+void PrepareSmooth(Support& support, const geometry::Shape& region, const std::vector<std::vector<Vec2>>& rings,
+                   const Pressure& pressure) {
   int degree = -1;
   std::function<double(const Vec2&)> user = UserDensity(pressure, &degree);
   for (const std::vector<Vec2>& ring : rings)
     for (const Vec2& p : ring)
       if (user(p) < 0.0) Fail("the pressure is negative at the region vertex " + Describe(p));
   // Total and first moment with a fan rule from the centroid (exact for polynomials). Its nodes
-  // also check the sign inside: |r|^2 - 0.001 on a 0.1 m box, >= 0 at every vertex and negative
-  // at the centre, was taken (c 0.0602, where c can be at most about 0.04 on that box).
+  // inside the region also check the sign: |r|^2 - 0.001 on a 0.1 m box, >= 0 at every vertex and
+  // negative at the centre, was taken (c 0.0602, where c can be at most about 0.04 on that box).
+  // Nodes in holes and notches (the fan covers the convex hull; their parts cancel) are not the
+  // region's: a pressure negative only there is valid.
   Eigen::Vector3d moments = Eigen::Vector3d::Zero();
   for (const std::vector<Vec2>& ring : rings)
     moments += detail::FanIntegral(ring, support.centroid, 20, [&](const Vec2& r) -> Eigen::Vector3d {
       const double p = user(r);
-      if (p < 0.0) Fail("the pressure is negative inside the region, at " + Describe(r) + " (" + Number(p) + ")");
+      if (p < 0.0 && geometry::QueryPoint(region, r).signed_distance < 0.0)
+        Fail("the pressure is negative inside the region, at " + Describe(r) + " (" + Number(p) + ")");
       return {p, p * r.x(), p * r.y()};
     });
   if (!(moments.x() > 0.0)) Fail("the pressure integrates to " + Number(moments.x()) + " (must be > 0)");
@@ -237,7 +243,7 @@ void PreparePolygons(Support& support, const geometry::Shape& region, const Pres
     case PressureKind::kLinear:
     case PressureKind::kFunction:
       support.model = SupportModel::kSmooth;
-      PrepareSmooth(support, rings, pressure);
+      PrepareSmooth(support, region, rings, pressure);
       return;
     case PressureKind::kPoints:
       support.model = SupportModel::kPoints;

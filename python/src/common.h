@@ -72,11 +72,16 @@ using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
 /// A list or tuple holding a bool (at any depth): NumPy reads (True, 0, 0) as the numbers
 /// (1, 0, 0), where a bool array is refused (docs/python.md: booleans are no numbers).
-inline void RefuseBooleansInSequences(const py::handle& object, const char* what) {
-  if (!py::isinstance<py::list>(object) && !py::isinstance<py::tuple>(object)) return;
+/// NumPy's own bools (np.True_) too. At most 32 levels deep, NumPy's own limit on dimensions (a
+/// list holding itself recursed until the stack overflowed); deeper is left to NumPy's error.
+inline void RefuseBooleansInSequences(const py::handle& object, const char* what, int depth = 0) {
+  if (depth > 32 || (!py::isinstance<py::list>(object) && !py::isinstance<py::tuple>(object))) return;
+  // Held for the process's life (a static py::object would be released after the interpreter).
+  static PyObject* const numpy_bool = py::object(py::module_::import("numpy").attr("bool_")).release().ptr();
   for (const py::handle item : object) {
-    if (PyBool_Check(item.ptr())) throw py::type_error(std::string(what) + ": expected real numbers, got a bool");
-    RefuseBooleansInSequences(item, what);
+    if (PyBool_Check(item.ptr()) || PyObject_IsInstance(item.ptr(), numpy_bool) == 1)
+      throw py::type_error(std::string(what) + ": expected real numbers, got a bool");
+    RefuseBooleansInSequences(item, what, depth + 1);
   }
 }
 

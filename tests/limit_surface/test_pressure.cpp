@@ -273,6 +273,19 @@ TEST(LimitSurfacePressure, RejectsBadPressures) {
   } catch (const LimitSurfaceError& e) {
     EXPECT_NE(std::string(e.what()).find("negative inside the region"), std::string::npos) << e.what();
   }
+  // Negative only in a hole or a notch, outside the region, is valid (the fan rule's nodes there
+  // are not the region's; a review found both refused by the first version of the check).
+  geometry::Polygon annulus;
+  annulus.outer = {{-0.05, -0.05}, {0.05, -0.05}, {0.05, 0.05}, {-0.05, 0.05}};
+  annulus.holes = {{{-0.02, -0.02}, {-0.02, 0.02}, {0.02, 0.02}, {0.02, -0.02}}};
+  EXPECT_NO_THROW(MakeWith(Shape::FromPolygons({annulus}), Pressure::Function([](const Vec2& r) {
+                             return std::max(std::abs(r.x()), std::abs(r.y())) - 0.02;
+                           })));
+  geometry::Polygon u;
+  u.outer = {{-0.05, -0.05}, {0.05, -0.05}, {0.05, 0.05}, {0.03, 0.05}, {0.03, -0.03}, {-0.03, -0.03}, {-0.03, 0.05}, {-0.05, 0.05}};
+  EXPECT_NO_THROW(MakeWith(Shape::FromPolygons({u}), Pressure::Function([](const Vec2& r) {
+                             return std::max(std::abs(r.x()) - 0.03, -0.03 - r.y());
+                           })));
   // The cell count in 64 bits: 65536 x 65537 read as "expected columns * rows = 65536".
   GridPressure huge;
   huge.columns = 65536;

@@ -48,6 +48,13 @@ def test_bad_shapes_name_what_and_where():
         pg.Shape.box(0.1, 0.06).signed_distance([[True, 0.0]])
     with pytest.raises(TypeError, match="got a bool"):
         pg.Shape.box(0.1, 0.06).transformed((True, 0, 0))
+    with pytest.raises(TypeError, match="got a bool"):
+        pg.Shape.box(0.1, 0.06).signed_distance([[np.True_, 0.0]])
+    # A list holding itself is NumPy's error, not a crash (the bool scan recursed without end).
+    loop = []
+    loop.append(loop)
+    with pytest.raises((ValueError, TypeError)):
+        pg.Shape.box(0.1, 0.06).signed_distance(loop)
     with pytest.raises(ValueError, match=r"shape \(N, 2\), got \(3, 3\)"):
         pg.Shape.from_arrays(np.zeros((3, 3)))
     with pytest.raises(ValueError, match="unknown key 'hole'"):
