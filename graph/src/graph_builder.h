@@ -123,7 +123,6 @@ struct SolveOutcome {
   std::unique_ptr<ChainSolver> chain;
 };
 
-
 class GraphBuilder {
  public:
   /// Solves `problem` (built by this builder) with config.solver; `what` names the stage in

@@ -469,14 +469,15 @@ RegistrationResult RegisterShape(const std::vector<const push::Trajectory*>& rec
   result.gaps.assign(best.gap.data(), best.gap.data() + best.gap.size());
 
   // The shape as given, scored by the same fit, and the gap statistics.
+  double gain_without_prior = 0.0;  // identity_cost - aligned_cost without the centroid prior's parts
   {
     ContactFit as_given(file_shape, refine, finger, disk, noise, o.centroid_prior * file_radius, o.gap_sigma);
     as_given.UseExactFinger(f.exact_finger);  // the same shape when the file won as given
     Placement identity = as_given.Start();
     as_given.Minimize(&identity, Active{false, false, false, true}, 20);  // its own calibration gaps
     result.identity_cost = identity.cost;
-    result.identity_prior_cost = 0.5 * as_given.Prior(identity, nullptr).squaredNorm();
-    result.aligned_prior_cost = 0.5 * fit.Prior(best, nullptr).squaredNorm();
+    gain_without_prior = (identity.cost - 0.5 * as_given.Prior(identity, nullptr).squaredNorm()) -
+                         (best.cost - 0.5 * fit.Prior(best, nullptr).squaredNorm());
     std::vector<double> gaps;
     for (std::size_t i = 0; i < as_given.size(); ++i) gaps.push_back(std::abs(as_given.Gap(i, as_given.Start())));
     result.identity_gap_rms = 1.4826 * WeightedMedian(gaps, refine.weight);
@@ -509,9 +510,7 @@ RegistrationResult RegisterShape(const std::vector<const push::Trajectory*>& rec
   // rim) and only the prior tells.
   const bool origin_on_outline =
       geometry::QueryPoint(file_shape, geometry::Vec2::Zero()).signed_distance >= -1e-3 * file_radius;
-  result.evidence = origin_on_outline ? (result.identity_cost - result.identity_prior_cost) -
-                                            (result.aligned_cost - result.aligned_prior_cost)
-                                      : result.identity_cost - result.aligned_cost;
+  result.evidence = origin_on_outline ? gain_without_prior : result.identity_cost - result.aligned_cost;
   result.better_elsewhere = !equivalent && result.evidence >= o.misfit_evidence && result.displacement > o.fit_tolerance;
   // With estimate_scale the continuous scale of a true shape comes back near, never at, 1 (0.9987
   // on a simulated push of the notched block): within three sigmas of 1, or moving the outline

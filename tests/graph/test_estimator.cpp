@@ -554,7 +554,7 @@ TEST(Estimator, ACorruptContactRowIsLeftOutByName) {
 // A resting box, a finger 0.15 to 0.25 m away that never touches it, and a force sensor reading
 // its declared noise (0.05 N) alone: the noise's chance crossings gated the finger into contact
 // and the box was dragged 120 mm (30 mm RMS against 1.5 mm raw; a hostile user's probe,
-// 2026-11-30). A finger beyond reach of the object is never gated in (ContactReach).
+// 2026-11-30). A contact is seen only where the force holds it for 0.1 s (ForceContactHeld).
 TEST(Estimator, ForceNoiseDoesNotGateAFarFingerIntoContact) {
   for (const bool sweeping : {false, true}) {
     push::Trajectory tr;

@@ -174,7 +174,6 @@ struct RegistrationResult {
   double identity_gap_rms = 0.0;  ///< robust RMS (m) of sd - r over the contact samples, as given
   double aligned_gap_rms = 0.0;   ///< the same with the transform
   double identity_cost = 0.0, aligned_cost = 0.0;  ///< Cauchy costs (including the prior)
-  double identity_prior_cost = 0.0, aligned_prior_cost = 0.0;  ///< the centroid prior's part of each
   /// The log-likelihood gain better_elsewhere weighs: identity_cost - aligned_cost, without the
   /// centroid prior's parts where the file's origin lies on or outside its outline (a CAD corner).
   double evidence = 0.0;
